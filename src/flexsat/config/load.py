@@ -1,0 +1,108 @@
+"""Loading satellite configurations from TOML, with one clear message per mistake."""
+
+from __future__ import annotations
+
+import difflib
+import tomllib
+from importlib import resources
+from pathlib import Path
+from typing import Any
+
+from pydantic import BaseModel, ValidationError
+
+from flexsat.config.models import SatelliteConfig
+from flexsat.errors import ConfigError
+
+__all__ = ["PRESETS", "load_config", "nominal", "preset_path", "validate_config"]
+
+PRESETS = ("nominal",)
+
+
+def preset_path(name: str) -> Path:
+    """Path of a shipped preset TOML file (copy it to start your own)."""
+    if name not in PRESETS:
+        raise ConfigError(f"unknown preset {name!r}; available: {', '.join(PRESETS)}")
+    return Path(str(resources.files("flexsat.config") / "presets" / f"{name}.toml"))
+
+
+def nominal() -> SatelliteConfig:
+    """The nominal case study of the reference thesis (table 3.1), the built-in default."""
+    return load_config(preset_path("nominal"))
+
+
+def load_config(path: str | Path | None = None) -> SatelliteConfig:
+    """Read and validate a satellite configuration.
+
+    Parameters
+    ----------
+    path : str or Path, optional
+        TOML file; ``None`` gives the built-in nominal case study.
+
+    Raises
+    ------
+    ConfigError
+        If the file is missing or unreadable, or any field is invalid; the message
+        names the field and the allowed range.
+    """
+    if path is None:
+        return nominal()
+    path = Path(path)
+    try:
+        data = tomllib.loads(path.read_text(encoding="utf-8"))
+    except FileNotFoundError:
+        raise ConfigError(f"config file not found: {path}") from None
+    except (OSError, UnicodeDecodeError) as exc:
+        raise ConfigError(f"cannot read config file {path}: {exc}") from None
+    except tomllib.TOMLDecodeError as exc:
+        raise ConfigError(f"{path}: not valid TOML: {exc}") from None
+    return validate_config(data, source=str(path))
+
+
+def validate_config(
+    data: dict[str, Any], source: str = "config", model: type[BaseModel] = SatelliteConfig
+) -> Any:
+    """Validate a plain dict as ``model`` and turn the first error into a :class:`ConfigError`."""
+    try:
+        return model.model_validate(data)
+    except ValidationError as exc:
+        raise ConfigError(f"{source}: {_describe(exc.errors()[0], model)}") from None
+
+
+def _describe(error: dict[str, Any], model: type[BaseModel]) -> str:
+    location = ".".join(str(part) for part in error["loc"]) or "(top level)"
+    kind = error["type"]
+    if kind == "extra_forbidden":
+        known = _known_keys(model, error["loc"][:-1])
+        hint = difflib.get_close_matches(str(error["loc"][-1]), known, n=1)
+        suggestion = f"; did you mean {hint[0]!r}?" if hint else ""
+        return f"unknown key {location!r}{suggestion} (allowed here: {', '.join(known)})"
+    if kind == "missing":
+        return f"missing required field {location!r}"
+    message = error["msg"].removeprefix("Value error, ")
+    if "input" in error and kind not in ("model_type", "dict_type"):
+        return f"{location}: {message} (got {error['input']!r})"
+    return f"{location}: {message}"
+
+
+def _known_keys(model: type[BaseModel], loc: tuple[Any, ...]) -> list[str]:
+    """Field names of the (sub)model at ``loc``, for unknown-key suggestions."""
+    current: Any = model
+    for part in loc:
+        if isinstance(part, int):
+            continue
+        field = current.model_fields.get(part) if hasattr(current, "model_fields") else None
+        if field is None:
+            return []
+        current = _model_of(field.annotation)
+    return sorted(current.model_fields) if hasattr(current, "model_fields") else []
+
+
+def _model_of(annotation: Any) -> Any:
+    """The BaseModel inside an annotation such as ``list[Model]`` or ``Model | None``."""
+    if isinstance(annotation, type) and issubclass(annotation, BaseModel):
+        return annotation
+    for arg in getattr(annotation, "__args__", ()):
+        found = _model_of(arg)
+        if found is not None:
+            return found
+    return None

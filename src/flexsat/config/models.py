@@ -1,0 +1,201 @@
+"""Validated, immutable parameter models of the flexible satellite.
+
+The models are frozen pydantic objects: they check themselves on construction and
+refuse unknown keys, wrong types, non-finite numbers and out-of-range values.
+Variants are derived by validating a modified dict (``load.validate_config``),
+never by mutation.
+
+Units are SI; angles at this boundary are in degrees and every such field says so
+(``sadm_angle_deg``). Frames: hub body frame B, mount frame M_i (fixed to the hub at
+the appendage root), panel frame P_i (moves with the appendage); see
+``docs/model.md``.
+"""
+
+from __future__ import annotations
+
+from typing import Annotated, Literal
+
+import numpy as np
+from pydantic import AllowInfNan, BaseModel, ConfigDict, Field, Strict, model_validator
+
+__all__ = [
+    "AppendageConfig",
+    "HubConfig",
+    "SatelliteConfig",
+    "TargetFrequencies",
+]
+
+# A real number: ints are accepted, strings and booleans are not, NaN and inf are not.
+Real = Annotated[float, Strict(), AllowInfNan(False)]
+Positive = Annotated[float, Strict(), AllowInfNan(False), Field(gt=0.0)]
+Angle = Annotated[float, Strict(), AllowInfNan(False), Field(ge=-360.0, le=360.0)]
+Vector3 = tuple[Real, Real, Real]
+Matrix3 = tuple[Vector3, Vector3, Vector3]
+
+
+class _Frozen(BaseModel):
+    model_config = ConfigDict(frozen=True, extra="forbid", validate_default=True)
+
+
+class HubConfig(_Frozen):
+    """Rigid central body.
+
+    Give either ``radius_m`` and ``height_m`` (homogeneous cylinder about hub Z,
+    thesis eqs. 2.3-2.4) or an explicit ``inertia_kg_m2`` about the hub centre of
+    mass in hub frame B.
+    """
+
+    mass_kg: Positive = Field(description="hub mass [kg]")
+    radius_m: Positive | None = Field(None, description="cylinder radius [m]")
+    height_m: Positive | None = Field(None, description="cylinder height along hub Z [m]")
+    inertia_kg_m2: Matrix3 | None = Field(
+        None, description="inertia about the hub centre of mass, hub frame B [kg m^2]"
+    )
+
+    @model_validator(mode="after")
+    def _geometry_or_inertia(self) -> HubConfig:
+        has_cylinder = self.radius_m is not None or self.height_m is not None
+        if self.inertia_kg_m2 is not None:
+            if has_cylinder:
+                raise ValueError(
+                    "give either radius_m and height_m or inertia_kg_m2, not both"
+                )
+            _check_inertia(np.array(self.inertia_kg_m2, dtype=float))
+        elif self.radius_m is None or self.height_m is None:
+            raise ValueError(
+                "give both radius_m and height_m (cylinder), or inertia_kg_m2 (3x3)"
+            )
+        return self
+
+    def inertia(self) -> np.ndarray:
+        """Inertia about the hub centre of mass in hub frame B, shape (3, 3) [kg m^2]."""
+        if self.inertia_kg_m2 is not None:
+            return np.array(self.inertia_kg_m2, dtype=float)
+        m, r, h = self.mass_kg, self.radius_m, self.height_m
+        j_xx = m * (3.0 * r**2 + h**2) / 12.0  # eq. 2.3
+        j_zz = 0.5 * m * r**2  # eq. 2.4
+        return np.diag([j_xx, j_xx, j_zz])
+
+
+def _check_inertia(j: np.ndarray) -> None:
+    scale = float(np.max(np.abs(j)))
+    if scale == 0.0 or np.max(np.abs(j - j.T)) > 1e-9 * scale:
+        raise ValueError("inertia_kg_m2 must be symmetric (J == J^T)")
+    principal = np.linalg.eigvalsh(j)
+    if principal[0] <= 0.0:
+        raise ValueError(
+            f"inertia_kg_m2 must be positive definite (principal moments > 0, "
+            f"got {principal.min():.6g})"
+        )
+    # A rigid body's principal moments obey the triangle inequality J1 + J2 >= J3.
+    if principal[0] + principal[1] < principal[2] * (1.0 - 1e-9):
+        raise ValueError(
+            "inertia_kg_m2 is not a rigid body's: the principal moments must satisfy "
+            "J1 + J2 >= J3"
+        )
+
+
+class TargetFrequencies(_Frozen):
+    """Cantilever (clamped-root) natural frequencies of one appendage, per joint DOF [Hz].
+
+    Rotations are about the mount frame axes: flapping about X_M (out-of-plane
+    bending), torsion about Y_M (the span axis), in-plane bending about Z_M.
+    """
+
+    flapping: Positive = Field(description="out-of-plane bending, rotation about X_M [Hz]")
+    in_plane: Positive = Field(description="in-plane bending, rotation about Z_M [Hz]")
+    torsion: Positive = Field(description="torsion, rotation about Y_M [Hz]")
+    translation_x: Positive = Field(description="root translation along X_M [Hz]")
+    translation_y: Positive = Field(description="root translation along Y_M [Hz]")
+    translation_z: Positive = Field(description="root translation along Z_M [Hz]")
+
+    def per_dof(self) -> np.ndarray:
+        """Frequencies in joint-DOF order, shape (6,) [Hz].
+
+        Order: [eta_x, eta_y, eta_z, eta_rx, eta_ry, eta_rz].
+        """
+        return np.array(
+            [
+                self.translation_x,
+                self.translation_y,
+                self.translation_z,
+                self.flapping,
+                self.torsion,
+                self.in_plane,
+            ]
+        )
+
+
+class AppendageConfig(_Frozen):
+    """One flexible appendage: a rigid thin plate on a 6-DOF elastic root joint.
+
+    The mount frame M is the hub frame B rotated by ``mount_yaw_deg`` about Z_B and
+    then by the SADM angle about the resulting Y axis; its origin is
+    ``mount_point_m``. The plate spans ``length_m`` along +Y_P or -Y_P
+    (``span_direction``), ``width_m`` along X_P and ``thickness_m`` along Z_P.
+    Give the mass either as ``surface_density_kg_m2`` (eq. 2.6) or as ``mass_kg``.
+    """
+
+    name: Annotated[str, Field(min_length=1, max_length=64)]
+    mount_point_m: Vector3 = Field(description="root position from hub centre of mass, frame B [m]")
+    mount_yaw_deg: Angle = Field(0.0, description="mount frame rotation about Z_B [deg]")
+    sadm_angle_deg: Angle = Field(0.0, description="SADM angle about Y_M [deg]")
+    span_direction: Literal["+y", "-y"] = Field("+y", description="span along +Y_M or -Y_M")
+    length_m: Positive = Field(description="span L_p [m]")
+    width_m: Positive = Field(description="chord W_p [m]")
+    thickness_m: Positive = Field(description="thickness t_p [m]")
+    surface_density_kg_m2: Positive | None = Field(None, description="rho_sup [kg/m^2]")
+    mass_kg: Positive | None = Field(None, description="panel mass M_p [kg]")
+    target_frequencies_hz: TargetFrequencies
+    damping_ratio: Annotated[float, Strict(), AllowInfNan(False), Field(ge=0.0, lt=1.0)] = Field(
+        description="viscous damping ratio zeta of every joint DOF [-]"
+    )
+
+    @model_validator(mode="after")
+    def _one_mass(self) -> AppendageConfig:
+        if (self.surface_density_kg_m2 is None) == (self.mass_kg is None):
+            raise ValueError("give exactly one of surface_density_kg_m2 and mass_kg")
+        if self.thickness_m > min(self.length_m, self.width_m):
+            raise ValueError("thickness_m must not exceed length_m or width_m (thin plate)")
+        return self
+
+    @property
+    def mass(self) -> float:
+        """Panel mass M_p [kg] (eq. 2.6 when given as a surface density)."""
+        if self.mass_kg is not None:
+            return self.mass_kg
+        return self.surface_density_kg_m2 * self.length_m * self.width_m  # eq. 2.6
+
+    def centroidal_inertia(self) -> np.ndarray:
+        """Inertia about the panel centre of mass in panel frame P, shape (3, 3) [kg m^2].
+
+        Thin plate with the span along Y_P (eqs. 2.9-2.11).
+        """
+        m, length, width, t = self.mass, self.length_m, self.width_m, self.thickness_m
+        return np.diag(
+            [
+                m * (length**2 + t**2) / 12.0,  # eq. 2.9
+                m * (width**2 + t**2) / 12.0,  # eq. 2.10
+                m * (length**2 + width**2) / 12.0,  # eq. 2.11
+            ]
+        )
+
+    def span_sign(self) -> float:
+        """+1 when the plate spans along +Y_P, -1 along -Y_P."""
+        return 1.0 if self.span_direction == "+y" else -1.0
+
+
+class SatelliteConfig(_Frozen):
+    """A hub and its list of flexible appendages."""
+
+    name: Annotated[str, Field(min_length=1, max_length=128)] = "satellite"
+    hub: HubConfig
+    appendages: Annotated[list[AppendageConfig], Field(min_length=1, max_length=64)]
+
+    @model_validator(mode="after")
+    def _unique_names(self) -> SatelliteConfig:
+        names = [a.name for a in self.appendages]
+        duplicated = sorted({n for n in names if names.count(n) > 1})
+        if duplicated:
+            raise ValueError(f"appendage names must be unique, repeated: {duplicated}")
+        return self
