@@ -1,0 +1,177 @@
+"""Modal analysis of the linearized, undamped coupled system (thesis section 3.2).
+
+Solves K_sys phi = omega^2 M(0) phi (eq. 3.3) with ``scipy.linalg.eigh`` and
+classifies each flexible mode automatically:
+
+- ``kind``: the joint DOF type holding most of the mode's strain energy
+  (flapping = rotation about X_M, torsion = about Y_M, in-plane bending = about
+  Z_M, translation = any root translation).
+- ``symmetry``: for a plant with a mirror symmetry (the two-panel case is symmetric
+  about the hub XZ plane), the parity of the mode under the reflection:
+  ``symmetric`` (the panels move as mirror images) or ``antisymmetric``;
+  ``none`` when the plant has no mirror symmetry or the mode has no parity.
+- ``hub_dof``: the hub DOF the mode drives most (mass-weighted amplitude), if it
+  carries at least 10 % of the mode's largest mass-weighted amplitude.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy.linalg import eigh
+
+from flexsat.dynamics.plant import Plant
+from flexsat.dynamics.rigid import rigid_inertia
+from flexsat.dynamics.symmetry import mirror_operator
+
+__all__ = ["HUB_DOFS", "JOINT_DOFS", "ModalAnalysis", "Mode", "dof_names", "modal_analysis"]
+
+HUB_DOFS = ("x", "y", "z", "phi", "theta", "psi")
+JOINT_DOFS = ("eta_x", "eta_y", "eta_z", "eta_rx", "eta_ry", "eta_rz")
+_KIND_OF_JOINT_DOF = (
+    "translation", "translation", "translation", "flapping", "torsion", "in_plane",
+)  # fmt: skip
+_PARITY_MIN = 0.9  # |<phi, P phi>_M| above this: the mode has a definite mirror parity
+_DOMINANT_MIN = 0.5  # normalized mass-weighted amplitude for a DOF to count as dominant
+_HUB_COUPLING_MIN = 0.1
+
+
+def dof_names(plant: Plant) -> list[str]:
+    """Names of the generalized coordinates: hub DOFs, then ``<appendage>.<joint DOF>``."""
+    names = list(HUB_DOFS)
+    for app in plant.config.appendages:
+        names += [f"{app.name}.{dof}" for dof in JOINT_DOFS]
+    return names
+
+
+@dataclass(frozen=True)
+class Mode:
+    """One mode of the coupled system (1-based ``index``, ascending frequency)."""
+
+    index: int
+    frequency_hz: float
+    kind: str
+    symmetry: str
+    dominant_dofs: list[str]
+    hub_dof: str | None
+
+    def to_dict(self) -> dict:
+        return {
+            "index": self.index,
+            "frequency_hz": self.frequency_hz,
+            "kind": self.kind,
+            "symmetry": self.symmetry,
+            "dominant_dofs": self.dominant_dofs,
+            "hub_dof": self.hub_dof,
+        }
+
+
+@dataclass(frozen=True)
+class ModalAnalysis:
+    """Result of :func:`modal_analysis`.
+
+    Attributes
+    ----------
+    frequencies_hz : ndarray, shape (n_dof,)
+        Natural frequencies, ascending; the six rigid-body modes are exactly 0.
+    shapes : ndarray, shape (n_dof, n_dof)
+        Mass-normalized mode shapes in columns (phi^T M phi = 1).
+    participation : ndarray, shape (n_dof, n_dof)
+        Mass-weighted amplitudes |phi_j| sqrt(M_jj), each column scaled to max 1:
+        the modal interaction map (thesis fig. 3.2).
+    """
+
+    plant: Plant
+    mass_matrix: np.ndarray
+    stiffness_matrix: np.ndarray
+    frequencies_hz: np.ndarray
+    shapes: np.ndarray
+    participation: np.ndarray
+    modes: list[Mode]
+    dof_names: list[str] = field(default_factory=list)
+
+    def to_dict(self) -> dict:
+        """JSON-ready summary (SI units, frequencies in Hz)."""
+        return {
+            "config_name": self.plant.config.name,
+            "dof_names": self.dof_names,
+            "mass_matrix": self.mass_matrix.tolist(),
+            "stiffness_diag": np.diag(self.stiffness_matrix).tolist(),
+            "damping_diag": np.diag(self.plant.damping_matrix()).tolist(),
+            "frequencies_hz": self.frequencies_hz.tolist(),
+            "modes": [m.to_dict() for m in self.modes],
+            "rigid_inertia": rigid_inertia(self.plant).tolist(),
+        }
+
+
+def modal_analysis(plant: Plant) -> ModalAnalysis:
+    """Modes of the coupled satellite linearized at q = 0, q_dot = 0 (eqs. 3.2-3.4).
+
+    Parameters
+    ----------
+    plant : Plant
+
+    Returns
+    -------
+    ModalAnalysis
+    """
+    M0 = plant.mass_matrix()
+    K = plant.stiffness_matrix()
+    eigenvalues, shapes = eigh(K, M0)
+    eigenvalues[:6] = 0.0  # K_sys has exactly six zero rows: the rigid-body modes
+    frequencies = np.sqrt(np.clip(eigenvalues, 0.0, None)) / (2.0 * np.pi)
+    weighted = np.abs(shapes) * np.sqrt(np.diag(M0))[:, None]
+    participation = weighted / weighted.max(axis=0, keepdims=True)
+    names = dof_names(plant)
+    mirror = mirror_operator(plant)
+    modes = []
+    for k in range(plant.n_dof):
+        phi = shapes[:, k]
+        rigid = k < 6
+        order = np.argsort(-participation[:, k])
+        modes.append(
+            Mode(
+                index=k + 1,
+                frequency_hz=float(frequencies[k]),
+                kind="rigid" if rigid else _kind(plant, phi),
+                symmetry="none" if rigid else _symmetry(phi, M0, mirror),
+                dominant_dofs=[names[j] for j in order if participation[j, k] >= _DOMINANT_MIN],
+                hub_dof=None if rigid else _hub_dof(participation[:, k]),
+            )
+        )
+    return ModalAnalysis(
+        plant=plant,
+        mass_matrix=M0,
+        stiffness_matrix=K,
+        frequencies_hz=frequencies,
+        shapes=shapes,
+        participation=participation,
+        modes=modes,
+        dof_names=names,
+    )
+
+
+def _kind(plant: Plant, phi: np.ndarray) -> str:
+    strain = (plant.stiffness * phi[6:].reshape(-1, 6) ** 2).sum(axis=0)
+    energy = {}
+    for dof, kind in enumerate(_KIND_OF_JOINT_DOF):
+        energy[kind] = energy.get(kind, 0.0) + strain[dof]
+    return max(energy, key=energy.get)
+
+
+def _symmetry(phi: np.ndarray, M0: np.ndarray, mirror: np.ndarray | None) -> str:
+    if mirror is None:
+        return "none"
+    parity = float(phi @ M0 @ (mirror @ phi)) / float(phi @ M0 @ phi)
+    if parity >= _PARITY_MIN:
+        return "symmetric"
+    if parity <= -_PARITY_MIN:
+        return "antisymmetric"
+    return "none"
+
+
+def _hub_dof(participation: np.ndarray) -> str | None:
+    hub = participation[:6]
+    j = int(np.argmax(hub))
+    return HUB_DOFS[j] if hub[j] >= _HUB_COUPLING_MIN else None
