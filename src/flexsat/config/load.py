@@ -78,8 +78,10 @@ def _describe(error: dict[str, Any], model: type[BaseModel]) -> str:
         return f"unknown key {location!r}{suggestion} (allowed here: {', '.join(known)})"
     if kind == "missing":
         return f"missing required field {location!r}"
+    if kind in ("model_type", "dict_type"):
+        return f"{location}: expected a TOML table (section), got {error.get('input')!r}"
     message = error["msg"].removeprefix("Value error, ")
-    if "input" in error and kind not in ("model_type", "dict_type"):
+    if "input" in error:
         return f"{location}: {message} (got {error['input']!r})"
     return f"{location}: {message}"
 

@@ -1,0 +1,202 @@
+"""The ``flexsat`` command: thin layer that loads configs, calls the API and prints.
+
+User mistakes (bad config, missing file...) end with one message on stderr and
+exit code 2, never a traceback.
+"""
+
+from __future__ import annotations
+
+import json
+import shutil
+import sys
+from pathlib import Path
+from typing import Annotated
+
+import numpy as np
+import typer
+from rich.console import Console
+from rich.table import Table
+
+from flexsat import __version__
+from flexsat.errors import FlexsatError
+
+__all__ = ["app", "main"]
+
+app = typer.Typer(
+    name="flexsat",
+    help=(
+        "Simulator and control-design toolkit for flexible spacecraft: a rigid hub with "
+        "flexible appendages and the control-structure interaction between them.\n\n"
+        "Without --config every command runs the built-in nominal case study "
+        "(hub 150 kg, two 4.5 m solar panels)."
+    ),
+    no_args_is_help=True,
+    add_completion=False,
+    pretty_exceptions_enable=False,
+)
+config_app = typer.Typer(help="Inspect and copy satellite configurations.", no_args_is_help=True)
+app.add_typer(config_app, name="config")
+
+_console = Console()
+_errors = Console(stderr=True)
+
+ConfigOption = Annotated[
+    Path | None,
+    typer.Option(
+        "--config", "-c", help="Satellite config (TOML). Default: the built-in nominal case."
+    ),
+]
+JsonOption = Annotated[
+    bool, typer.Option("--json", help="Print one JSON object (SI units) instead of tables.")
+]
+
+
+def _version(value: bool) -> None:
+    if value:
+        typer.echo(f"flexsat {__version__}")
+        raise typer.Exit()
+
+
+@app.callback()
+def _root(
+    version: Annotated[
+        bool,
+        typer.Option("--version", callback=_version, is_eager=True, help="Show the version."),
+    ] = False,
+) -> None:
+    """flexsat command line."""
+
+
+@app.command()
+def modal(
+    config: ConfigOption = None,
+    json_output: JsonOption = False,
+    out: Annotated[
+        Path | None,
+        typer.Option(help="Write the figures, mode animations and modal.json to this folder."),
+    ] = None,
+    animate: Annotated[
+        list[int] | None,
+        typer.Option(help="Mode index (1-based) to animate as a GIF; repeat for more."),
+    ] = None,
+) -> None:
+    """Modal analysis of the coupled satellite: frequencies, mode shapes and classification."""
+    from flexsat.analysis.modal import modal_analysis
+    from flexsat.config import load_config
+    from flexsat.dynamics.plant import Plant
+
+    analysis = modal_analysis(Plant.from_config(load_config(config)))
+    summary = analysis.to_dict()
+    if animate:
+        bad = [k for k in animate if not 1 <= k <= len(analysis.modes)]
+        if bad:
+            n_modes = len(analysis.modes)
+            raise FlexsatError(f"--animate: mode index must be in 1..{n_modes}, got {bad}")
+    if out is not None:
+        from flexsat.plots.modal import write_modal_figures
+
+        out.mkdir(parents=True, exist_ok=True)
+        (out / "modal.json").write_text(json.dumps(summary, indent=2))
+        written = write_modal_figures(analysis, out, mode_indices=animate)
+        summary["files"] = [str(p) for p in [out / "modal.json", *written]]
+    if json_output:
+        typer.echo(json.dumps(summary))
+        return
+    _print_modal(summary)
+
+
+def _print_modal(summary: dict) -> None:
+    table = Table(title=f"Coupled modes — {summary['config_name']}")
+    for column in ("mode", "f [Hz]", "kind", "symmetry", "hub DOF", "dominant DOFs"):
+        table.add_column(column)
+    for mode in summary["modes"]:
+        table.add_row(
+            str(mode["index"]),
+            f"{mode['frequency_hz']:.4g}",
+            mode["kind"],
+            mode["symmetry"],
+            mode["hub_dof"] or "-",
+            ", ".join(mode["dominant_dofs"][:3]),
+        )
+    _console.print(table)
+    j_tot = np.array(summary["rigid_inertia"])
+    _console.print("Rigid design inertia J_tot about the hub centre of mass [kg m^2]:")
+    _console.print(np.array2string(j_tot, precision=3, suppress_small=True))
+    for path in summary.get("files", []):
+        _console.print(f"wrote {path}")
+
+
+@config_app.command("show")
+def config_show(config: ConfigOption = None, json_output: JsonOption = False) -> None:
+    """Validate a config and print it with the derived mass, inertia and joint tuning."""
+    from flexsat.config import load_config
+    from flexsat.dynamics.plant import Plant
+
+    cfg = load_config(config)
+    plant = Plant.from_config(cfg)
+    derived = {
+        "hub_inertia_kg_m2": plant.hub_J.tolist(),
+        "appendages": [
+            {
+                "name": app_cfg.name,
+                "mass_kg": float(plant.panel_mass[i]),
+                "centroidal_inertia_kg_m2": plant.panel_J[i].tolist(),
+                "stiffness": plant.stiffness[i].tolist(),
+                "damping": plant.damping[i].tolist(),
+            }
+            for i, app_cfg in enumerate(cfg.appendages)
+        ],
+    }
+    payload = {"config": cfg.model_dump(mode="json"), "derived": derived}
+    if json_output:
+        typer.echo(json.dumps(payload))
+    else:
+        _console.print_json(json.dumps(payload))
+
+
+@config_app.command("preset")
+def config_preset(
+    name: Annotated[str, typer.Argument(help="Preset name, e.g. 'nominal'.")] = "nominal",
+    output: Annotated[
+        Path | None, typer.Option("--output", "-o", help="Copy the preset to this file.")
+    ] = None,
+) -> None:
+    """Print a shipped preset, or copy it to a file you can edit."""
+    from flexsat.config import preset_path
+
+    source = preset_path(name)
+    if output is None:
+        typer.echo(source.read_text())
+        return
+    if output.exists():
+        raise FlexsatError(f"{output} exists; choose another file name")
+    shutil.copyfile(source, output)
+    _console.print(f"wrote {output}")
+
+
+@app.command()
+def equations(
+    appendages: Annotated[
+        int, typer.Option(min=1, max=4, help="Number of appendages of the derived topology.")
+    ] = 2,
+    fmt: Annotated[str, typer.Option("--format", help="'pretty' or 'latex'.")] = "pretty",
+    small_angle: Annotated[
+        bool, typer.Option(help="Use the small-angle panel rate of thesis eq. 2.31.")
+    ] = False,
+) -> None:
+    """Print the symbolic Lagrangian model (energies and equations of motion)."""
+    from flexsat.dynamics.symbolic import derive
+
+    if fmt not in ("pretty", "latex"):
+        raise FlexsatError(f"--format must be 'pretty' or 'latex', got {fmt!r}")
+    model = derive(appendages, "small_angle" if small_angle else "exact")
+    typer.echo(model.equations_text(fmt))
+
+
+def main() -> None:
+    """Entry point: run the app, turning flexsat errors into a message and exit code 2."""
+    try:
+        app()
+    except FlexsatError as exc:
+        _errors.print(f"[bold red]error:[/] {exc}", highlight=False)
+        sys.exit(2)
