@@ -69,7 +69,7 @@ def validate_config(
 
 
 def _describe(error: dict[str, Any], model: type[BaseModel]) -> str:
-    location = ".".join(str(part) for part in error["loc"]) or "(top level)"
+    location = _location(error["loc"])
     kind = error["type"]
     if kind == "extra_forbidden":
         known = _known_keys(model, error["loc"][:-1])
@@ -84,6 +84,14 @@ def _describe(error: dict[str, Any], model: type[BaseModel]) -> str:
     if "input" in error:
         return f"{location}: {message} (got {error['input']!r})"
     return f"{location}: {message}"
+
+
+def _location(loc: tuple[Any, ...]) -> str:
+    """``('appendages', 0, 'length_m')`` -> ``appendages[0].length_m``."""
+    text = ""
+    for part in loc:
+        text += f"[{part}]" if isinstance(part, int) else (f".{part}" if text else str(part))
+    return text or "(top level)"
 
 
 def _known_keys(model: type[BaseModel], loc: tuple[Any, ...]) -> list[str]:
