@@ -38,7 +38,7 @@ config_app = typer.Typer(help="Inspect and copy satellite configurations.", no_a
 app.add_typer(config_app, name="config")
 
 _console = Console()
-_errors = Console(stderr=True)
+_errors = Console(stderr=True, soft_wrap=True)
 
 ConfigOption = Annotated[
     Path | None,

@@ -16,6 +16,7 @@ from flexsat.errors import ConfigError
 __all__ = ["PRESETS", "load_config", "nominal", "preset_path", "validate_config"]
 
 PRESETS = ("nominal",)
+_MAX_REPORTED = 3  # problems listed in one error message
 
 
 def preset_path(name: str) -> Path:
@@ -65,7 +66,10 @@ def validate_config(
     try:
         return model.model_validate(data)
     except ValidationError as exc:
-        raise ConfigError(f"{source}: {_describe(exc.errors()[0], model)}") from None
+        problems = [_describe(error, model) for error in exc.errors()[:_MAX_REPORTED]]
+        more = exc.error_count() - len(problems)
+        suffix = f"; and {more} more" if more > 0 else ""
+        raise ConfigError(f"{source}: {'; '.join(problems)}{suffix}") from None
 
 
 def _describe(error: dict[str, Any], model: type[BaseModel]) -> str:

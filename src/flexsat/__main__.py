@@ -1,0 +1,5 @@
+"""``python -m flexsat`` runs the command line."""
+
+from flexsat.cli.main import main
+
+main()

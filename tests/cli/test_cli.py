@@ -1,0 +1,71 @@
+"""The flexsat command, run as a user runs it: in a subprocess."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+
+import pytest
+
+FLEXSAT = [sys.executable, "-m", "flexsat"]
+
+
+def run(*args: str) -> subprocess.CompletedProcess:
+    return subprocess.run([*FLEXSAT, *args], capture_output=True, text=True, timeout=300)
+
+
+def test_help_reads_well():
+    result = run("--help")
+    assert result.returncode == 0
+    for command in ("modal", "config", "equations"):
+        assert command in result.stdout
+
+
+def test_modal_json_has_the_documented_keys():
+    result = run("modal", "--json")
+    assert result.returncode == 0, result.stderr
+    summary = json.loads(result.stdout)
+    for key in ("mass_matrix", "stiffness_diag", "frequencies_hz", "modes", "rigid_inertia"):
+        assert key in summary
+    assert len(summary["frequencies_hz"]) == 18
+    # Thesis table 3.3: the yaw-coupled antisymmetric in-plane mode at 1.23 Hz.
+    mode_12 = summary["modes"][11]
+    assert mode_12["frequency_hz"] == pytest.approx(1.23, abs=0.005)
+    assert (mode_12["kind"], mode_12["symmetry"]) == ("in_plane", "antisymmetric")
+
+
+@pytest.mark.parametrize(
+    ("content", "fragment"),
+    [
+        ("[hub]\nmass_kg = -1\n", "hub.mass_kg"),
+        ("colour = 1\n", "unknown key 'colour'"),
+        ("[hub\n", "not valid TOML"),
+    ],
+)
+def test_bad_config_exits_2_with_one_message(tmp_path, content, fragment):
+    path = tmp_path / "bad.toml"
+    path.write_text(content)
+    result = run("modal", "--config", str(path))
+    assert result.returncode == 2
+    assert fragment in result.stderr
+    assert "Traceback" not in result.stderr
+
+
+def test_missing_config_file_exits_2(tmp_path):
+    result = run("modal", "--config", str(tmp_path / "absent.toml"))
+    assert result.returncode == 2
+    assert "not found" in result.stderr
+    assert "Traceback" not in result.stderr
+
+
+def test_preset_copy_round_trips(tmp_path):
+    target = tmp_path / "mine.toml"
+    assert run("config", "preset", "nominal", "-o", str(target)).returncode == 0
+    shown = run("config", "show", "--config", str(target), "--json")
+    assert shown.returncode == 0, shown.stderr
+    payload = json.loads(shown.stdout)
+    assert payload["config"]["name"] == "nominal"
+    assert payload["derived"]["appendages"][0]["mass_kg"] == pytest.approx(6.75)
+    again = run("config", "preset", "nominal", "-o", str(target))
+    assert again.returncode == 2 and "exists" in again.stderr
