@@ -21,14 +21,12 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.linalg import eigh
 
-from flexsat.dynamics.plant import Plant
+from flexsat.dynamics.plant import HUB_DOFS, JOINT_DOFS, Plant
 from flexsat.dynamics.rigid import rigid_inertia
 from flexsat.dynamics.symmetry import mirror_operator
 
 __all__ = ["HUB_DOFS", "JOINT_DOFS", "ModalAnalysis", "Mode", "dof_names", "modal_analysis"]
 
-HUB_DOFS = ("x", "y", "z", "phi", "theta", "psi")
-JOINT_DOFS = ("eta_x", "eta_y", "eta_z", "eta_rx", "eta_ry", "eta_rz")
 _KIND_OF_JOINT_DOF = (
     "translation", "translation", "translation", "flapping", "torsion", "in_plane",
 )  # fmt: skip
@@ -38,11 +36,8 @@ _HUB_COUPLING_MIN = 0.1
 
 
 def dof_names(plant: Plant) -> list[str]:
-    """Names of the generalized coordinates: hub DOFs, then ``<appendage>.<joint DOF>``."""
-    names = list(HUB_DOFS)
-    for app in plant.config.appendages:
-        names += [f"{app.name}.{dof}" for dof in JOINT_DOFS]
-    return names
+    """Names of the generalized coordinates (see :meth:`Plant.dof_names`)."""
+    return plant.dof_names()
 
 
 @dataclass(frozen=True)

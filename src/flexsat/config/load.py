@@ -13,7 +13,7 @@ from pydantic import BaseModel, ValidationError
 from flexsat.config.models import SatelliteConfig
 from flexsat.errors import ConfigError
 
-__all__ = ["PRESETS", "load_config", "nominal", "preset_path", "validate_config"]
+__all__ = ["PRESETS", "load_config", "nominal", "preset_path", "read_toml", "validate_config"]
 
 PRESETS = ("nominal",)
 _MAX_REPORTED = 3  # problems listed in one error message
@@ -47,16 +47,20 @@ def load_config(path: str | Path | None = None) -> SatelliteConfig:
     """
     if path is None:
         return nominal()
+    return validate_config(read_toml(path, "config"), source=str(path))
+
+
+def read_toml(path: str | Path, what: str = "config") -> dict[str, Any]:
+    """Parse a TOML file, turning a missing, unreadable or malformed file into a ConfigError."""
     path = Path(path)
     try:
-        data = tomllib.loads(path.read_text(encoding="utf-8"))
+        return tomllib.loads(path.read_text(encoding="utf-8"))
     except FileNotFoundError:
-        raise ConfigError(f"config file not found: {path}") from None
+        raise ConfigError(f"{what} file not found: {path}") from None
     except (OSError, UnicodeDecodeError) as exc:
-        raise ConfigError(f"cannot read config file {path}: {exc}") from None
+        raise ConfigError(f"cannot read {what} file {path}: {exc}") from None
     except tomllib.TOMLDecodeError as exc:
         raise ConfigError(f"{path}: not valid TOML: {exc}") from None
-    return validate_config(data, source=str(path))
 
 
 def validate_config(

@@ -57,6 +57,7 @@ from flexsat.dynamics.linalg3 import (
     scale_m,
     skew,
     sub,
+    transpose,
 )
 
 __all__ = [
@@ -67,6 +68,7 @@ __all__ = [
     "bias_forces",
     "hub_joint_wrench",
     "kinetic_energy",
+    "locked_inertia",
     "mass_matrix",
     "system_angular_momentum",
     "tip_displacement",
@@ -412,3 +414,22 @@ def tip_displacement(q, tip_point, out):
         R_MP = rot_zyx(q[o + 3], q[o + 4], q[o + 5])
         moved = add(load_seg(q, o), sub(mv(R_MP, tip), tip))
         out[i, 0], out[i, 1], out[i, 2] = moved
+
+
+@njit(cache=True)
+def locked_inertia(q, hub_J, mount_point, R_BM, com_offset, panel_mass, panel_J, out):
+    """Inertia of the satellite frozen in its current shape, about the hub centre of mass.
+
+    J(eta) in hub frame B, written into ``out`` (3, 3) [kg m^2]; J(eta) omega_B is the
+    rigid part of the angular momentum the thesis plots.
+    """
+    out[:, :] = hub_J
+    for i in range(panel_mass.shape[0]):
+        R_MP, R_BP, S_rho, r_P, r_G = _panel_pose(q, i, mount_point, R_BM, com_offset)
+        J_B = mm(R_BP, mm(load_m33(panel_J, i), transpose(R_BP)))
+        r2 = dot(r_G, r_G)
+        m = panel_mass[i]
+        for a in range(3):
+            for b in range(3):
+                out[a, b] += J_B[a][b] - m * r_G[a] * r_G[b]
+            out[a, a] += m * r2

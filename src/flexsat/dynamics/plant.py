@@ -16,10 +16,14 @@ from scipy.spatial.transform import Rotation
 
 from flexsat.config.models import SatelliteConfig
 from flexsat.dynamics import kernels
+from flexsat.dynamics.linalg3 import euler_rate_matrix
 from flexsat.dynamics.tuning import tune_joints
 from flexsat.errors import SimulationError
 
-__all__ = ["Plant"]
+__all__ = ["HUB_DOFS", "JOINT_DOFS", "Plant"]
+
+HUB_DOFS = ("x", "y", "z", "phi", "theta", "psi")
+JOINT_DOFS = ("eta_x", "eta_y", "eta_z", "eta_rx", "eta_ry", "eta_rz")
 
 _STATUS_MESSAGES = {
     kernels.STATUS_HUB_GIMBAL_LOCK: "hub pitch reached +-90 deg (ZYX Euler-angle singularity)",
@@ -124,6 +128,13 @@ class Plant:
             self.stiffness, self.damping,
         )  # fmt: skip
 
+    def dof_names(self) -> list[str]:
+        """Names of the generalized coordinates: hub DOFs, then ``<appendage>.<joint DOF>``."""
+        names = list(HUB_DOFS)
+        for app in self.config.appendages:
+            names += [f"{app.name}.{dof}" for dof in JOINT_DOFS]
+        return names
+
     def zeros(self) -> np.ndarray:
         """A zero generalized vector, shape (n_dof,)."""
         return np.zeros(self.n_dof)
@@ -187,14 +198,7 @@ class Plant:
             Q with Q_r = force_N and Q_Theta = S(Theta)^T torque_B.
         """
         q = self._state(q)
-        phi, theta = q[3], q[4]
-        S = np.array(
-            [
-                [1.0, 0.0, -np.sin(theta)],
-                [0.0, np.cos(phi), np.cos(theta) * np.sin(phi)],
-                [0.0, -np.sin(phi), np.cos(theta) * np.cos(phi)],
-            ]
-        )  # eq. 2.28
+        S = np.array(euler_rate_matrix(q[3], q[4]))  # eq. 2.28
         out = self.zeros()
         if force_N is not None:
             out[0:3] = force_N
@@ -241,6 +245,15 @@ class Plant:
         kernels.system_angular_momentum(
             self._state(q), self._state(qd), *self.inertia_args, out
         )
+        return out
+
+    def locked_inertia(self, q: np.ndarray) -> np.ndarray:
+        """Inertia of the satellite frozen in shape q about the hub centre of mass, B, (3, 3)."""
+        out = np.empty((3, 3))
+        kernels.locked_inertia(
+            self._state(q), self.hub_J, self.mount_point, self.R_BM, self.com_offset,
+            self.panel_mass, self.panel_J, out,
+        )  # fmt: skip
         return out
 
     def joint_wrench_on_hub(

@@ -1,0 +1,133 @@
+"""Compiled fixed-step RK4 loop for the open-loop plant (numba).
+
+The whole loop runs in compiled code; the only allocations happen once per call,
+before the first step. The state integrated is x = [q, q_dot, W_in, W_diss]: the
+work done by the applied torque and the energy dissipated by the joint dampers are
+integrated with the same RK4 stages as the motion, so the energy balance
+E(t) - E(0) - W_in(t) + W_diss(t) measures the integrator alone.
+
+Torque profile: piecewise-constant segments [start, end) with a body torque each,
+plus a constant disturbance torque, held over each step at its start value (zero-
+order hold, the same convention as a sampled controller).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+from flexsat.dynamics.kernels import STATUS_OK, accelerations
+from flexsat.dynamics.linalg3 import euler_rate_matrix, mtv
+
+__all__ = ["STATUS_NOT_FINITE", "applied_torque", "rk4_open_loop"]
+
+STATUS_NOT_FINITE = 3  # a state component became NaN or infinite
+
+
+@njit(cache=True)
+def applied_torque(t, seg_start, seg_end, seg_torque, disturbance):
+    """Body torque at time t: active segments plus the disturbance, hub frame B [N m]."""
+    tx, ty, tz = disturbance[0], disturbance[1], disturbance[2]
+    for k in range(seg_start.shape[0]):
+        if seg_start[k] <= t < seg_end[k]:
+            tx += seg_torque[k, 0]
+            ty += seg_torque[k, 1]
+            tz += seg_torque[k, 2]
+    return (tx, ty, tz)
+
+
+@njit(cache=True)
+def _derivative(x, torque_B, n, Q, dx, args):
+    """dx/dt of the augmented state; ``Q`` is scratch of length n. Returns a status."""
+    q = x[:n]
+    qd = x[n : 2 * n]
+    Q[:] = 0.0
+    Q[3], Q[4], Q[5] = mtv(euler_rate_matrix(q[3], q[4]), torque_B)  # Q_Theta = S^T tau
+    dx[:n] = qd
+    status = accelerations(q, qd, Q, *args, dx[n : 2 * n])
+    power_in = 0.0
+    for j in range(3, 6):
+        power_in += Q[j] * qd[j]
+    damping = args[10]
+    dissipated = 0.0
+    for i in range(damping.shape[0]):
+        for j in range(6):
+            v = qd[6 + 6 * i + j]
+            dissipated += damping[i, j] * v * v
+    dx[2 * n] = power_in
+    dx[2 * n + 1] = dissipated
+    return status
+
+
+@njit(cache=True)
+def rk4_open_loop(
+    x, t0, dt, n_steps, record_every, seg_start, seg_end, seg_torque, disturbance, args,
+    rec_t, rec_x, rec_tau, rec_start,
+):  # fmt: skip
+    """Advance x in place by ``n_steps`` RK4 steps, recording every ``record_every`` steps.
+
+    Parameters
+    ----------
+    x : ndarray, shape (2 n_dof + 2,)
+        Augmented state [q, q_dot, W_in, W_diss], advanced in place.
+    t0, dt : float
+        Time of x and step [s]; step k starts at t0 + k dt.
+    n_steps, record_every : int
+    seg_start, seg_end : ndarray, shape (k,)
+    seg_torque : ndarray, shape (k, 3)
+    disturbance : ndarray, shape (3,)
+    args : tuple
+        ``Plant.dynamics_args``.
+    rec_t, rec_x, rec_tau : ndarray
+        Record buffers, shapes (m,), (m, 2 n_dof + 2), (m, 3); the state after step
+        k is written at row rec_start + (k + 1) / record_every - 1 when
+        (k + 1) is a multiple of ``record_every``, with the torque held during the
+        next step.
+
+    Returns
+    -------
+    status : int
+        0, a kernel status, or ``STATUS_NOT_FINITE``.
+    steps_done : int
+        Steps completed without error (x is the state after them).
+    """
+    n = (x.shape[0] - 2) // 2
+    size = x.shape[0]
+    Q = np.empty(n)
+    k1 = np.empty(size)
+    k2 = np.empty(size)
+    k3 = np.empty(size)
+    k4 = np.empty(size)
+    stage = np.empty(size)
+    row = rec_start
+    for k in range(n_steps):
+        t = t0 + k * dt
+        torque = applied_torque(t, seg_start, seg_end, seg_torque, disturbance)
+        status = _derivative(x, torque, n, Q, k1, args)
+        for j in range(size):
+            stage[j] = x[j] + 0.5 * dt * k1[j]
+        status |= _derivative(stage, torque, n, Q, k2, args)
+        for j in range(size):
+            stage[j] = x[j] + 0.5 * dt * k2[j]
+        status |= _derivative(stage, torque, n, Q, k3, args)
+        for j in range(size):
+            stage[j] = x[j] + dt * k3[j]
+        status |= _derivative(stage, torque, n, Q, k4, args)
+        if status != STATUS_OK:
+            return status, k
+        finite = True
+        for j in range(size):
+            stage[j] = x[j] + dt / 6.0 * (k1[j] + 2.0 * k2[j] + 2.0 * k3[j] + k4[j])
+            if not np.isfinite(stage[j]):
+                finite = False
+        if not finite:
+            return STATUS_NOT_FINITE, k
+        x[:] = stage
+        if (k + 1) % record_every == 0:
+            t_next = t0 + (k + 1) * dt
+            rec_t[row] = t_next
+            rec_x[row, :] = x
+            tau = applied_torque(t_next, seg_start, seg_end, seg_torque, disturbance)
+            rec_tau[row, 0], rec_tau[row, 1], rec_tau[row, 2] = tau
+            row += 1
+    return STATUS_OK, n_steps

@@ -1,0 +1,222 @@
+"""Open-loop simulation: a torque profile applied to the flexible plant (thesis section 3.3)."""
+
+from __future__ import annotations
+
+import itertools
+import json
+import time
+
+import numpy as np
+from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
+from scipy.integrate import solve_ivp
+
+from flexsat import __version__
+from flexsat.dynamics import kernels
+from flexsat.dynamics.integrators import STATUS_NOT_FINITE, applied_torque, rk4_open_loop
+from flexsat.dynamics.linalg3 import euler_rate_matrix_inv
+from flexsat.dynamics.plant import Plant
+from flexsat.errors import ConfigError, SimulationError
+from flexsat.simulate.result import Result, build_dataset
+from flexsat.simulate.scenario import OpenLoopScenario, thesis_openloop
+
+__all__ = ["initial_state", "run_openloop"]
+
+_PROGRESS_MIN_STEPS = 200_000  # runs shorter than this (~1 s of wall time) show no bar
+_CHUNK_STEPS = 10_000  # compiled steps between progress updates
+_FAILURES = {
+    kernels.STATUS_HUB_GIMBAL_LOCK: "hub pitch reached +-90 deg (ZYX Euler-angle singularity)",
+    kernels.STATUS_JOINT_GIMBAL_LOCK: "a joint root rotation rho_y reached +-90 deg",
+    STATUS_NOT_FINITE: "the state became non-finite (the integration diverged)",
+}
+
+
+def initial_state(plant: Plant, scenario: OpenLoopScenario) -> tuple[np.ndarray, np.ndarray]:
+    """q(0) and q_dot(0) from the scenario's initial state (degrees converted to radians).
+
+    Raises
+    ------
+    ConfigError
+        If an initial state names an appendage the satellite does not have.
+    """
+    init = scenario.initial
+    q = plant.zeros()
+    qd = plant.zeros()
+    q[3:6] = np.radians(init.attitude_deg)
+    omega_B = np.radians(init.rate_deg_s)
+    qd[3:6] = np.array(euler_rate_matrix_inv(q[3], q[4])) @ omega_B  # Theta_dot = S^-1 omega
+    names = [a.name for a in plant.config.appendages]
+    for app in init.appendages:
+        if app.name not in names:
+            raise ConfigError(
+                f"initial.appendages: unknown appendage {app.name!r} (the satellite has "
+                f"{', '.join(names)})"
+            )
+        o = 6 + 6 * names.index(app.name)
+        q[o : o + 3] = app.eta_m
+        q[o + 3 : o + 6] = np.radians(app.rho_deg)
+        qd[o : o + 3] = app.eta_rate_m_s
+        # Relative rate given as ZYX angle rates [deg/s].
+        qd[o + 3 : o + 6] = np.radians(app.rho_rate_deg_s)
+    return q, qd
+
+
+def _profile(scenario: OpenLoopScenario):
+    end = scenario.duration_s + 1.0
+    seg_start = np.array([s.start_s for s in scenario.torque], dtype=float)
+    seg_end = np.array([end if s.end_s is None else s.end_s for s in scenario.torque], dtype=float)
+    seg_torque = np.array([s.torque_nm for s in scenario.torque], dtype=float).reshape(-1, 3)
+    return seg_start, seg_end, seg_torque, np.array(scenario.disturbance_torque_nm, dtype=float)
+
+
+def run_openloop(
+    plant: Plant, scenario: OpenLoopScenario | None = None, progress: bool | None = None
+) -> Result:
+    """Simulate the plant under the scenario's torque profile.
+
+    Parameters
+    ----------
+    plant : Plant
+    scenario : OpenLoopScenario, optional
+        Default: the thesis's scenario (1 N m about Z for 10 s, free to 120 s).
+    progress : bool, optional
+        Show a progress bar; default: only for runs of at least 200 000 steps.
+
+    Returns
+    -------
+    Result
+        Recorded every ``record_dt_s``. A diverging run stops at the failing step and
+        returns its history up to there with ``status = "failed"`` and a message
+        that names the time; it does not raise.
+    """
+    scenario = scenario or thesis_openloop()
+    q0, qd0 = initial_state(plant, scenario)
+    profile = _profile(scenario)
+    start = time.perf_counter()
+    if scenario.solver == "rk4":
+        t, X, tau, status, t_fail, steps = _run_rk4(plant, scenario, q0, qd0, profile, progress)
+    else:
+        t, X, tau, status, t_fail, steps = _run_dop853(plant, scenario, q0, qd0, profile)
+    wall = time.perf_counter() - start
+    n = plant.n_dof
+    seg_start, seg_end, seg_torque, _ = profile
+    tau_cmd = np.array(
+        [applied_torque(tk, seg_start, seg_end, seg_torque, np.zeros(3)) for tk in t]
+    ).reshape(-1, 3)
+    message = ""
+    if status:
+        message = f"simulation stopped at t = {t_fail:.6g} s: {_FAILURES[status]}"
+    attrs = {
+        "title": f"flexsat open-loop run '{scenario.name}' of '{plant.config.name}'",
+        "flexsat_version": __version__,
+        "config": json.dumps(plant.config.model_dump(mode="json")),
+        "scenario": json.dumps(scenario.model_dump(mode="json")),
+        "solver": scenario.solver,
+        "status": "ok" if status == 0 else "failed",
+        "message": message,
+        "failure_time_s": t_fail if status else -1.0,
+        "wall_time_s": wall,
+        "steps": steps,
+    }
+    dataset = build_dataset(
+        plant, t, X[:, :n], X[:, n : 2 * n], X[:, 2 * n], X[:, 2 * n + 1], tau_cmd, tau, attrs
+    )
+    return Result(dataset)
+
+
+def _run_rk4(plant, scenario, q0, qd0, profile, progress):
+    n = plant.n_dof
+    n_steps, every, dt = scenario.n_steps, scenario.record_every, scenario.dt_s
+    n_records = n_steps // every + 1
+    rec_t = np.empty(n_records)
+    rec_x = np.empty((n_records, 2 * n + 2))
+    rec_tau = np.empty((n_records, 3))
+    x = np.concatenate([q0, qd0, [0.0, 0.0]])
+    rec_t[0], rec_x[0] = 0.0, x
+    rec_tau[0] = applied_torque(0.0, *profile)
+    show = n_steps >= _PROGRESS_MIN_STEPS if progress is None else progress
+    chunk = max(every, (_CHUNK_STEPS // every) * every)
+    done, status = 0, 0
+    with _progress_bar(show, scenario.duration_s) as (bar, task):
+        while done < n_steps and status == 0:
+            steps = min(chunk, n_steps - done)
+            status, ran = rk4_open_loop(
+                x, done * dt, dt, steps, every, *profile, plant.dynamics_args,
+                rec_t, rec_x, rec_tau, done // every + 1,
+            )  # fmt: skip
+            done += ran
+            if bar is not None:
+                bar.update(task, completed=done * dt)
+    kept = done // every + 1
+    t_fail = done * dt if status else -1.0
+    if status:
+        # Keep the last good state too, even between two records.
+        rec_t[kept - 1 : kept] = done * dt
+        rec_x[kept - 1] = x
+        rec_tau[kept - 1] = applied_torque(done * dt, *profile)
+        rec_t, rec_x, rec_tau = rec_t[:kept], rec_x[:kept], rec_tau[:kept]
+    return rec_t, rec_x, rec_tau, status, t_fail, done
+
+
+class _progress_bar:
+    """Context manager yielding (progress, task) or (None, None) when hidden."""
+
+    def __init__(self, show: bool, total_s: float) -> None:
+        self.show, self.total = show, total_s
+        self.progress = None
+
+    def __enter__(self):
+        if not self.show:
+            return None, None
+        self.progress = Progress(
+            TextColumn("simulating"), BarColumn(),
+            TextColumn("{task.completed:.1f}/{task.total:.0f} s"), TimeRemainingColumn(),
+            transient=True,
+        )  # fmt: skip
+        self.progress.start()
+        return self.progress, self.progress.add_task("run", total=self.total)
+
+    def __exit__(self, *exc) -> None:
+        if self.progress is not None:
+            self.progress.stop()
+
+
+def _run_dop853(plant, scenario, q0, qd0, profile):
+    """Adaptive DOP853 (scipy), integrated piecewise between torque switching times."""
+    n = plant.n_dof
+    seg_start, seg_end, seg_torque, disturbance = profile
+    every = scenario.record_every
+    t_rec = np.arange(scenario.n_steps // every + 1) * scenario.record_dt_s
+    breaks = np.unique(
+        np.clip(np.concatenate([[0.0, scenario.duration_s], seg_start, seg_end]), 0.0, t_rec[-1])
+    )
+    x = np.concatenate([q0, qd0, [0.0, 0.0]])
+    X = np.empty((t_rec.size, x.size))
+    qdd = np.empty(n)
+    Q = np.zeros(n)
+    evaluations = 0
+
+    for a, b in itertools.pairwise(breaks):
+        torque = np.array(applied_torque(0.5 * (a + b), *profile))
+
+        def rhs(t, y, torque=torque):
+            nonlocal evaluations
+            evaluations += 1
+            q, qd = y[:n], y[n : 2 * n]
+            Q[:] = plant.generalized_forces(q, torque)
+            if kernels.accelerations(q, qd, Q, *plant.dynamics_args, qdd) != 0:
+                raise SimulationError(f"singular kinematics at t = {t:.6g} s")
+            dissipated = plant.dissipation_power(qd)
+            return np.concatenate([qd, qdd, [Q[3:6] @ qd[3:6], dissipated]])
+
+        inside = (t_rec >= a) & (t_rec <= b)
+        sol = solve_ivp(
+            rhs, (a, b), x, method="DOP853", rtol=scenario.rtol, atol=scenario.atol,
+            dense_output=True,
+        )  # fmt: skip
+        if not sol.success:
+            raise SimulationError(f"DOP853 failed between {a} and {b} s: {sol.message}")
+        X[inside] = sol.sol(t_rec[inside]).T
+        x = sol.y[:, -1]
+    tau = np.array([applied_torque(t, *profile) for t in t_rec]).reshape(-1, 3)
+    return t_rec, X, tau, 0, -1.0, evaluations
+

@@ -1,0 +1,169 @@
+"""Simulation results: an ``xarray.Dataset`` with units, the configs that made it, a status.
+
+Every variable carries a ``units`` attribute; the dataset's attributes hold the
+satellite config and the scenario as JSON, the flexsat version, the solver, the
+wall time and the run's status. A run that stopped early (diverged) keeps its
+history up to the failure, with ``status = "failed"`` and the message.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import xarray as xr
+from scipy.spatial.transform import Rotation
+
+from flexsat.dynamics.linalg3 import euler_rate_bias, euler_rate_matrix
+from flexsat.dynamics.plant import Plant
+from flexsat.errors import SimulationError
+
+__all__ = ["Result", "build_dataset"]
+
+AXES = ("x", "y", "z")
+
+
+@dataclass(frozen=True)
+class Result:
+    """A simulation result wrapping its dataset (``result.dataset``)."""
+
+    dataset: xr.Dataset
+
+    @property
+    def ok(self) -> bool:
+        return self.dataset.attrs["status"] == "ok"
+
+    @property
+    def message(self) -> str:
+        return str(self.dataset.attrs.get("message", ""))
+
+    @property
+    def time(self) -> np.ndarray:
+        return self.dataset["time"].values
+
+    def raise_for_status(self) -> None:
+        """Raise the run's :class:`SimulationError` if it failed."""
+        if not self.ok:
+            raise SimulationError(self.message)
+
+    def to_netcdf(self, path: str | Path) -> Path:
+        """Write the dataset to NetCDF (written to a temporary name, then moved)."""
+        path = Path(path)
+        path.parent.mkdir(parents=True, exist_ok=True)
+        partial = path.with_suffix(path.suffix + ".partial")
+        self.dataset.to_netcdf(partial)
+        partial.replace(path)
+        return path
+
+    @classmethod
+    def from_netcdf(cls, path: str | Path) -> Result:
+        """Read a result written by :meth:`to_netcdf` (loaded into memory)."""
+        with xr.open_dataset(path) as ds:
+            return cls(ds.load())
+
+
+def build_dataset(
+    plant: Plant,
+    t: np.ndarray,
+    q: np.ndarray,
+    qd: np.ndarray,
+    work_in: np.ndarray,
+    dissipated: np.ndarray,
+    tau_cmd: np.ndarray,
+    tau_applied: np.ndarray,
+    attrs: dict,
+) -> xr.Dataset:
+    """Derive every recorded quantity from the recorded states.
+
+    Parameters
+    ----------
+    t : ndarray, shape (m,)
+        Record times [s].
+    q, qd : ndarray, shape (m, n_dof)
+    work_in, dissipated : ndarray, shape (m,)
+        Cumulative work of the applied torque and damper dissipation [J].
+    tau_cmd, tau_applied : ndarray, shape (m, 3)
+        Commanded and applied body torque held from each record time [N m].
+    attrs : dict
+        Dataset attributes (configs as JSON, status...).
+    """
+    m, n = q.shape
+    names = [a.name for a in plant.config.appendages]
+    n_app = len(names)
+    omega = np.empty((m, 3))
+    omega_dot = np.empty((m, 3))
+    tau_flex = np.empty((m, 3))
+    H = np.empty((m, 3))
+    H_rigid = np.empty((m, 3))
+    kinetic = np.empty(m)
+    elastic = np.empty(m)
+    tips = np.empty((m, n_app, 3))
+    rotations = Rotation.from_euler("ZYX", q[:, 5:2:-1])  # R_NB = Rz(psi) Ry(theta) Rx(phi)
+    R_NB = rotations.as_matrix()
+    for k in range(m):
+        phi, theta = q[k, 3], q[k, 4]
+        S = np.array(euler_rate_matrix(phi, theta))
+        Q = plant.generalized_forces(q[k], tau_applied[k])
+        qdd = plant.accelerations(q[k], qd[k], Q)
+        omega[k] = S @ qd[k, 3:6]
+        omega_dot[k] = S @ qdd[3:6] + np.array(euler_rate_bias(phi, theta, *qd[k, 3:6]))
+        tau_flex[k] = plant.joint_wrench_on_hub(q[k], qd[k])[1]
+        H[k] = plant.angular_momentum(q[k], qd[k])
+        H_rigid[k] = R_NB[k] @ plant.locked_inertia(q[k]) @ omega[k]
+        kinetic[k] = plant.kinetic_energy(q[k], qd[k])
+        elastic[k] = plant.elastic_energy(q[k])
+        tips[k] = plant.tip_displacement(q[k])
+    total = kinetic + elastic
+    quat_scalar_last = rotations.as_quat()
+    quaternion = np.column_stack([quat_scalar_last[:, 3], quat_scalar_last[:, :3]])
+    flex = q[:, 6:].reshape(m, n_app, 6)
+    flex_rate = qd[:, 6:].reshape(m, n_app, 6)
+
+    def var(dims, data, units, description):
+        return (dims, data, {"units": units, "description": description})
+
+    ta, tpa = ("time", "axis"), ("time", "appendage", "axis")
+    data_vars = {
+        "q": var(("time", "dof"), q, "SI (m, rad)", "generalized coordinates"),
+        "qd": var(("time", "dof"), qd, "SI (m/s, rad/s)", "generalized velocities"),
+        "euler_deg": var(("time", "euler"), np.degrees(q[:, 3:6]), "deg", "hub ZYX Euler angles"),
+        "quaternion": var(
+            ("time", "quat"), quaternion, "1", "hub attitude quaternion, scalar first"
+        ),
+        "omega": var(ta, omega, "rad/s", "hub body rate, frame B"),
+        "omega_dot": var(ta, omega_dot, "rad/s^2", "hub angular acceleration, frame B"),
+        "eta": var(tpa, flex[:, :, :3], "m", "root translation, mount frame"),
+        "rho": var(tpa, flex[:, :, 3:], "rad", "root rotation (ZYX angles), mount frame"),
+        "eta_rate": var(tpa, flex_rate[:, :, :3], "m/s", "root translation rate"),
+        "rho_rate": var(tpa, flex_rate[:, :, 3:], "rad/s", "root rotation angle rates"),
+        "tip_displacement": var(tpa, tips, "m", "panel tip displacement, mount frame"),
+        "tau_cmd": var(ta, tau_cmd, "N m", "commanded body torque, frame B"),
+        "tau_applied": var(ta, tau_applied, "N m", "applied body torque, frame B"),
+        "tau_flex": var(ta, tau_flex, "N m", "torque of the joints on the hub about its CoM"),
+        "tau_net": var(ta, tau_applied + tau_flex, "N m", "net torque on the hub, frame B"),
+        "angular_momentum": var(ta, H, "N m s", "total angular momentum, inertial frame"),
+        "rigid_angular_momentum": var(
+            ta, H_rigid, "N m s", "rigid part J(eta) omega, inertial frame"
+        ),
+        "kinetic_energy": var("time", kinetic, "J", "kinetic energy T"),
+        "elastic_energy": var("time", elastic, "J", "elastic energy U"),
+        "total_energy": var("time", total, "J", "T + U"),
+        "work_in": var("time", work_in, "J", "cumulative work of the applied torque"),
+        "dissipated_energy": var("time", dissipated, "J", "cumulative damper dissipation"),
+        "energy_balance_error": var(
+            "time",
+            total - total[0] - work_in + dissipated,
+            "J",
+            "E(t) - E(0) - W_in(t) + W_diss(t): numerical error of the integration",
+        ),
+    }
+    coords = {
+        "time": ("time", t, {"units": "s"}),
+        "axis": list(AXES),
+        "euler": ["roll", "pitch", "yaw"],
+        "quat": ["q0", "q1", "q2", "q3"],
+        "appendage": names,
+        "dof": plant.dof_names(),
+    }
+    return xr.Dataset(data_vars, coords=coords, attrs=attrs)

@@ -1,0 +1,136 @@
+"""Open-loop scenarios: initial state, body-torque profile, integration settings.
+
+Validated, immutable models loaded from TOML like the satellite config. Angles at
+this boundary are in degrees (fields ending in ``_deg``), everything else SI.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated, Literal
+
+from pydantic import Field, model_validator
+
+from flexsat.config.load import read_toml, validate_config
+from flexsat.config.models import Positive, Real, Vector3, _Frozen
+
+__all__ = [
+    "AppendageInitialState",
+    "InitialState",
+    "OpenLoopScenario",
+    "TorqueSegment",
+    "load_scenario",
+    "pulse",
+    "step",
+    "thesis_openloop",
+]
+
+_ZERO3 = (0.0, 0.0, 0.0)
+
+
+class TorqueSegment(_Frozen):
+    """A constant body torque applied over [start_s, end_s); ``end_s`` omitted: to the end."""
+
+    start_s: Annotated[float, Field(ge=0.0, allow_inf_nan=False)] = 0.0
+    end_s: Positive | None = None
+    torque_nm: Vector3 = Field(description="torque on the hub, hub frame B [N m]")
+
+    @model_validator(mode="after")
+    def _ordered(self) -> TorqueSegment:
+        if self.end_s is not None and self.end_s <= self.start_s:
+            raise ValueError(f"end_s must be > start_s ({self.start_s}), got {self.end_s}")
+        return self
+
+
+def step(start_s: float, torque_nm: tuple[float, float, float]) -> TorqueSegment:
+    """A torque switched on at ``start_s`` and held to the end of the run."""
+    return TorqueSegment(start_s=start_s, torque_nm=torque_nm)
+
+
+def pulse(
+    start_s: float, duration_s: float, torque_nm: tuple[float, float, float]
+) -> TorqueSegment:
+    """A torque applied for ``duration_s`` from ``start_s``."""
+    return TorqueSegment(start_s=start_s, end_s=start_s + duration_s, torque_nm=torque_nm)
+
+
+class AppendageInitialState(_Frozen):
+    """Initial deformation of one appendage's root joint (mount frame)."""
+
+    name: str
+    eta_m: Vector3 = _ZERO3
+    rho_deg: Annotated[
+        tuple[Real, Real, Real], Field(description="ZYX root rotation (x, y, z) [deg]")
+    ] = _ZERO3
+    eta_rate_m_s: Vector3 = _ZERO3
+    rho_rate_deg_s: Vector3 = _ZERO3
+
+    @model_validator(mode="after")
+    def _small(self) -> AppendageInitialState:
+        if max(abs(a) for a in self.rho_deg) >= 45.0:
+            raise ValueError("rho_deg must stay below 45 deg (small elastic deformation)")
+        return self
+
+
+class InitialState(_Frozen):
+    """Hub attitude and rate, and appendage deformations, at t = 0."""
+
+    attitude_deg: Vector3 = Field(_ZERO3, description="ZYX Euler angles (roll, pitch, yaw) [deg]")
+    rate_deg_s: Vector3 = Field(_ZERO3, description="body rate, hub frame B [deg/s]")
+    appendages: list[AppendageInitialState] = Field(default_factory=list)
+
+    @model_validator(mode="after")
+    def _pitch(self) -> InitialState:
+        if abs(self.attitude_deg[1]) >= 89.0:
+            raise ValueError("attitude_deg pitch must be within (-89, 89) deg (ZYX singularity)")
+        return self
+
+
+class OpenLoopScenario(_Frozen):
+    """An open-loop run. The default is the thesis's (section 3.3): at rest,
+    1 N m about body Z for 0 <= t < 10 s, then free, to 120 s, RK4 at 1 ms."""
+
+    name: str = "thesis-openloop"
+    duration_s: Annotated[float, Field(gt=0.0, le=1e6, allow_inf_nan=False)] = 120.0
+    dt_s: Annotated[float, Field(gt=0.0, le=0.1, allow_inf_nan=False)] = 1e-3
+    record_dt_s: Annotated[float, Field(gt=0.0, allow_inf_nan=False)] = 1e-2
+    solver: Literal["rk4", "dop853"] = "rk4"
+    rtol: Annotated[float, Field(gt=0.0, lt=1.0)] = 1e-10
+    atol: Annotated[float, Field(gt=0.0, lt=1.0)] = 1e-12
+    initial: InitialState = Field(default_factory=InitialState)
+    torque: list[TorqueSegment] = Field(
+        default_factory=lambda: [TorqueSegment(start_s=0.0, end_s=10.0, torque_nm=(0, 0, 1.0))]
+    )
+    disturbance_torque_nm: Vector3 = Field(_ZERO3, description="constant body torque [N m]")
+
+    @model_validator(mode="after")
+    def _steps(self) -> OpenLoopScenario:
+        ratio = self.record_dt_s / self.dt_s
+        if ratio < 1.0 - 1e-9 or abs(ratio - round(ratio)) > 1e-6 * ratio:
+            raise ValueError(
+                f"record_dt_s must be a whole multiple of dt_s ({self.dt_s}), "
+                f"got {self.record_dt_s}"
+            )
+        if self.duration_s < self.dt_s:
+            raise ValueError(f"duration_s must be at least dt_s ({self.dt_s})")
+        return self
+
+    @property
+    def n_steps(self) -> int:
+        return round(self.duration_s / self.dt_s)
+
+    @property
+    def record_every(self) -> int:
+        return round(self.record_dt_s / self.dt_s)
+
+
+def thesis_openloop() -> OpenLoopScenario:
+    """The thesis's open-loop validation scenario (section 3.3)."""
+    return OpenLoopScenario()
+
+
+def load_scenario(path: str | Path | None = None) -> OpenLoopScenario:
+    """Read and validate an open-loop scenario TOML; ``None`` gives :func:`thesis_openloop`."""
+    if path is None:
+        return thesis_openloop()
+    return validate_config(read_toml(path, "scenario"), source=str(path), model=OpenLoopScenario)
