@@ -25,7 +25,9 @@ def openloop_metrics(ds: xr.Dataset) -> dict:
     """
     t = ds["time"].values
     commanded = np.abs(ds["tau_cmd"].values).max(axis=1) > 0.0
-    free_from = t[np.nonzero(commanded)[0][-1] + 1] if commanded.any() and not commanded[-1] else 0.0
+    free_from = 0.0
+    if commanded.any() and not commanded[-1]:
+        free_from = t[np.nonzero(commanded)[0][-1] + 1]
     free = t >= free_from
     dominant = float("nan")
     if free.sum() >= 64:
