@@ -126,6 +126,88 @@ def _print_modal(summary: dict) -> None:
         _console.print(f"wrote {path}")
 
 
+@app.command()
+def openloop(
+    config: ConfigOption = None,
+    scenario: Annotated[
+        Path | None,
+        typer.Option(help="Open-loop scenario (TOML). Default: the thesis's 1 N m yaw pulse."),
+    ] = None,
+    duration: Annotated[float | None, typer.Option(help="Override the duration [s].")] = None,
+    dt: Annotated[float | None, typer.Option(help="Override the RK4 step [s].")] = None,
+    solver: Annotated[str | None, typer.Option(help="Override the solver: rk4 or dop853.")] = None,
+    json_output: JsonOption = False,
+    out: Annotated[
+        Path | None,
+        typer.Option(help="Write result.nc, metrics.json and the figures to this folder."),
+    ] = None,
+) -> None:
+    """Open-loop run: apply a torque profile to the flexible satellite and watch it respond.
+
+    A run that diverges stops cleanly: its history up to the failure is saved (with
+    --out) and the command exits with code 1 after naming the time.
+    """
+    from flexsat.analysis.openloop import openloop_metrics
+    from flexsat.config import load_config, validate_config
+    from flexsat.dynamics.plant import Plant
+    from flexsat.simulate import OpenLoopScenario, load_scenario, run_openloop
+
+    plant = Plant.from_config(load_config(config))
+    chosen = load_scenario(scenario)
+    overrides = {
+        key: value
+        for key, value in (("duration_s", duration), ("dt_s", dt), ("solver", solver))
+        if value is not None
+    }
+    if dt is not None and chosen.record_dt_s % dt > 1e-12 * chosen.record_dt_s:
+        overrides["record_dt_s"] = max(dt, round(chosen.record_dt_s / dt) * dt)
+    if overrides:
+        chosen = validate_config(
+            {**chosen.model_dump(), **overrides}, source="options", model=OpenLoopScenario
+        )
+    result = run_openloop(plant, chosen, progress=None if not json_output else False)
+    metrics = openloop_metrics(result.dataset)
+    if out is not None:
+        out.mkdir(parents=True, exist_ok=True)
+        files = [result.to_netcdf(out / "result.nc")]
+        if result.ok:
+            files += _openloop_figures(result, plant, out)
+        (out / "metrics.json").write_text(json.dumps(metrics, indent=2))
+        metrics["files"] = [str(p) for p in [*files, out / "metrics.json"]]
+    if json_output:
+        typer.echo(json.dumps(metrics))
+    else:
+        _print_metrics(metrics)
+    if not result.ok:
+        _errors.print(f"[bold red]error:[/] {result.message}", highlight=False)
+        raise typer.Exit(1)
+
+
+def _openloop_figures(result, plant, out: Path) -> list[Path]:
+    from flexsat.analysis.modal import modal_analysis
+    from flexsat.plots.openloop import write_openloop_figures
+
+    return write_openloop_figures(result.dataset, modal_analysis(plant), out)
+
+
+def _print_metrics(metrics: dict) -> None:
+    table = Table(title="Open-loop run")
+    table.add_column("metric")
+    table.add_column("value", justify="right")
+    for key, value in metrics.items():
+        if key == "files":
+            continue
+        shown = (
+            ", ".join(f"{v:.6g}" for v in value)
+            if isinstance(value, list)
+            else (f"{value:.6g}" if isinstance(value, float) else str(value))
+        )
+        table.add_row(key, shown)
+    _console.print(table)
+    for path in metrics.get("files", []):
+        _console.print(f"wrote {path}")
+
+
 @config_app.command("show")
 def config_show(config: ConfigOption = None, json_output: JsonOption = False) -> None:
     """Validate a config and print it with the derived mass, inertia and joint tuning."""

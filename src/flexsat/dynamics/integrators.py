@@ -19,7 +19,7 @@ from numba import njit
 from flexsat.dynamics.kernels import STATUS_OK, accelerations
 from flexsat.dynamics.linalg3 import euler_rate_matrix, mtv
 
-__all__ = ["STATUS_NOT_FINITE", "applied_torque", "rk4_open_loop"]
+__all__ = ["STATUS_NOT_FINITE", "applied_torque", "augmented_derivative", "rk4_open_loop"]
 
 STATUS_NOT_FINITE = 3  # a state component became NaN or infinite
 
@@ -37,8 +37,12 @@ def applied_torque(t, seg_start, seg_end, seg_torque, disturbance):
 
 
 @njit(cache=True)
-def _derivative(x, torque_B, n, Q, dx, args):
-    """dx/dt of the augmented state; ``Q`` is scratch of length n. Returns a status."""
+def augmented_derivative(x, torque_B, n, Q, dx, args):
+    """dx/dt of the augmented state [q, q_dot, W_in, W_diss] under a body torque.
+
+    ``torque_B`` is a 3-tuple [N m], ``Q`` scratch of length n, ``dx`` the output.
+    Shared by the compiled RK4 loop and the adaptive scipy solver. Returns a status.
+    """
     q = x[:n]
     qd = x[n : 2 * n]
     Q[:] = 0.0
@@ -103,16 +107,16 @@ def rk4_open_loop(
     for k in range(n_steps):
         t = t0 + k * dt
         torque = applied_torque(t, seg_start, seg_end, seg_torque, disturbance)
-        status = _derivative(x, torque, n, Q, k1, args)
+        status = augmented_derivative(x, torque, n, Q, k1, args)
         for j in range(size):
             stage[j] = x[j] + 0.5 * dt * k1[j]
-        status |= _derivative(stage, torque, n, Q, k2, args)
+        status |= augmented_derivative(stage, torque, n, Q, k2, args)
         for j in range(size):
             stage[j] = x[j] + 0.5 * dt * k2[j]
-        status |= _derivative(stage, torque, n, Q, k3, args)
+        status |= augmented_derivative(stage, torque, n, Q, k3, args)
         for j in range(size):
             stage[j] = x[j] + dt * k3[j]
-        status |= _derivative(stage, torque, n, Q, k4, args)
+        status |= augmented_derivative(stage, torque, n, Q, k4, args)
         if status != STATUS_OK:
             return status, k
         finite = True

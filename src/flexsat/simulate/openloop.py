@@ -12,7 +12,12 @@ from scipy.integrate import solve_ivp
 
 from flexsat import __version__
 from flexsat.dynamics import kernels
-from flexsat.dynamics.integrators import STATUS_NOT_FINITE, applied_torque, rk4_open_loop
+from flexsat.dynamics.integrators import (
+    STATUS_NOT_FINITE,
+    applied_torque,
+    augmented_derivative,
+    rk4_open_loop,
+)
 from flexsat.dynamics.linalg3 import euler_rate_matrix_inv
 from flexsat.dynamics.plant import Plant
 from flexsat.errors import ConfigError, SimulationError
@@ -183,7 +188,7 @@ class _progress_bar:
 def _run_dop853(plant, scenario, q0, qd0, profile):
     """Adaptive DOP853 (scipy), integrated piecewise between torque switching times."""
     n = plant.n_dof
-    seg_start, seg_end, seg_torque, disturbance = profile
+    seg_start, seg_end, _, _ = profile
     every = scenario.record_every
     t_rec = np.arange(scenario.n_steps // every + 1) * scenario.record_dt_s
     breaks = np.unique(
@@ -191,22 +196,19 @@ def _run_dop853(plant, scenario, q0, qd0, profile):
     )
     x = np.concatenate([q0, qd0, [0.0, 0.0]])
     X = np.empty((t_rec.size, x.size))
-    qdd = np.empty(n)
-    Q = np.zeros(n)
+    Q = np.empty(n)
     evaluations = 0
 
     for a, b in itertools.pairwise(breaks):
-        torque = np.array(applied_torque(0.5 * (a + b), *profile))
+        torque = applied_torque(0.5 * (a + b), *profile)
 
         def rhs(t, y, torque=torque):
             nonlocal evaluations
             evaluations += 1
-            q, qd = y[:n], y[n : 2 * n]
-            Q[:] = plant.generalized_forces(q, torque)
-            if kernels.accelerations(q, qd, Q, *plant.dynamics_args, qdd) != 0:
+            dy = np.empty_like(y)
+            if augmented_derivative(y, torque, n, Q, dy, plant.dynamics_args) != 0:
                 raise SimulationError(f"singular kinematics at t = {t:.6g} s")
-            dissipated = plant.dissipation_power(qd)
-            return np.concatenate([qd, qdd, [Q[3:6] @ qd[3:6], dissipated]])
+            return dy
 
         inside = (t_rec >= a) & (t_rec <= b)
         sol = solve_ivp(

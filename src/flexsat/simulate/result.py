@@ -101,19 +101,11 @@ def build_dataset(
     tips = np.empty((m, n_app, 3))
     rotations = Rotation.from_euler("ZYX", q[:, 5:2:-1])  # R_NB = Rz(psi) Ry(theta) Rx(phi)
     R_NB = rotations.as_matrix()
-    for k in range(m):
-        phi, theta = q[k, 3], q[k, 4]
-        S = np.array(euler_rate_matrix(phi, theta))
-        Q = plant.generalized_forces(q[k], tau_applied[k])
-        qdd = plant.accelerations(q[k], qd[k], Q)
-        omega[k] = S @ qd[k, 3:6]
-        omega_dot[k] = S @ qdd[3:6] + np.array(euler_rate_bias(phi, theta, *qd[k, 3:6]))
-        tau_flex[k] = plant.joint_wrench_on_hub(q[k], qd[k])[1]
-        H[k] = plant.angular_momentum(q[k], qd[k])
-        H_rigid[k] = R_NB[k] @ plant.locked_inertia(q[k]) @ omega[k]
-        kinetic[k] = plant.kinetic_energy(q[k], qd[k])
-        elastic[k] = plant.elastic_energy(q[k])
-        tips[k] = plant.tip_displacement(q[k])
+    # A diverged run keeps its last finite state, whose derived values may overflow.
+    with np.errstate(over="ignore", invalid="ignore"):
+        for k in range(m):
+            _derive_record(plant, k, q, qd, tau_applied, R_NB, omega, omega_dot, tau_flex, H,
+                           H_rigid, kinetic, elastic, tips)  # fmt: skip
     total = kinetic + elastic
     quat_scalar_last = rotations.as_quat()
     quaternion = np.column_stack([quat_scalar_last[:, 3], quat_scalar_last[:, :3]])
@@ -167,3 +159,22 @@ def build_dataset(
         "dof": plant.dof_names(),
     }
     return xr.Dataset(data_vars, coords=coords, attrs=attrs)
+
+
+def _derive_record(plant, k, q, qd, tau_applied, R_NB, omega, omega_dot, tau_flex, H, H_rigid,
+                   kinetic, elastic, tips):  # fmt: skip
+    """Fill row k of the derived arrays from the recorded state."""
+    phi, theta = q[k, 3], q[k, 4]
+    S = np.array(euler_rate_matrix(phi, theta))
+    omega[k] = S @ qd[k, 3:6]
+    try:
+        qdd = plant.accelerations(q[k], qd[k], plant.generalized_forces(q[k], tau_applied[k]))
+        omega_dot[k] = S @ qdd[3:6] + np.array(euler_rate_bias(phi, theta, *qd[k, 3:6]))
+        tau_flex[k] = plant.joint_wrench_on_hub(q[k], qd[k])[1]
+    except SimulationError:  # the singular state a failed run stopped at
+        omega_dot[k] = tau_flex[k] = np.nan
+    H[k] = plant.angular_momentum(q[k], qd[k])
+    H_rigid[k] = R_NB[k] @ plant.locked_inertia(q[k]) @ omega[k]
+    kinetic[k] = plant.kinetic_energy(q[k], qd[k])
+    elastic[k] = plant.elastic_energy(q[k])
+    tips[k] = plant.tip_displacement(q[k])
