@@ -1,0 +1,35 @@
+"""Figures of flexsat: satellite geometry for drawing, modal-analysis plots and animations."""
+
+from flexsat.plots.geometry import (
+    HubOutline,
+    SatelliteGeometry,
+    hub_outline,
+    panel_corners_local,
+    rot_zyx,
+    satellite_geometry,
+)
+from flexsat.plots.modal import (
+    DEFAULT_PEAK_FRACTION,
+    animate_mode,
+    default_animated_modes,
+    mode_amplitude,
+    plot_frequencies,
+    plot_interaction_map,
+    write_modal_figures,
+)
+
+__all__ = [
+    "DEFAULT_PEAK_FRACTION",
+    "HubOutline",
+    "SatelliteGeometry",
+    "animate_mode",
+    "default_animated_modes",
+    "hub_outline",
+    "mode_amplitude",
+    "panel_corners_local",
+    "plot_frequencies",
+    "plot_interaction_map",
+    "rot_zyx",
+    "satellite_geometry",
+    "write_modal_figures",
+]
