@@ -69,3 +69,46 @@ def test_preset_copy_round_trips(tmp_path):
     assert payload["derived"]["appendages"][0]["mass_kg"] == pytest.approx(6.75)
     again = run("config", "preset", "nominal", "-o", str(target))
     assert again.returncode == 2 and "exists" in again.stderr
+
+
+def test_openloop_json_has_the_documented_keys():
+    result = run("openloop", "--duration", "12", "--json")
+    assert result.returncode == 0, result.stderr
+    metrics = json.loads(result.stdout)
+    for key in (
+        "final_angular_momentum_nms", "final_rate_deg_s", "total_energy_j",
+        "peak_elastic_energy_j", "dissipated_energy_j", "peak_flex_torque_nm",
+        "peak_tip_displacement_m", "dominant_frequency_hz", "energy_balance_error_j",
+        "wall_time_s", "steps",
+    ):  # fmt: skip
+        assert key in metrics
+    # 1 N m about Z for 10 s: H_z = 10 N m s (round-off).
+    assert metrics["final_angular_momentum_nms"][2] == pytest.approx(10.0, abs=1e-9)
+    assert metrics["steps"] == 12000
+
+
+def test_openloop_divergence_exits_1_and_keeps_the_partial_result(tmp_path):
+    config = tmp_path / "stiff.toml"
+    from flexsat.config import preset_path
+
+    text = preset_path("nominal").read_text()
+    text = text.replace("translation_x = 50.0", "translation_x = 3000.0")
+    config.write_text(text)
+    out = tmp_path / "run"
+    result = run(
+        "openloop", "--config", str(config), "--dt", "0.01", "--duration", "30", "--out", str(out)
+    )
+    assert result.returncode == 1
+    assert "stopped at t =" in result.stderr
+    assert "Traceback" not in result.stderr
+    import xarray as xr
+
+    with xr.open_dataset(out / "result.nc") as ds:
+        assert ds.attrs["status"] == "failed"
+        assert ds["time"].size > 1
+
+
+def test_openloop_bad_option_exits_2():
+    result = run("openloop", "--dt", "0.5")
+    assert result.returncode == 2
+    assert "dt_s" in result.stderr
