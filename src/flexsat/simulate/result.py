@@ -15,8 +15,8 @@ import numpy as np
 import xarray as xr
 from scipy.spatial.transform import Rotation
 
-from flexsat.dynamics.linalg3 import euler_rate_bias, euler_rate_matrix
 from flexsat.dynamics.plant import Plant
+from flexsat.dynamics.records import derive_records
 from flexsat.errors import SimulationError
 
 __all__ = ["Result", "build_dataset"]
@@ -100,12 +100,13 @@ def build_dataset(
     elastic = np.empty(m)
     tips = np.empty((m, n_app, 3))
     rotations = Rotation.from_euler("ZYX", q[:, 5:2:-1])  # R_NB = Rz(psi) Ry(theta) Rx(phi)
-    R_NB = rotations.as_matrix()
     # A diverged run keeps its last finite state, whose derived values may overflow.
     with np.errstate(over="ignore", invalid="ignore"):
-        for k in range(m):
-            _derive_record(plant, k, q, qd, tau_applied, R_NB, omega, omega_dot, tau_flex, H,
-                           H_rigid, kinetic, elastic, tips)  # fmt: skip
+        derive_records(
+            np.ascontiguousarray(q), np.ascontiguousarray(qd), np.ascontiguousarray(tau_applied),
+            plant.dynamics_args, plant.tip_point,
+            omega, omega_dot, tau_flex, H, H_rigid, kinetic, elastic, tips,
+        )  # fmt: skip
     total = kinetic + elastic
     quat_scalar_last = rotations.as_quat()
     quaternion = np.column_stack([quat_scalar_last[:, 3], quat_scalar_last[:, :3]])
@@ -160,21 +161,3 @@ def build_dataset(
     }
     return xr.Dataset(data_vars, coords=coords, attrs=attrs)
 
-
-def _derive_record(plant, k, q, qd, tau_applied, R_NB, omega, omega_dot, tau_flex, H, H_rigid,
-                   kinetic, elastic, tips):  # fmt: skip
-    """Fill row k of the derived arrays from the recorded state."""
-    phi, theta = q[k, 3], q[k, 4]
-    S = np.array(euler_rate_matrix(phi, theta))
-    omega[k] = S @ qd[k, 3:6]
-    try:
-        qdd = plant.accelerations(q[k], qd[k], plant.generalized_forces(q[k], tau_applied[k]))
-        omega_dot[k] = S @ qdd[3:6] + np.array(euler_rate_bias(phi, theta, *qd[k, 3:6]))
-        tau_flex[k] = plant.joint_wrench_on_hub(q[k], qd[k])[1]
-    except SimulationError:  # the singular state a failed run stopped at
-        omega_dot[k] = tau_flex[k] = np.nan
-    H[k] = plant.angular_momentum(q[k], qd[k])
-    H_rigid[k] = R_NB[k] @ plant.locked_inertia(q[k]) @ omega[k]
-    kinetic[k] = plant.kinetic_energy(q[k], qd[k])
-    elastic[k] = plant.elastic_energy(q[k])
-    tips[k] = plant.tip_displacement(q[k])
