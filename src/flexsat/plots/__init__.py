@@ -17,9 +17,23 @@ from flexsat.plots.modal import (
     plot_interaction_map,
     write_modal_figures,
 )
+from flexsat.plots.openloop import (
+    OPENLOOP_FIGURES,
+    plot_angular_acceleration,
+    plot_angular_momentum,
+    plot_attitude,
+    plot_energy,
+    plot_quaternion,
+    plot_root_deformation,
+    plot_spectrogram,
+    plot_tip_displacement,
+    plot_torques,
+    write_openloop_figures,
+)
 
 __all__ = [
     "DEFAULT_PEAK_FRACTION",
+    "OPENLOOP_FIGURES",
     "HubOutline",
     "SatelliteGeometry",
     "animate_mode",
@@ -27,9 +41,19 @@ __all__ = [
     "hub_outline",
     "mode_amplitude",
     "panel_corners_local",
+    "plot_angular_acceleration",
+    "plot_angular_momentum",
+    "plot_attitude",
+    "plot_energy",
     "plot_frequencies",
     "plot_interaction_map",
+    "plot_quaternion",
+    "plot_root_deformation",
+    "plot_spectrogram",
+    "plot_tip_displacement",
+    "plot_torques",
     "rot_zyx",
     "satellite_geometry",
     "write_modal_figures",
+    "write_openloop_figures",
 ]
