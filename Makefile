@@ -14,7 +14,8 @@ $(STAMP): pyproject.toml
 
 demo: $(STAMP)
 	$(BIN)/flexsat modal --out out/modal
-	@echo "Figures and JSON written to out/modal/"
+	$(BIN)/flexsat openloop --out out/openloop
+	@echo "Modal analysis in out/modal/, open-loop validation (result.nc, metrics.json, figures) in out/openloop/"
 
 test: $(STAMP)
 	$(BIN)/ruff check src tests bench
@@ -22,6 +23,7 @@ test: $(STAMP)
 
 bench: $(STAMP)
 	$(BIN)/python bench/bench_dynamics.py
+	$(BIN)/python bench/bench_openloop.py
 
 lint: $(STAMP)
 	$(BIN)/ruff check src tests bench
