@@ -238,3 +238,14 @@ def test_other_topologies_simulate(any_plant):
     pushing = t <= 10.0
     np.testing.assert_allclose(H[pushing], impulse[pushing], atol=1e-5 * 10.0)
     np.testing.assert_allclose(H[t > 10.0], np.broadcast_to(H[-1], H[t > 10.0].shape), atol=1e-8)
+
+
+def test_recorded_flex_torque_two_ways(nominal_plant, thesis_run):
+    # DESIGN.md: tau_flex from the joint wrench equals J_hub w_dot + w x J_hub w -
+    # tau_applied (the hub's Euler equation), on every record; round-off only.
+    ds = thesis_run.dataset
+    J = nominal_plant.hub_J
+    w, w_dot = ds["omega"].values, ds["omega_dot"].values
+    expected = w_dot @ J.T + np.cross(w, w @ J.T) - ds["tau_applied"].values
+    np.testing.assert_allclose(ds["tau_flex"].values, expected, rtol=0, atol=1e-10)
+    assert np.all(ds["tau_flex"].values[0] == 0.0)  # at rest and undeformed
