@@ -100,7 +100,7 @@ def modal(
         written = write_modal_figures(analysis, out, mode_indices=animate)
         summary["files"] = [str(p) for p in [out / "modal.json", *written]]
     if json_output:
-        typer.echo(json.dumps(summary))
+        typer.echo(json.dumps(_jsonable(summary)))
         return
     _print_modal(summary)
 
@@ -172,12 +172,68 @@ def openloop(
         files = [result.to_netcdf(out / "result.nc")]
         if result.ok:
             files += _openloop_figures(result, plant, out)
-        (out / "metrics.json").write_text(json.dumps(metrics, indent=2))
+        (out / "metrics.json").write_text(json.dumps(_jsonable(metrics), indent=2))
         metrics["files"] = [str(p) for p in [*files, out / "metrics.json"]]
     if json_output:
-        typer.echo(json.dumps(metrics))
+        typer.echo(json.dumps(_jsonable(metrics)))
     else:
         _print_metrics(metrics)
+    if not result.ok:
+        _errors.print(f"[bold red]error:[/] {result.message}", highlight=False)
+        raise typer.Exit(1)
+
+
+@app.command()
+def slew(
+    config: ConfigOption = None,
+    scenario: Annotated[
+        Path | None,
+        typer.Option(help="Slew scenario (TOML). Default: the thesis's 45/45/45 deg ASMC slew."),
+    ] = None,
+    controller: Annotated[
+        str | None, typer.Option(help="Override the law: asmc, smc or pd (default gains).")
+    ] = None,
+    duration: Annotated[float | None, typer.Option(help="Override the duration [s].")] = None,
+    json_output: JsonOption = False,
+    out: Annotated[
+        Path | None, typer.Option(help="Write result.nc and metrics.json to this folder.")
+    ] = None,
+) -> None:
+    """Closed-loop slew: a control law flies the flexible satellite; requirements checked.
+
+    The controller knows only the rigid design model of the nominal satellite,
+    whatever --config says (the plant may differ: robustness studies).
+    """
+    from flexsat.analysis.requirements import slew_metrics
+    from flexsat.config import load_config, validate_config
+    from flexsat.dynamics.plant import Plant
+    from flexsat.simulate import SlewScenario, load_slew, run_slew
+
+    plant = Plant.from_config(load_config(config))
+    chosen = load_slew(scenario)
+    overrides: dict = {}
+    if duration is not None:
+        overrides["duration_s"] = duration
+    if controller is not None:
+        overrides["controller"] = {"kind": controller}
+    if overrides:
+        chosen = validate_config(
+            {**chosen.model_dump(by_alias=True), **overrides}, source="options", model=SlewScenario
+        )
+    result = run_slew(plant, chosen, progress=None if not json_output else False)
+    req = chosen.requirements
+    metrics = slew_metrics(
+        result.dataset, req.pointing_deg, req.jitter_deg_s, chosen.actuator.t_max_nm
+    )
+    if out is not None:
+        out.mkdir(parents=True, exist_ok=True)
+        files = [result.to_netcdf(out / "result.nc")]
+        (out / "metrics.json").write_text(json.dumps(_jsonable(metrics), indent=2))
+        metrics["files"] = [str(p) for p in [*files, out / "metrics.json"]]
+    if json_output:
+        typer.echo(json.dumps(_jsonable(metrics)))
+    else:
+        _print_metrics(metrics, title=f"Slew with {chosen.controller.kind.upper()}")
     if not result.ok:
         _errors.print(f"[bold red]error:[/] {result.message}", highlight=False)
         raise typer.Exit(1)
@@ -190,8 +246,19 @@ def _openloop_figures(result, plant, out: Path) -> list[Path]:
     return write_openloop_figures(result.dataset, modal_analysis(plant), out)
 
 
-def _print_metrics(metrics: dict) -> None:
-    table = Table(title="Open-loop run")
+def _jsonable(value):
+    """Strict JSON: NaN (a quantity that does not exist, e.g. never settled) -> null."""
+    if isinstance(value, float) and not np.isfinite(value):
+        return None
+    if isinstance(value, dict):
+        return {key: _jsonable(item) for key, item in value.items()}
+    if isinstance(value, list):
+        return [_jsonable(item) for item in value]
+    return value
+
+
+def _print_metrics(metrics: dict, title: str = "Open-loop run") -> None:
+    table = Table(title=title)
     table.add_column("metric")
     table.add_column("value", justify="right")
     for key, value in metrics.items():
@@ -199,7 +266,7 @@ def _print_metrics(metrics: dict) -> None:
             continue
         shown = (
             ", ".join(f"{v:.6g}" for v in value)
-            if isinstance(value, list)
+            if isinstance(value, list) and all(isinstance(v, float) for v in value)
             else (f"{value:.6g}" if isinstance(value, float) else str(value))
         )
         table.add_row(key, shown)

@@ -19,7 +19,13 @@ from numba import njit
 from flexsat.dynamics.kernels import STATUS_OK, accelerations
 from flexsat.dynamics.linalg3 import euler_rate_matrix, mtv
 
-__all__ = ["STATUS_NOT_FINITE", "applied_torque", "augmented_derivative", "rk4_open_loop"]
+__all__ = [
+    "STATUS_NOT_FINITE",
+    "applied_torque",
+    "augmented_derivative",
+    "rk4_open_loop",
+    "rk4_step",
+]
 
 STATUS_NOT_FINITE = 3  # a state component became NaN or infinite
 
@@ -64,6 +70,35 @@ def augmented_derivative(x, torque_B, n, Q, dx, args):
 
 
 @njit(cache=True)
+def rk4_step(x, dt, torque_B, n, Q, scratch, args):
+    """One RK4 step of the augmented state x, in place, under a held body torque.
+
+    ``scratch`` (5, len(x)) and ``Q`` (n,) are work arrays the caller allocates once.
+    On a non-zero status x is left unchanged.
+    """
+    size = x.shape[0]
+    k1, k2, k3, k4, stage = scratch[0], scratch[1], scratch[2], scratch[3], scratch[4]
+    status = augmented_derivative(x, torque_B, n, Q, k1, args)
+    for j in range(size):
+        stage[j] = x[j] + 0.5 * dt * k1[j]
+    status |= augmented_derivative(stage, torque_B, n, Q, k2, args)
+    for j in range(size):
+        stage[j] = x[j] + 0.5 * dt * k2[j]
+    status |= augmented_derivative(stage, torque_B, n, Q, k3, args)
+    for j in range(size):
+        stage[j] = x[j] + dt * k3[j]
+    status |= augmented_derivative(stage, torque_B, n, Q, k4, args)
+    if status != STATUS_OK:
+        return status
+    for j in range(size):
+        stage[j] = x[j] + dt / 6.0 * (k1[j] + 2.0 * k2[j] + 2.0 * k3[j] + k4[j])
+        if not np.isfinite(stage[j]):
+            return STATUS_NOT_FINITE
+    x[:] = stage
+    return STATUS_OK
+
+
+@njit(cache=True)
 def rk4_open_loop(
     x, t0, dt, n_steps, record_every, seg_start, seg_end, seg_torque, disturbance, args,
     rec_t, rec_x, rec_tau, rec_start,
@@ -96,37 +131,15 @@ def rk4_open_loop(
         Steps completed without error (x is the state after them).
     """
     n = (x.shape[0] - 2) // 2
-    size = x.shape[0]
+    scratch = np.empty((5, x.shape[0]))
     Q = np.empty(n)
-    k1 = np.empty(size)
-    k2 = np.empty(size)
-    k3 = np.empty(size)
-    k4 = np.empty(size)
-    stage = np.empty(size)
     row = rec_start
     for k in range(n_steps):
         t = t0 + k * dt
         torque = applied_torque(t, seg_start, seg_end, seg_torque, disturbance)
-        status = augmented_derivative(x, torque, n, Q, k1, args)
-        for j in range(size):
-            stage[j] = x[j] + 0.5 * dt * k1[j]
-        status |= augmented_derivative(stage, torque, n, Q, k2, args)
-        for j in range(size):
-            stage[j] = x[j] + 0.5 * dt * k2[j]
-        status |= augmented_derivative(stage, torque, n, Q, k3, args)
-        for j in range(size):
-            stage[j] = x[j] + dt * k3[j]
-        status |= augmented_derivative(stage, torque, n, Q, k4, args)
+        status = rk4_step(x, dt, torque, n, Q, scratch, args)
         if status != STATUS_OK:
             return status, k
-        finite = True
-        for j in range(size):
-            stage[j] = x[j] + dt / 6.0 * (k1[j] + 2.0 * k2[j] + 2.0 * k3[j] + k4[j])
-            if not np.isfinite(stage[j]):
-                finite = False
-        if not finite:
-            return STATUS_NOT_FINITE, k
-        x[:] = stage
         if (k + 1) % record_every == 0:
             t_next = t0 + (k + 1) * dt
             rec_t[row] = t_next

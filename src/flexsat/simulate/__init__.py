@@ -1,11 +1,15 @@
 """Simulation drivers: scenarios in, :class:`Result` (an xarray Dataset) out."""
 
+from flexsat.simulate.closedloop import design_inertia, run_slew
 from flexsat.simulate.openloop import initial_state, run_openloop
 from flexsat.simulate.result import Result
 from flexsat.simulate.scenario import (
     OpenLoopScenario,
+    Requirements,
+    SlewScenario,
     TorqueSegment,
     load_scenario,
+    load_slew,
     pulse,
     step,
     thesis_openloop,
@@ -13,12 +17,17 @@ from flexsat.simulate.scenario import (
 
 __all__ = [
     "OpenLoopScenario",
+    "Requirements",
     "Result",
+    "SlewScenario",
     "TorqueSegment",
+    "design_inertia",
     "initial_state",
     "load_scenario",
+    "load_slew",
     "pulse",
     "run_openloop",
+    "run_slew",
     "step",
     "thesis_openloop",
 ]

@@ -3,17 +3,12 @@
 from __future__ import annotations
 
 import itertools
-import json
 import time
 
 import numpy as np
-from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
 from scipy.integrate import solve_ivp
 
-from flexsat import __version__
-from flexsat.dynamics import kernels
 from flexsat.dynamics.integrators import (
-    STATUS_NOT_FINITE,
     applied_torque,
     augmented_derivative,
     rk4_open_loop,
@@ -21,18 +16,17 @@ from flexsat.dynamics.integrators import (
 from flexsat.dynamics.linalg3 import euler_rate_matrix_inv
 from flexsat.dynamics.plant import Plant
 from flexsat.errors import ConfigError, SimulationError
+from flexsat.simulate.common import (
+    PROGRESS_MIN_STEPS,
+    chunk_steps,
+    progress_bar,
+    run_attributes,
+)
 from flexsat.simulate.result import Result, build_dataset
 from flexsat.simulate.scenario import OpenLoopScenario, thesis_openloop
 
 __all__ = ["initial_state", "run_openloop"]
 
-_PROGRESS_MIN_STEPS = 200_000  # runs shorter than this (~1 s of wall time) show no bar
-_CHUNK_STEPS = 10_000  # compiled steps between progress updates
-_FAILURES = {
-    kernels.STATUS_HUB_GIMBAL_LOCK: "hub pitch reached +-90 deg (ZYX Euler-angle singularity)",
-    kernels.STATUS_JOINT_GIMBAL_LOCK: "a joint root rotation rho_y reached +-90 deg",
-    STATUS_NOT_FINITE: "the state became non-finite (the integration diverged)",
-}
 
 
 def initial_state(plant: Plant, scenario: OpenLoopScenario) -> tuple[np.ndarray, np.ndarray]:
@@ -107,21 +101,8 @@ def run_openloop(
     tau_cmd = np.array(
         [applied_torque(tk, seg_start, seg_end, seg_torque, np.zeros(3)) for tk in t]
     ).reshape(-1, 3)
-    message = ""
-    if status:
-        message = f"simulation stopped at t = {t_fail:.6g} s: {_FAILURES[status]}"
-    attrs = {
-        "title": f"flexsat open-loop run '{scenario.name}' of '{plant.config.name}'",
-        "flexsat_version": __version__,
-        "config": json.dumps(plant.config.model_dump(mode="json")),
-        "scenario": json.dumps(scenario.model_dump(mode="json")),
-        "solver": scenario.solver,
-        "status": "ok" if status == 0 else "failed",
-        "message": message,
-        "failure_time_s": t_fail if status else -1.0,
-        "wall_time_s": wall,
-        "steps": steps,
-    }
+    attrs = run_attributes(plant, scenario, "open-loop", status, t_fail, wall, steps)
+    attrs["solver"] = scenario.solver
     dataset = build_dataset(
         plant, t, X[:, :n], X[:, n : 2 * n], X[:, 2 * n], X[:, 2 * n + 1], tau_cmd, tau, attrs
     )
@@ -138,10 +119,10 @@ def _run_rk4(plant, scenario, q0, qd0, profile, progress):
     x = np.concatenate([q0, qd0, [0.0, 0.0]])
     rec_t[0], rec_x[0] = 0.0, x
     rec_tau[0] = applied_torque(0.0, *profile)
-    show = n_steps >= _PROGRESS_MIN_STEPS if progress is None else progress
-    chunk = max(every, (_CHUNK_STEPS // every) * every)
+    show = n_steps >= PROGRESS_MIN_STEPS if progress is None else progress
+    chunk = chunk_steps(every)
     done, status = 0, 0
-    with _progress_bar(show, scenario.duration_s) as (bar, task):
+    with progress_bar(show, scenario.duration_s) as (bar, task):
         while done < n_steps and status == 0:
             steps = min(chunk, n_steps - done)
             status, ran = rk4_open_loop(
@@ -160,29 +141,6 @@ def _run_rk4(plant, scenario, q0, qd0, profile, progress):
         rec_tau[kept - 1] = applied_torque(done * dt, *profile)
         rec_t, rec_x, rec_tau = rec_t[:kept], rec_x[:kept], rec_tau[:kept]
     return rec_t, rec_x, rec_tau, status, t_fail, done
-
-
-class _progress_bar:
-    """Context manager yielding (progress, task) or (None, None) when hidden."""
-
-    def __init__(self, show: bool, total_s: float) -> None:
-        self.show, self.total = show, total_s
-        self.progress = None
-
-    def __enter__(self):
-        if not self.show:
-            return None, None
-        self.progress = Progress(
-            TextColumn("simulating"), BarColumn(),
-            TextColumn("{task.completed:.1f}/{task.total:.0f} s"), TimeRemainingColumn(),
-            transient=True,
-        )  # fmt: skip
-        self.progress.start()
-        return self.progress, self.progress.add_task("run", total=self.total)
-
-    def __exit__(self, *exc) -> None:
-        if self.progress is not None:
-            self.progress.stop()
 
 
 def _run_dop853(plant, scenario, q0, qd0, profile):

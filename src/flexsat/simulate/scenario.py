@@ -13,13 +13,17 @@ from pydantic import Field, model_validator
 
 from flexsat.config.load import read_toml, validate_config
 from flexsat.config.models import Positive, Real, Vector3, _Frozen
+from flexsat.control.config import ActuatorConfig, ASMCConfig, ControllerConfig, DisturbanceConfig
 
 __all__ = [
     "AppendageInitialState",
     "InitialState",
     "OpenLoopScenario",
+    "Requirements",
+    "SlewScenario",
     "TorqueSegment",
     "load_scenario",
+    "load_slew",
     "pulse",
     "step",
     "thesis_openloop",
@@ -122,6 +126,62 @@ class OpenLoopScenario(_Frozen):
     @property
     def record_every(self) -> int:
         return round(self.record_dt_s / self.dt_s)
+
+
+class Requirements(_Frozen):
+    """Pointing requirements checked on every slew (thesis sec. 5.1.1)."""
+
+    pointing_deg: Positive = Field(0.05, description="R1: absolute pointing error [deg]")
+    jitter_deg_s: Positive = Field(1e-3, description="R2: residual rate [deg/s]")
+
+
+class SlewScenario(_Frozen):
+    """A closed-loop rest-to-rest slew. The default is the thesis's (section 5.1):
+    from the identity to 45 deg on roll, pitch and yaw, ASMC, disturbances at their
+    maximum, 120 s, RK4 at 1 ms with the controller at every step."""
+
+    name: str = "thesis-slew"
+    duration_s: Annotated[float, Field(gt=0.0, le=1e6, allow_inf_nan=False)] = 120.0
+    dt_s: Annotated[float, Field(gt=0.0, le=0.1, allow_inf_nan=False)] = 1e-3
+    control_dt_s: Annotated[float, Field(gt=0.0, le=10.0, allow_inf_nan=False)] = 1e-3
+    record_dt_s: Annotated[float, Field(gt=0.0, allow_inf_nan=False)] = 1e-2
+    initial: InitialState = Field(default_factory=InitialState)
+    target_euler_deg: Vector3 = Field(
+        (45.0, 45.0, 45.0), description="target ZYX Euler angles (roll, pitch, yaw) [deg]"
+    )
+    controller: ControllerConfig = Field(default_factory=ASMCConfig)
+    actuator: ActuatorConfig = Field(default_factory=ActuatorConfig)
+    disturbances: DisturbanceConfig = Field(default_factory=DisturbanceConfig)
+    requirements: Requirements = Field(default_factory=Requirements)
+
+    @model_validator(mode="after")
+    def _steps(self) -> SlewScenario:
+        for field in ("control_dt_s", "record_dt_s"):
+            ratio = getattr(self, field) / self.dt_s
+            if ratio < 1.0 - 1e-9 or abs(ratio - round(ratio)) > 1e-6 * ratio:
+                raise ValueError(f"{field} must be a whole multiple of dt_s ({self.dt_s})")
+        if self.duration_s < self.record_dt_s:
+            raise ValueError(f"duration_s must be at least record_dt_s ({self.record_dt_s})")
+        return self
+
+    @property
+    def n_steps(self) -> int:
+        return round(self.duration_s / self.dt_s)
+
+    @property
+    def control_every(self) -> int:
+        return round(self.control_dt_s / self.dt_s)
+
+    @property
+    def record_every(self) -> int:
+        return round(self.record_dt_s / self.dt_s)
+
+
+def load_slew(path: str | Path | None = None) -> SlewScenario:
+    """Read and validate a slew scenario TOML; ``None`` gives the thesis's slew."""
+    if path is None:
+        return SlewScenario()
+    return validate_config(read_toml(path, "scenario"), source=str(path), model=SlewScenario)
 
 
 def thesis_openloop() -> OpenLoopScenario:

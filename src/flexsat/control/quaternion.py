@@ -1,0 +1,49 @@
+"""Attitude quaternions (scalar first, as the thesis): compiled helpers and the one
+conversion point to scipy's scalar-last convention."""
+
+from __future__ import annotations
+
+from math import cos, sin
+
+import numpy as np
+from numba import njit
+from scipy.spatial.transform import Rotation
+
+__all__ = ["euler_zyx_to_quaternion", "quaternion_error", "target_quaternion"]
+
+
+@njit(cache=True)
+def euler_zyx_to_quaternion(phi, theta, psi):
+    """Scalar-first quaternion of R_NB = Rz(psi) Ry(theta) Rx(phi) (the sensor interface)."""
+    c1, s1 = cos(0.5 * phi), sin(0.5 * phi)
+    c2, s2 = cos(0.5 * theta), sin(0.5 * theta)
+    c3, s3 = cos(0.5 * psi), sin(0.5 * psi)
+    return (
+        c1 * c2 * c3 + s1 * s2 * s3,
+        s1 * c2 * c3 - c1 * s2 * s3,
+        c1 * s2 * c3 + s1 * c2 * s3,
+        c1 * c2 * s3 - s1 * s2 * c3,
+    )
+
+
+@njit(cache=True)
+def quaternion_error(q_d, q):
+    """q_e = q_d^-1 (x) q (eq. 4.1), sign chosen so that q_e0 >= 0 (the shorter rotation)."""
+    e0 = q_d[0] * q[0] + q_d[1] * q[1] + q_d[2] * q[2] + q_d[3] * q[3]
+    e1 = -q_d[1] * q[0] + q_d[0] * q[1] + q_d[3] * q[2] - q_d[2] * q[3]
+    e2 = -q_d[2] * q[0] - q_d[3] * q[1] + q_d[0] * q[2] + q_d[1] * q[3]
+    e3 = -q_d[3] * q[0] + q_d[2] * q[1] - q_d[1] * q[2] + q_d[0] * q[3]
+    if e0 < 0.0:
+        return (-e0, -e1, -e2, -e3)
+    return (e0, e1, e2, e3)
+
+
+def target_quaternion(euler_deg: tuple[float, float, float]) -> np.ndarray:
+    """Exact scalar-first quaternion of target ZYX Euler angles (roll, pitch, yaw) [deg].
+
+    The thesis's [0.8446, 0.1913, 0.4619, 0.1913] for 45 deg on each axis is this,
+    printed to 4 decimals. scipy works scalar-last; this is the conversion point.
+    """
+    roll, pitch, yaw = euler_deg
+    x, y, z, w = Rotation.from_euler("ZYX", [yaw, pitch, roll], degrees=True).as_quat()
+    return np.array([w, x, y, z])
