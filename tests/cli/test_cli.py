@@ -112,3 +112,18 @@ def test_openloop_bad_option_exits_2():
     result = run("openloop", "--dt", "0.5")
     assert result.returncode == 2
     assert "dt_s" in result.stderr
+
+
+def test_slew_json_reports_the_requirements():
+    result = run("slew", "--duration", "60", "--json")
+    assert result.returncode == 0, result.stderr
+    metrics = json.loads(result.stdout)
+    for key in ("final_pointing_error_deg", "r1_pass", "r2_pass", "r3_pass", "r1_settling_time_s"):
+        assert key in metrics
+    assert metrics["r1_pass"] and metrics["r3_pass"]
+
+
+def test_slew_unknown_controller_exits_2():
+    result = run("slew", "--controller", "lqr")
+    assert result.returncode == 2
+    assert "controller.kind: must be one of" in result.stderr

@@ -86,6 +86,9 @@ def _describe(error: dict[str, Any], model: type[BaseModel]) -> str:
         return f"unknown key {location!r}{suggestion} (allowed here: {', '.join(known)})"
     if kind == "missing":
         return f"missing required field {location!r}"
+    if kind == "union_tag_invalid":
+        ctx = error.get("ctx", {})
+        return f"{location}.kind: must be one of {ctx.get('expected_tags')} (got {ctx.get('tag')!r})"
     if kind in ("model_type", "dict_type"):
         return f"{location}: expected a TOML table (section), got {error.get('input')!r}"
     message = error["msg"].removeprefix("Value error, ")

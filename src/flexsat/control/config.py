@@ -5,7 +5,7 @@ from __future__ import annotations
 from typing import Annotated, Literal
 
 import numpy as np
-from pydantic import Field, model_validator
+from pydantic import Discriminator, Field, Tag, model_validator
 
 from flexsat.config.models import Positive, Vector3, _Frozen
 
@@ -74,7 +74,19 @@ class PDConfig(_Frozen):
         ])  # fmt: skip
 
 
-ControllerConfig = Annotated[ASMCConfig | SMCConfig | PDConfig, Field(discriminator="kind")]
+def _controller_kind(value: object) -> str | None:
+    """The law a controller table names; a table without ``kind`` is the ASMC."""
+    if isinstance(value, dict):
+        return value.get("kind", "asmc")
+    return getattr(value, "kind", None)
+
+
+ControllerConfig = Annotated[
+    Annotated[ASMCConfig, Tag("asmc")]
+    | Annotated[SMCConfig, Tag("smc")]
+    | Annotated[PDConfig, Tag("pd")],
+    Discriminator(_controller_kind),
+]
 
 
 class ActuatorConfig(_Frozen):

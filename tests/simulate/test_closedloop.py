@@ -1,0 +1,119 @@
+"""The thesis's closed-loop validation (section 5.1) and the closed loop's mechanics."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from flexsat.analysis.requirements import settling_time, slew_metrics
+from flexsat.dynamics.plant import Plant
+from flexsat.simulate import SlewScenario, design_inertia, run_slew
+from tests.conftest import config_from, variant
+
+
+def _metrics(result, scenario=None):
+    scenario = scenario or SlewScenario()
+    req = scenario.requirements
+    return slew_metrics(result.dataset, req.pointing_deg, req.jitter_deg_s, 2.0)
+
+
+@pytest.fixture(scope="module")
+def thesis_slew(nominal_plant):
+    return run_slew(nominal_plant)
+
+
+@pytest.fixture(scope="module")
+def thesis_metrics(thesis_slew):
+    return _metrics(thesis_slew)
+
+
+def test_requirements_are_met(thesis_metrics):
+    # Section 5.1.3: R1 (< 0.05 deg), R2 (< 1e-3 deg/s), R3 (|tau| <= 2 N m) all met.
+    assert thesis_metrics["r1_pass"] and thesis_metrics["r2_pass"] and thesis_metrics["r3_pass"]
+
+
+def test_final_pointing_error(thesis_metrics):
+    # Thesis: 2.50e-3 deg at the end. Our run: 2.3e-3 deg. The steady state is set
+    # by the boundary layer and the disturbances (eq. 4.25); the thesis plots a
+    # single value with no stated precision, so we accept the same order: within
+    # 30 % of 2.5e-3 deg.
+    assert thesis_metrics["final_pointing_error_deg"] == pytest.approx(2.5e-3, rel=0.3)
+    np.testing.assert_allclose(thesis_metrics["final_euler_deg"], 45.0, atol=0.01)
+
+
+def test_torque_never_exceeds_the_limits(thesis_slew):
+    ds = thesis_slew.dataset
+    # R3: commands within the software limit RF T_max = 1.9 N m; the applied torque
+    # (gain 0.95, disturbances) within T_max = 2 N m on every axis and record.
+    assert np.abs(ds["tau_cmd"].values).max() <= 1.9 + 1e-12
+    assert np.abs(ds["tau_applied"].values).max() <= 2.0 + 1e-12
+
+
+def test_adaptation_timeline(thesis_metrics):
+    # Section 5.1.3: Lambda leaves its minimum "around 30 s" (the error crosses
+    # theta_th = 5 deg) and the pointing error stays inside R1 "from t ~ 45 s".
+    # Our run: 27.3 s and 37 s. The law as written is the spec (DESIGN.md); the
+    # thesis's plot timing is read off a figure, so the bounds are generous and the
+    # gap on R1 is reported in docs/control.md.
+    assert 20.0 < thesis_metrics["lambda_leaves_min_s"] < 35.0
+    assert 30.0 < thesis_metrics["r1_settling_time_s"] < 50.0
+
+
+def test_adaptive_gains_stay_in_their_bounds(thesis_slew):
+    ds = thesis_slew.dataset
+    lam = ds["lambda_act"].values
+    assert lam.min() >= 0.2 - 1e-12 and lam.max() <= 5.0 + 1e-12
+    assert ds["jk"].values.min() >= 0.8925 - 1e-12  # JK_min floor (eq. 4.30)
+    assert lam[-1] == pytest.approx(5.0, abs=0.01)  # Lambda_max at convergence
+
+
+def test_controller_knows_only_the_nominal_design_model():
+    # A heavier hub is a different plant; the controller keeps the nominal J_tot.
+    heavy = variant()
+    heavy["hub"]["mass_kg"] = 180.0
+    plant = Plant.from_config(config_from(heavy))
+    result = run_slew(plant, SlewScenario(duration_s=1.0))
+    np.testing.assert_array_equal(
+        np.array(result.dataset.attrs["design_inertia"]).reshape(3, 3), design_inertia()
+    )
+
+
+@pytest.mark.parametrize("kind", ["smc", "pd"])
+def test_baselines_fly_the_same_slew(nominal_plant, kind):
+    scenario = SlewScenario.model_validate({"controller": {"kind": kind}})
+    metrics = _metrics(run_slew(nominal_plant, scenario), scenario)
+    assert metrics["r3_pass"]
+    # Both converge near the target; the PD has no integral action, so the
+    # constant disturbances leave it a standing error (~0.08 deg), which is the
+    # point of the comparison.
+    assert metrics["final_pointing_error_deg"] < 0.1
+
+
+def test_lambda_dot_switch(nominal_plant):
+    scenario = SlewScenario.model_validate({"controller": {"include_lambda_dot": True}})
+    metrics = _metrics(run_slew(nominal_plant, scenario), scenario)
+    assert metrics["r1_pass"] and metrics["r3_pass"]
+
+
+def test_slews_are_deterministic(nominal_plant):
+    scenario = SlewScenario(duration_s=5.0)
+    a = run_slew(nominal_plant, scenario).dataset["q"].values
+    b = run_slew(nominal_plant, scenario).dataset["q"].values
+    np.testing.assert_array_equal(a, b)
+
+
+def test_control_sampling_slower_than_the_plant(nominal_plant):
+    # A 10 ms controller (zero-order hold over 10 plant steps) still flies the slew.
+    scenario = SlewScenario(control_dt_s=0.01)
+    metrics = _metrics(run_slew(nominal_plant, scenario), scenario)
+    assert metrics["r1_pass"] and metrics["r3_pass"]
+    held = run_slew(nominal_plant, SlewScenario(control_dt_s=0.01, duration_s=0.1))
+    tau = held.dataset["tau_cmd"].values  # records every 10 ms: a new value each
+    assert np.unique(tau[:, 0]).size == tau.shape[0]
+
+
+def test_settling_time():
+    t = np.arange(6.0)
+    assert settling_time(t, np.array([5, 4, 0.1, 2, 0.1, 0.1]), 1.0) == 4.0
+    assert np.isnan(settling_time(t, np.array([5, 4, 0.1, 2, 0.1, 3]), 1.0))
+    assert settling_time(t, np.zeros(6), 1.0) == 0.0
