@@ -88,7 +88,8 @@ def _describe(error: dict[str, Any], model: type[BaseModel]) -> str:
         return f"missing required field {location!r}"
     if kind == "union_tag_invalid":
         ctx = error.get("ctx", {})
-        return f"{location}.kind: must be one of {ctx.get('expected_tags')} (got {ctx.get('tag')!r})"
+        allowed, got = ctx.get("expected_tags"), ctx.get("tag")
+        return f"{location}.kind: must be one of {allowed} (got {got!r})"
     if kind in ("model_type", "dict_type"):
         return f"{location}: expected a TOML table (section), got {error.get('input')!r}"
     message = error["msg"].removeprefix("Value error, ")
