@@ -18,7 +18,7 @@ demo: $(STAMP)
 	@echo "Modal analysis in out/modal/, open-loop validation (result.nc, metrics.json, figures) in out/openloop/"
 
 test: $(STAMP)
-	$(BIN)/ruff check src tests bench
+	$(BIN)/ruff check src tests bench examples
 	$(BIN)/python -m pytest -q
 
 bench: $(STAMP)
@@ -26,7 +26,7 @@ bench: $(STAMP)
 	$(BIN)/python bench/bench_openloop.py
 
 lint: $(STAMP)
-	$(BIN)/ruff check src tests bench
+	$(BIN)/ruff check src tests bench examples
 
 clean:
 	rm -rf $(VENV) out build *.egg-info src/*.egg-info .pytest_cache .ruff_cache .hypothesis

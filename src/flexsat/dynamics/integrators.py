@@ -23,6 +23,7 @@ __all__ = [
     "STATUS_NOT_FINITE",
     "applied_torque",
     "augmented_derivative",
+    "rk4_hold",
     "rk4_open_loop",
     "rk4_step",
 ]
@@ -96,6 +97,19 @@ def rk4_step(x, dt, torque_B, n, Q, scratch, args):
             return STATUS_NOT_FINITE
     x[:] = stage
     return STATUS_OK
+
+
+@njit(cache=True)
+def rk4_hold(x, dt, n_steps, torque_B, args):
+    """``n_steps`` RK4 steps under one held body torque (3-tuple). Returns (status, done)."""
+    n = (x.shape[0] - 2) // 2
+    scratch = np.empty((5, x.shape[0]))
+    Q = np.empty(n)
+    for k in range(n_steps):
+        status = rk4_step(x, dt, torque_B, n, Q, scratch, args)
+        if status != STATUS_OK:
+            return status, k
+    return STATUS_OK, n_steps
 
 
 @njit(cache=True)
