@@ -117,3 +117,17 @@ def test_settling_time():
     assert settling_time(t, np.array([5, 4, 0.1, 2, 0.1, 0.1]), 1.0) == 4.0
     assert np.isnan(settling_time(t, np.array([5, 4, 0.1, 2, 0.1, 3]), 1.0))
     assert settling_time(t, np.zeros(6), 1.0) == 0.0
+
+
+def test_random_disturbance_draws_are_seeded_and_bounded(nominal_plant):
+    def draw(seed):
+        scenario = SlewScenario.model_validate(
+            {"duration_s": 1.0, "disturbances": {"mode": "random", "seed": seed}}
+        )
+        return np.array(run_slew(nominal_plant, scenario).dataset.attrs["realised_disturbances"])
+
+    a, b, c = draw(1), draw(1), draw(2)
+    np.testing.assert_array_equal(a, b)  # same seed, same draw
+    assert not np.array_equal(a, c)
+    assert np.all((a[0:3] >= 0.95) & (a[0:3] <= 1.05))  # gain within 1 +- 5 %
+    assert np.all(np.abs(a[3:6]) <= 0.005) and 0.0 <= a[6] <= 0.02

@@ -104,7 +104,17 @@ class ActuatorConfig(_Frozen):
 
 
 class DisturbanceConfig(_Frozen):
-    """Disturbance torques "forced to maximum" in the nominal validation (DESIGN.md)."""
+    """Disturbance torques: "forced to maximum" (the nominal validation, DESIGN.md) or
+    one random draw within the same bounds.
+
+    In ``mode = "random"`` each run draws, from ``seed``: the actuator gain per axis
+    uniformly within 1 +- |1 - G_act|, the environment and residual torques per axis
+    within +-|value|, and the sloshing ratio within [0, ratio]. The realised values
+    are stored in the result's attributes so the run can be replayed.
+    """
+
+    mode: Literal["maximum", "random"] = "maximum"
+    seed: Annotated[int, Field(ge=0)] = 0
 
     environment_nm: Vector3 = Field((0.005, 0.005, 0.005), description="constant [N m]")
     sloshing_ratio: Annotated[float, Field(ge=0.0, le=1.0)] = Field(
@@ -114,7 +124,16 @@ class DisturbanceConfig(_Frozen):
     residual_nm: Vector3 = Field((0.0, 0.0, 0.0), description="unmodelled residual [N m]")
 
     def packed(self, actuator: ActuatorConfig) -> np.ndarray:
-        return np.array([
-            *actuator.gain, *self.environment_nm, self.sloshing_ratio, self.sloshing_hz,
-            *self.residual_nm, actuator.t_max_nm,
-        ])  # fmt: skip
+        """Actuator gain, environment, sloshing ratio and frequency, residual, T_max."""
+        gain = np.array(actuator.gain, dtype=float)
+        env = np.array(self.environment_nm, dtype=float)
+        res = np.array(self.residual_nm, dtype=float)
+        ratio = self.sloshing_ratio
+        if self.mode == "random":
+            rng = np.random.default_rng(np.random.SeedSequence(self.seed))
+            spread = np.abs(1.0 - gain)
+            gain = rng.uniform(1.0 - spread, 1.0 + spread)
+            env = rng.uniform(-np.abs(env), np.abs(env))
+            res = rng.uniform(-np.abs(res), np.abs(res))
+            ratio = rng.uniform(0.0, ratio)
+        return np.array([*gain, *env, ratio, self.sloshing_hz, *res, actuator.t_max_nm])

@@ -116,6 +116,8 @@ def run_slew(
     attrs["controller"] = scenario.controller.kind if controller is None else "python"
     attrs["design_inertia"] = J.ravel().tolist()
     attrs["target_quaternion"] = list(q_d)
+    # gain (3), environment (3), sloshing ratio and Hz, residual (3), T_max
+    attrs["realised_disturbances"] = dist.tolist()
     ds = build_dataset(
         plant, rec_t, rec_x[:, :n], rec_x[:, n : 2 * n], rec_x[:, 2 * n], rec_x[:, 2 * n + 1],
         rec_ctrl[:, 0:3], rec_ctrl[:, 3:6], attrs,
