@@ -55,8 +55,8 @@ def test_adaptation_timeline(thesis_metrics):
     # Our run: 27.3 s and 37 s. The law as written is the spec (DESIGN.md); the
     # thesis's plot timing is read off a figure, so the bounds are generous and the
     # gap on R1 is reported in docs/control.md.
-    assert 20.0 < thesis_metrics["lambda_leaves_min_s"] < 35.0
-    assert 30.0 < thesis_metrics["r1_settling_time_s"] < 50.0
+    assert 20.0 < thesis_metrics["lambda_switch_time_s"] < 35.0
+    assert 30.0 < thesis_metrics["settling_time_s"] < 50.0
 
 
 def test_adaptive_gains_stay_in_their_bounds(thesis_slew):
@@ -131,3 +131,55 @@ def test_random_disturbance_draws_are_seeded_and_bounded(nominal_plant):
     assert not np.array_equal(a, c)
     assert np.all((a[0:3] >= 0.95) & (a[0:3] <= 1.05))  # gain within 1 +- 5 %
     assert np.all(np.abs(a[3:6]) <= 0.005) and 0.0 <= a[6] <= 0.02
+
+
+def test_residual_disturbance_switch_still_meets_r1(nominal_plant):
+    # DESIGN.md: injecting the 0.005 N m residual roughly doubles the steady-state
+    # error, still inside R1 (measured 4.6e-3 deg against 2.3e-3 deg).
+    scenario = SlewScenario.model_validate({"disturbances": {"residual_nm": [0.005] * 3}})
+    metrics = _metrics(run_slew(nominal_plant, scenario), scenario)
+    assert metrics["r1_pass"] and metrics["r3_pass"]
+    assert 1.5e-3 < metrics["final_pointing_error_deg"] < 0.05
+
+
+def test_python_callback_form_reproduces_the_compiled_asmc(nominal_plant):
+    # The same compiled law called from Python at each control instant, through
+    # the Python-callback path: identical arithmetic, identical trajectory.
+    from flexsat.control.laws import CompiledLaw
+    from flexsat.control.quaternion import target_quaternion
+
+    scenario = SlewScenario(duration_s=20.0)
+    law = CompiledLaw(
+        scenario.controller, scenario.actuator, design_inertia(),
+        target_quaternion(scenario.target_euler_deg), scenario.control_dt_s,
+    )  # fmt: skip
+    compiled = run_slew(nominal_plant, scenario).dataset
+    python = run_slew(nominal_plant, scenario, controller=law).dataset
+    np.testing.assert_allclose(python["q"].values, compiled["q"].values, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(
+        python["tau_cmd"].values, compiled["tau_cmd"].values, rtol=0, atol=1e-12
+    )
+
+
+BAD_SCENARIOS = [
+    ({"target_euler_deg": [45.0, float("nan"), 45.0]}, "target_euler_deg"),
+    ({"actuator": {"t_max_nm": -2.0}}, "actuator.t_max_nm: Input should be greater than 0"),
+    ({"actuator": {"reduction_factor": 1.2}}, "reduction_factor: Input should be less than or"),
+    ({"actuator": {"reduction_factor": 0.0}}, "reduction_factor: Input should be greater than 0"),
+    ({"controller": {"phi": 0.0}}, "controller.asmc.phi: Input should be greater than 0"),
+    ({"controller": {"lambda_min": 6.0}}, "lambda_max must be >= lambda_min"),
+    ({"controller": {"kind": "lqr"}}, "controller.kind: must be one of"),
+    ({"control_dt_s": 0.0015}, "control_dt_s must be a whole multiple of dt_s"),
+    ({"disturbances": {"sloshing_ratio": -0.1}}, "sloshing_ratio"),
+    ({"requirements": {"pointing_deg": 0.0}}, "requirements.pointing_deg"),
+]
+
+
+@pytest.mark.parametrize(("data", "fragment"), BAD_SCENARIOS, ids=[f for _, f in BAD_SCENARIOS])
+def test_bad_slew_scenarios_are_refused(data, fragment):
+    from flexsat.config import validate_config
+    from flexsat.errors import ConfigError
+
+    with pytest.raises(ConfigError) as caught:
+        validate_config(data, model=SlewScenario)
+    assert fragment in str(caught.value)

@@ -24,7 +24,9 @@ def slew_metrics(ds: xr.Dataset, pointing_deg: float, jitter_deg_s: float, t_max
     R1: pointing error below ``pointing_deg`` at the end; R2: residual rate below
     ``jitter_deg_s`` at the end; R3: |applied torque| <= T_max on every axis at every
     record. Settling times are when each quantity enters its band for good (NaN if
-    it does not by the end). Keys end in their unit (``_deg``, ``_s``, ``_nm``).
+    it does not by the end): ``settling_time_s`` is R1's, ``r2_settling_time_s`` R2's.
+    ``max_abs_torque_nm`` is the applied torque's (R3), ``lambda_switch_time_s`` when
+    Lambda first leaves its initial value. Keys end in their unit.
     """
     t = ds["time"].values
     pointing = ds["pointing_error_deg"].values
@@ -39,14 +41,14 @@ def slew_metrics(ds: xr.Dataset, pointing_deg: float, jitter_deg_s: float, t_max
         "controller": str(ds.attrs.get("controller", "")),
         "final_pointing_error_deg": float(pointing[-1]),
         "final_rate_error_deg_s": float(jitter[-1]),
-        "r1_settling_time_s": r1_time,
+        "settling_time_s": r1_time,
         "r2_settling_time_s": r2_time,
         "r1_pass": bool(pointing[-1] < pointing_deg),
         "r2_pass": bool(jitter[-1] < jitter_deg_s),
+        "max_abs_torque_nm": applied.max(axis=0).tolist(),
         "max_commanded_torque_nm": commanded.max(axis=0).tolist(),
-        "max_applied_torque_nm": applied.max(axis=0).tolist(),
         "r3_pass": bool(np.all(applied <= t_max_nm * (1 + 1e-12))),
-        "lambda_leaves_min_s": float(t[leaves[0]]) if leaves.size else float("nan"),
+        "lambda_switch_time_s": float(t[leaves[0]]) if leaves.size else float("nan"),
         "final_euler_deg": ds["euler_deg"].values[-1].tolist(),
         "peak_flex_torque_nm": np.abs(ds["tau_flex"].values).max(axis=0).tolist(),
         "peak_tip_displacement_m": float(

@@ -191,52 +191,122 @@ def slew(
         typer.Option(help="Slew scenario (TOML). Default: the thesis's 45/45/45 deg ASMC slew."),
     ] = None,
     controller: Annotated[
-        str | None, typer.Option(help="Override the law: asmc, smc or pd (default gains).")
+        str | None,
+        typer.Option(help="Override the law: asmc, smc, pd (default gains) or all (compare)."),
+    ] = None,
+    target_euler_deg: Annotated[
+        str | None, typer.Option(help="Override the target as 'roll,pitch,yaw' [deg].")
     ] = None,
     duration: Annotated[float | None, typer.Option(help="Override the duration [s].")] = None,
     json_output: JsonOption = False,
     out: Annotated[
-        Path | None, typer.Option(help="Write result.nc and metrics.json to this folder.")
+        Path | None,
+        typer.Option(help="Write result.nc, metrics.json and the figures to this folder."),
     ] = None,
 ) -> None:
-    """Closed-loop slew: a control law flies the flexible satellite; requirements checked.
+    """Closed-loop slew: a control law flies the flexible satellite; R1-R3 checked.
 
     The controller knows only the rigid design model of the nominal satellite,
     whatever --config says (the plant may differ: robustness studies).
     """
-    from flexsat.analysis.requirements import slew_metrics
     from flexsat.config import load_config, validate_config
     from flexsat.dynamics.plant import Plant
-    from flexsat.simulate import SlewScenario, load_slew, run_slew
+    from flexsat.simulate import SlewScenario, load_slew
 
     plant = Plant.from_config(load_config(config))
     chosen = load_slew(scenario)
     overrides: dict = {}
     if duration is not None:
         overrides["duration_s"] = duration
-    if controller is not None:
+    if target_euler_deg is not None:
+        overrides["target_euler_deg"] = _parse_triple(target_euler_deg, "--target-euler-deg")
+    if controller is not None and controller != "all":
         overrides["controller"] = {"kind": controller}
     if overrides:
         chosen = validate_config(
             {**chosen.model_dump(by_alias=True), **overrides}, source="options", model=SlewScenario
         )
-    result = run_slew(plant, chosen, progress=None if not json_output else False)
-    req = chosen.requirements
+    if controller == "all":
+        kinds = ("asmc", "smc", "pd")
+        runs = {
+            kind: validate_config(
+                {**chosen.model_dump(by_alias=True), "controller": {"kind": kind}},
+                source="options",
+                model=SlewScenario,
+            )
+            for kind in kinds
+        }
+    else:
+        runs = {chosen.controller.kind: chosen}
+    results = {}
+    failed = []
+    for kind, slew_scenario in runs.items():
+        sub = out / kind if (out is not None and len(runs) > 1) else out
+        metrics, ok, message = _fly(plant, slew_scenario, sub, quiet=json_output)
+        results[kind] = metrics
+        if not ok:
+            failed.append(message)
+    if json_output:
+        payload = results if controller == "all" else next(iter(results.values()))
+        typer.echo(json.dumps(_jsonable(payload)))
+    elif controller == "all":
+        _print_comparison(results)
+    else:
+        kind, metrics = next(iter(results.items()))
+        _print_metrics(metrics, title=f"Slew with {kind.upper()}")
+    if failed:
+        for message in failed:
+            _errors.print(f"[bold red]error:[/] {message}", highlight=False)
+        raise typer.Exit(1)
+
+
+def _parse_triple(text: str, option: str) -> list[float]:
+    try:
+        values = [float(v) for v in text.split(",")]
+    except ValueError:
+        values = []
+    if len(values) != 3:
+        raise FlexsatError(f"{option}: expected three comma-separated numbers, got {text!r}")
+    return values
+
+
+def _fly(plant, scenario, out: Path | None, quiet: bool) -> tuple[dict, bool, str]:
+    """Run one slew, write its files, return (metrics, ok, message)."""
+    from flexsat.analysis.requirements import slew_metrics
+    from flexsat.simulate import run_slew
+
+    result = run_slew(plant, scenario, progress=None if not quiet else False)
+    req = scenario.requirements
     metrics = slew_metrics(
-        result.dataset, req.pointing_deg, req.jitter_deg_s, chosen.actuator.t_max_nm
+        result.dataset, req.pointing_deg, req.jitter_deg_s, scenario.actuator.t_max_nm
     )
     if out is not None:
         out.mkdir(parents=True, exist_ok=True)
         files = [result.to_netcdf(out / "result.nc")]
+        if result.ok:
+            files += _slew_figures(result, out)
         (out / "metrics.json").write_text(json.dumps(_jsonable(metrics), indent=2))
         metrics["files"] = [str(p) for p in [*files, out / "metrics.json"]]
-    if json_output:
-        typer.echo(json.dumps(_jsonable(metrics)))
-    else:
-        _print_metrics(metrics, title=f"Slew with {chosen.controller.kind.upper()}")
-    if not result.ok:
-        _errors.print(f"[bold red]error:[/] {result.message}", highlight=False)
-        raise typer.Exit(1)
+    return metrics, result.ok, result.message
+
+
+def _slew_figures(result, out: Path) -> list[Path]:
+    try:
+        from flexsat.plots.slew import write_slew_figures
+    except ImportError:  # figures of slews not available in this build
+        return []
+    return write_slew_figures(result.dataset, out)
+
+
+def _print_comparison(results: dict) -> None:
+    table = Table(title="Controller comparison (same slew, same plant, same disturbances)")
+    table.add_column("metric", no_wrap=True)
+    for kind in results:
+        table.add_column(kind.upper(), justify="right")
+    keys = [k for k in next(iter(results.values())) if k not in ("files", "controller")]
+    for key in keys:
+        table.add_row(key, *(_shown(results[kind][key]) for kind in results))
+    _console.print(table)
 
 
 def _openloop_figures(result, plant, out: Path) -> list[Path]:
@@ -257,19 +327,20 @@ def _jsonable(value):
     return value
 
 
+def _shown(value) -> str:
+    if isinstance(value, list) and all(isinstance(v, float) for v in value):
+        return ", ".join(f"{v:.6g}" for v in value)
+    return f"{value:.6g}" if isinstance(value, float) else str(value)
+
+
 def _print_metrics(metrics: dict, title: str = "Open-loop run") -> None:
     table = Table(title=title)
-    table.add_column("metric")
+    table.add_column("metric", no_wrap=True)
     table.add_column("value", justify="right")
     for key, value in metrics.items():
         if key == "files":
             continue
-        shown = (
-            ", ".join(f"{v:.6g}" for v in value)
-            if isinstance(value, list) and all(isinstance(v, float) for v in value)
-            else (f"{value:.6g}" if isinstance(value, float) else str(value))
-        )
-        table.add_row(key, shown)
+        table.add_row(key, _shown(value))
     _console.print(table)
     for path in metrics.get("files", []):
         _console.print(f"wrote {path}")

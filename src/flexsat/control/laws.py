@@ -31,6 +31,7 @@ __all__ = [
     "PD_GAINS",
     "SMC",
     "SMC_GAINS",
+    "CompiledLaw",
     "control_law",
 ]
 
@@ -146,3 +147,40 @@ def control_law(kind, gains, J, q_d, q, omega_B, dt, memory, diag):
     diag[13], diag[14], diag[15] = tau_rob
     diag[16] = theta_err
     return tau
+
+
+class CompiledLaw:
+    """A built-in law as a plain-Python controller (the ``Controller`` protocol).
+
+    Calls the same compiled :func:`control_law` the closed loop runs internally, so
+    a slew flown through the Python-callback path with it reproduces the compiled
+    loop; useful to check a custom loop or to wrap a built-in law.
+
+    Parameters
+    ----------
+    config : ASMCConfig, SMCConfig or PDConfig
+    actuator : ActuatorConfig
+    J : ndarray, shape (3, 3)
+        Design inertia [kg m^2].
+    q_d : ndarray, shape (4,)
+        Target quaternion, scalar first.
+    control_dt : float
+        Control period [s] (for the Lambda_dot term).
+    """
+
+    def __init__(self, config, actuator, J, q_d, control_dt: float) -> None:
+        import numpy as np
+
+        self.kind = {"asmc": ASMC, "smc": SMC, "pd": PD}[config.kind]
+        self.gains = config.gains(actuator)
+        self.J = np.ascontiguousarray(J, dtype=float)
+        self.q_d = tuple(float(v) for v in q_d)
+        self.dt = float(control_dt)
+        self.memory = np.zeros(2)
+        self.diag = np.empty(DIAG_SIZE)
+
+    def __call__(self, t, q, omega_B):
+        return control_law(
+            self.kind, self.gains, self.J, self.q_d, tuple(q), tuple(omega_B), self.dt,
+            self.memory, self.diag,
+        )  # fmt: skip
