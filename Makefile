@@ -24,6 +24,7 @@ test: $(STAMP)
 bench: $(STAMP)
 	$(BIN)/python bench/bench_dynamics.py
 	$(BIN)/python bench/bench_openloop.py
+	$(BIN)/python bench/bench_slew.py
 
 lint: $(STAMP)
 	$(BIN)/ruff check src tests bench examples
