@@ -20,6 +20,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.spatial.transform import Rotation
 
 from flexsat.dynamics.plant import Plant
 
@@ -53,15 +54,8 @@ def rot_zyx(angles: np.ndarray) -> np.ndarray:
         :func:`flexsat.dynamics.linalg3.rot_zyx`.
     """
     a = np.asarray(angles, dtype=float)
-    c1, s1 = np.cos(a[..., 0]), np.sin(a[..., 0])
-    c2, s2 = np.cos(a[..., 1]), np.sin(a[..., 1])
-    c3, s3 = np.cos(a[..., 2]), np.sin(a[..., 2])
-    rows = (
-        (c3 * c2, c3 * s2 * s1 - s3 * c1, c3 * s2 * c1 + s3 * s1),
-        (s3 * c2, s3 * s2 * s1 + c3 * c1, s3 * s2 * c1 - c3 * s1),
-        (-s2, c2 * s1, c2 * c1),
-    )
-    return np.stack([np.stack(row, axis=-1) for row in rows], axis=-2)
+    flat = Rotation.from_euler("ZYX", a.reshape(-1, 3)[:, ::-1]).as_matrix()
+    return flat.reshape(*a.shape[:-1], 3, 3)
 
 
 @dataclass(frozen=True)
