@@ -15,7 +15,8 @@ $(STAMP): pyproject.toml
 demo: $(STAMP)
 	$(BIN)/flexsat modal --out out/modal
 	$(BIN)/flexsat openloop --out out/openloop
-	@echo "Modal analysis in out/modal/, open-loop validation (result.nc, metrics.json, figures) in out/openloop/"
+	$(BIN)/flexsat slew --out out/slew
+	@echo "Study of the nominal case written to out/: modal/ (modes), openloop/ (open-loop validation), slew/ (ASMC slew, R1-R3)"
 
 test: $(STAMP)
 	$(BIN)/ruff check src tests bench examples

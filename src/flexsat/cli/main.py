@@ -291,10 +291,8 @@ def _fly(plant, scenario, out: Path | None, quiet: bool) -> tuple[dict, bool, st
 
 
 def _slew_figures(result, out: Path) -> list[Path]:
-    try:
-        from flexsat.plots.slew import write_slew_figures
-    except ImportError:  # figures of slews not available in this build
-        return []
+    from flexsat.plots.slew import write_slew_figures
+
     return write_slew_figures(result.dataset, out)
 
 

@@ -103,15 +103,21 @@ def _free_from(ds: xr.Dataset) -> float | None:
     return None if end >= t[-1] and np.abs(ds["tau_cmd"].values[-1]).max() > 0.0 else float(end)
 
 
+def _shaded(ds: xr.Dataset) -> bool:
+    """Open-loop runs shade their torque pulses; a slew commands torque throughout."""
+    return "controller" not in ds.attrs
+
+
 def _shade_torque(axes, ds: xr.Dataset) -> None:
-    intervals = _torque_intervals(ds)
+    intervals = _torque_intervals(ds) if _shaded(ds) else []
     for ax in np.ravel(axes):
         for a, b in intervals:
             ax.axvspan(a, b, color=_TORQUE_SHADE, zorder=0, linewidth=0)
 
 
-def _torque_patch() -> Patch:
-    return Patch(color=_TORQUE_SHADE, label="torque commanded")
+def _torque_patches(ds: xr.Dataset) -> list[Patch]:
+    """The legend entry of the shading, when there is shading."""
+    return [Patch(color=_TORQUE_SHADE, label="torque commanded")] if _shaded(ds) else []
 
 
 def _suptitle(fig: Figure, ds: xr.Dataset, what: str) -> None:
@@ -192,7 +198,8 @@ def plot_attitude(ds: xr.Dataset) -> Figure:
         _line(axes[1, k], t, rate[:, k], color=_AXIS_COLOURS[k], label=f"ω_{_AXES[k]}")
         axes[1, k].set_ylabel(f"ω_{_AXES[k]} [deg/s]")
         axes[1, k].set_title(f"body rate ω_{_AXES[k]} (frame B)", fontsize=10)
-    axes[0, 0].legend(handles=[_torque_patch()], loc="upper left", fontsize=8)
+    if _shaded(ds):
+        axes[0, 0].legend(handles=_torque_patches(ds), loc="upper left", fontsize=8)
     _finish_time_axis(axes, t)
     _suptitle(fig, ds, "Hub attitude (ZYX Euler angles) and body rates")
     return fig
@@ -222,7 +229,7 @@ def plot_quaternion(ds: xr.Dataset) -> Figure:
     ax.set_ylabel("quaternion component [-]")
     ax.set_ylim(-1.1, 1.1)
     handles, _ = ax.get_legend_handles_labels()
-    ax.legend(handles=[*handles, _torque_patch()], loc="lower left", fontsize=8, ncols=5)
+    ax.legend(handles=[*handles, *_torque_patches(ds)], loc="lower left", fontsize=8, ncols=5)
     _finish_time_axis(axes, t)
     _suptitle(fig, ds, "Hub attitude quaternion (scalar first, frame B to N)")
     return fig
@@ -267,7 +274,7 @@ def plot_angular_acceleration(ds: xr.Dataset, analysis: ModalAnalysis | None = N
               label=f"ω̇_{_AXES[k]}")  # fmt: skip
         ax.set_ylabel(f"ω̇_{_AXES[k]} [{units}]")
         handles, _ = ax.get_legend_handles_labels()
-        ax.legend(handles=handles + ([_torque_patch()] if k == 0 else []), loc="upper right",
+        ax.legend(handles=handles + (_torque_patches(ds) if k == 0 else []), loc="upper right",
                   fontsize=8)  # fmt: skip
     _finish_time_axis(np.array(axes)[:, None], t)
     for ax in axes[:2]:
@@ -371,7 +378,7 @@ def plot_torques(ds: xr.Dataset) -> Figure:
         ax.set_title(f"{_AXES[k]} axis  (peak |τ_flex| = {np.abs(flex[:, k]).max():.3g} N m)",
                      fontsize=10)  # fmt: skip
         handles, _ = ax.get_legend_handles_labels()
-        ax.legend(handles=[*handles, _torque_patch()], loc="upper right", fontsize=8, ncols=2)
+        ax.legend(handles=[*handles, *_torque_patches(ds)], loc="upper right", fontsize=8, ncols=2)
     _finish_time_axis(axes, t)
     _suptitle(fig, ds, "Torques on the hub: applied, flexible reaction, net (frame B)")
     return fig
@@ -419,7 +426,7 @@ def plot_root_deformation(ds: xr.Dataset) -> Figure:
         axes[k, 1].set_ylabel(f"η_{_AXES[k]} [{eta_units}]")
         axes[k, 1].set_title(f"root translation η_{_AXES[k]}", fontsize=10)
     handles, _ = axes[0, 0].get_legend_handles_labels()
-    fig.legend(handles=[*handles, _torque_patch()], loc="outside lower center",
+    fig.legend(handles=[*handles, *_torque_patches(ds)], loc="outside lower center",
                ncols=len(handles) + 1, fontsize=9)  # fmt: skip
     _finish_time_axis(axes, t)
     _suptitle(fig, ds, "Appendage root-joint deformations (mount frame)")
@@ -456,7 +463,7 @@ def plot_tip_displacement(ds: xr.Dataset) -> Figure:
         ax.set_ylabel("tip displacement [mm]")
         ax.set_title(f"{name}  (peak |δ| = {norm.max():.3g} mm)", fontsize=10)
     handles, _ = axes[0, 0].get_legend_handles_labels()
-    fig.legend(handles=[*handles, _torque_patch()], loc="outside lower center",
+    fig.legend(handles=[*handles, *_torque_patches(ds)], loc="outside lower center",
                ncols=len(handles) + 1, fontsize=9)  # fmt: skip
     _finish_time_axis(axes, t)
     _suptitle(fig, ds, "Panel tip displacement (mount frame)")
@@ -509,7 +516,7 @@ def plot_angular_momentum(ds: xr.Dataset) -> Figure:
                          fontsize=10)  # fmt: skip
     axes[1, 0].set_ylabel(f"H − J(η)ω [{units}]")
     handles, _ = axes[0, 0].get_legend_handles_labels()
-    axes[0, 0].legend(handles=[*handles, _torque_patch()], loc="center right", fontsize=8,
+    axes[0, 0].legend(handles=[*handles, *_torque_patches(ds)], loc="center right", fontsize=8,
                       ncols=2)  # fmt: skip
     handles, _ = axes[1, 0].get_legend_handles_labels()
     axes[1, 0].legend(handles=handles, loc="upper right", fontsize=8)
@@ -569,7 +576,7 @@ def plot_energy(ds: xr.Dataset) -> Figure:
                     fontsize=10)  # fmt: skip
     for ax in (macro, micro):
         handles, _ = ax.get_legend_handles_labels()
-        ax.legend(handles=[*handles, _torque_patch()], loc="center right", fontsize=8)
+        ax.legend(handles=[*handles, *_torque_patches(ds)], loc="center right", fontsize=8)
     _finish_time_axis(axes, t)
     _suptitle(fig, ds, "Energy balance")
     return fig

@@ -18,14 +18,19 @@ run (``ds.attrs["scenario"]``), so they match whatever scenario flew the slew.
 - :func:`plot_torque_limits`: commanded and applied torque against RF*T_max, T_max.
 - :func:`plot_torque_breakdown`: gyroscopic, equivalent and robust parts of the law.
 - :func:`plot_flex_torque`: joint torque of the appendages against the net torque.
-- :func:`write_slew_figures`: all of the above, plus the appendage deformations,
-  tip displacements and energy balance of :mod:`flexsat.plots.openloop`, as PNG.
+- :func:`plot_slew_root_deformation`, :func:`plot_slew_tip_displacement`,
+  :func:`plot_slew_energy`: the open-loop figures of :mod:`flexsat.plots.openloop`
+  drawn for the slew (without their torque-on shading, torque being commanded
+  throughout a slew).
+- :func:`attitude_error_vector`: q_v,e at every record, for the phase plane.
+- :func:`write_slew_figures`: all of the above into a folder as PNG.
 """
 
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from itertools import pairwise
 from pathlib import Path
 
 import numpy as np
@@ -34,6 +39,7 @@ from matplotlib.axes import Axes
 from matplotlib.collections import LineCollection
 from matplotlib.colors import Normalize
 from matplotlib.figure import Figure
+from matplotlib.ticker import MaxNLocator
 from pydantic import ValidationError
 
 from flexsat.analysis.requirements import settling_time
@@ -63,7 +69,10 @@ __all__ = [
     "plot_phase_plane",
     "plot_pointing",
     "plot_slew_attitude",
+    "plot_slew_energy",
     "plot_slew_quaternion",
+    "plot_slew_root_deformation",
+    "plot_slew_tip_displacement",
     "plot_sliding_variables",
     "plot_torque_breakdown",
     "plot_torque_limits",
@@ -75,7 +84,8 @@ _SURFACE_MIN = "tab:purple"  # sliding surface with Lambda_min (far from the tar
 _SURFACE_MAX = "tab:orange"  # sliding surface with Lambda_max (near the target)
 _SOFT_LIMIT = "tab:orange"  # RF * T_max
 _HARD_LIMIT = "tab:red"  # T_max
-_PHASE_POINTS = 20_000  # longer records are strided for the phase-plane trajectory
+_PHASE_POINTS = 50_000  # longer records are strided for the phase-plane trajectory
+_PHASE_COLOURS = 400  # pieces of the trajectory, each drawn in one colour
 
 
 # -- scenario --------------------------------------------------------------------------
@@ -130,12 +140,56 @@ def _no_data(ax: Axes, text: str) -> None:
     ax.text(0.5, 0.5, text, ha="center", va="center", transform=ax.transAxes, color="0.4")
 
 
+def _no_surface(ds: xr.Dataset, what: str) -> str:
+    """Why a sliding-mode quantity is missing from a run."""
+    if ds.attrs.get("controller") == "python":
+        return f"no {what}: not recorded for a plain-Python controller"
+    return f"no {what}: the {_law_name(ds)} law has no sliding surface"
+
+
 def _recorded(values: np.ndarray) -> bool:
     return bool(np.isfinite(values).any())
 
 
-def _fmt_time(t: float) -> str:
-    return "never" if math.isnan(t) else f"t = {t:.4g} s"
+def _settled(what: str, t: float) -> str:
+    """When ``what`` holds for good, from a settling time (NaN: not by the end)."""
+    return "not settled by the end of the run" if math.isnan(t) else f"{what} from t = {t:.4g} s"
+
+
+def _figure_legend(fig: Figure, axes, ncols: int | None = None) -> None:
+    """One legend below the axes with every distinct label of ``axes``, in order."""
+    seen: dict[str, object] = {}
+    for ax in np.ravel(axes):
+        for handle, label in zip(*ax.get_legend_handles_labels(), strict=True):
+            seen.setdefault(label, handle)
+    if seen:
+        fig.legend(list(seen.values()), list(seen), loc="outside lower center",
+                   ncols=ncols or min(len(seen), 6), fontsize=9)  # fmt: skip
+
+
+def plot_slew_root_deformation(ds: xr.Dataset) -> Figure:
+    """Appendage root rotations rho [deg] and translations eta [m] during the slew.
+
+    :func:`flexsat.plots.openloop.plot_root_deformation` without the torque shading
+    (torque is commanded throughout a slew).
+    """
+    return plot_root_deformation(ds)
+
+
+def plot_slew_tip_displacement(ds: xr.Dataset) -> Figure:
+    """Panel tip displacement of each appendage [mm] during the slew.
+
+    :func:`flexsat.plots.openloop.plot_tip_displacement` without the torque shading.
+    """
+    return plot_tip_displacement(ds)
+
+
+def plot_slew_energy(ds: xr.Dataset) -> Figure:
+    """Energy balance of the slew [J], linear and logarithmic.
+
+    :func:`flexsat.plots.openloop.plot_energy` without the torque shading.
+    """
+    return plot_energy(ds)
 
 
 # -- attitude error --------------------------------------------------------------------
@@ -273,7 +327,7 @@ def _requirement_panel(ax: Axes, t: np.ndarray, values: np.ndarray, bound: float
                     xytext=(8, 18), textcoords="offset points", fontsize=9, color="darkgreen",
                     arrowprops={"arrowstyle": "->", "color": "darkgreen"})  # fmt: skip
     ax.set_title(f"{tag} {verdict}: final {final:.3g} {unit} (limit {bound:.3g} {unit}), "
-                 f"settled: {_fmt_time(settle)}", fontsize=10)  # fmt: skip
+                 f"{_settled('in the band for good', settle)}", fontsize=10)  # fmt: skip
     ax.legend(loc="upper right", fontsize=8)
 
 
@@ -327,7 +381,7 @@ def _phase_limits(x: np.ndarray, y: np.ndarray) -> tuple[tuple, tuple]:
 
 
 def _phase_panel(ax: Axes, q: np.ndarray, w: np.ndarray, t: np.ndarray, norm: Normalize,
-                 surface: _Surface | None) -> LineCollection:  # fmt: skip
+                 surface: _Surface | None, first: str | None) -> LineCollection:  # fmt: skip
     """One phase-plane panel: trajectory coloured by time over the surfaces."""
     xlim, ylim = _phase_limits(q, w)
     if surface is not None:
@@ -338,24 +392,35 @@ def _phase_panel(ax: Axes, q: np.ndarray, w: np.ndarray, t: np.ndarray, norm: No
         else:
             slopes = [(surface.lambda_max, _SURFACE_MAX, "surface ω = −Λ q")]
         for lam, colour, label in slopes:
+            layer = f"boundary layer |s| ≤ Φ: ±{surface.phi / lam:.3g} in q"
             ax.fill_between(grid, -lam * grid - surface.phi, -lam * grid + surface.phi,
-                            color=colour, alpha=0.15, linewidth=0,
-                            label=f"boundary layer |s| ≤ Φ: ±{surface.phi / lam:.3g} in q")
+                            color=colour, alpha=0.15, linewidth=0, label=layer)  # fmt: skip
             ax.plot(grid, -lam * grid, color=colour, linestyle="--", linewidth=1.3,
                     label=f"{label}, Λ = {lam:.3g} rad/s")  # fmt: skip
     ok = np.isfinite(q) & np.isfinite(w)
     points = np.column_stack([q[ok], w[ok]])
-    segments = np.stack([points[:-1], points[1:]], axis=1)
-    lines = LineCollection(segments, cmap="viridis", norm=norm, linewidths=1.4, zorder=3)
-    lines.set_array(0.5 * (t[ok][:-1] + t[ok][1:]))
+    # consecutive pieces sharing their end points, each coloured by its mid time
+    edges = np.linspace(0, max(points.shape[0] - 1, 0), _PHASE_COLOURS + 1).round().astype(int)
+    edges = np.unique(edges)
+    pieces = [points[a : b + 1] for a, b in pairwise(edges)]
+    lines = LineCollection(pieces, cmap="viridis", norm=norm, linewidths=1.4, zorder=3,
+                           capstyle="round", joinstyle="round")  # fmt: skip
+    times = t[ok]
+    lines.set_array(0.5 * (times[edges[:-1]] + times[edges[1:]]))
     ax.add_collection(lines)
     if points.shape[0]:
-        ax.plot(*points[0], "o", color="black", markersize=6, zorder=4, label="start")
-        ax.plot(*points[-1], "*", color="red", markersize=11, zorder=4, label="end")
+        marker = {"marker": "o", "color": "black"}
+        if not (first and first.startswith("start")):
+            marker = {"marker": "D", "color": "black", "markerfacecolor": "white"}
+        ax.plot(*points[0], linestyle="none", markersize=6, zorder=4, label=first, **marker)
+        ax.plot(*points[-1], "*", color="red", markersize=11, zorder=4,
+                label=f"end (t = {t[ok][-1]:.4g} s)")  # fmt: skip
     ax.axhline(0.0, color="0.5", linewidth=0.6)
     ax.axvline(0.0, color="0.5", linewidth=0.6)
     ax.set_xlim(xlim)
     ax.set_ylim(ylim)
+    ax.xaxis.set_major_locator(MaxNLocator(5))
+    ax.ticklabel_format(axis="both", style="sci", scilimits=(-3, 3))
     ax.grid(True, color="0.85", linewidth=0.6)
     return lines
 
@@ -389,7 +454,11 @@ def plot_phase_plane(ds: xr.Dataset) -> Figure:
     omega = np.asarray(ds["omega"].values, dtype=float)
     step = max(1, math.ceil(t.size / _PHASE_POINTS))
     t_s, qv_s, omega_s = t[::step], qv[::step], omega[::step]
-    norm = Normalize(vmin=t[0], vmax=t[-1])
+    # colour by time up to when the rate has settled (R2): later the state stays put
+    settled = settling_time(t, np.asarray(ds["rate_error_deg_s"].values),
+                            scenario.requirements.jitter_deg_s)  # fmt: skip
+    t_colour = float(t[-1]) if math.isnan(settled) else min(float(t[-1]), 1.1 * settled)
+    norm = Normalize(vmin=t[0], vmax=max(t_colour, t[0] + 1e-9))
     threshold = surface.theta_threshold_deg if surface and surface.theta_threshold_deg else 5.0
     pointing = np.asarray(ds["pointing_error_deg"].values)
     near = np.nonzero(pointing < threshold)[0]
@@ -400,21 +469,23 @@ def plot_phase_plane(ds: xr.Dataset) -> Figure:
     lines = None
     for k in range(3):
         a = _AXES[k]
-        lines = _phase_panel(axes[0, k], qv_s[:, k], omega_s[:, k], t_s, norm, surface)
+        lines = _phase_panel(axes[0, k], qv_s[:, k], omega_s[:, k], t_s, norm, surface,
+                             f"start (t = {t[0]:.3g} s)")  # fmt: skip
         axes[0, k].set_title(f"axis {a}: whole slew", fontsize=10)
         if zoom.sum() >= 2:
-            _phase_panel(axes[1, k], qv_s[zoom, k], omega_s[zoom, k], t_s[zoom], norm, surface)
+            _phase_panel(axes[1, k], qv_s[zoom, k], omega_s[zoom, k], t_s[zoom], norm, surface,
+                         f"close-up from t = {t_near:.4g} s")  # fmt: skip
             axes[1, k].set_title(f"axis {a}: near the target (t ≥ {t_near:.4g} s)", fontsize=10)
         else:
             _no_data(axes[1, k], f"pointing error never below {threshold:.3g} deg")
         for row in range(2):
             axes[row, k].set_xlabel(f"q_v,e,{a} [-]")
             axes[row, k].set_ylabel(f"ω_e,{a} [rad/s]")
-    handles, labels = axes[0, 0].get_legend_handles_labels()
-    fig.legend(handles, labels, loc="outside lower center", ncols=min(len(handles), 6),
-               fontsize=9)  # fmt: skip
+    _figure_legend(fig, axes[:, 0], ncols=4)
     if lines is not None:
-        fig.colorbar(lines, ax=axes.ravel().tolist(), shrink=0.85, label="time t [s]")
+        extend = "max" if t_colour < t[-1] else "neither"
+        label = "time t [s]" + (" (later: end colour)" if extend == "max" else "")
+        fig.colorbar(lines, ax=axes.ravel().tolist(), shrink=0.85, extend=extend, label=label)
     what = "sliding surfaces s = ω_e + Λ q_v,e = 0" if surface else "no sliding surface"
     _suptitle(fig, ds, f"Phase plane q_v,e – ω_e per axis ({_law_name(ds)}, {what})")
     return fig
@@ -445,7 +516,7 @@ def plot_sliding_variables(ds: xr.Dataset) -> Figure:
         ax = axes[k, 0]
         ax.set_ylabel(f"s_{_AXES[k]} [rad/s]")
         if surface is None or not _recorded(s[:, k]):
-            _no_data(ax, "no sliding variable: the law has no sliding surface")
+            _no_data(ax, _no_surface(ds, "sliding variable"))
             continue
         phi = surface.phi
         ax.axhspan(-phi, phi, color=_SURFACE_MAX, alpha=0.12, linewidth=0,
@@ -454,17 +525,18 @@ def plot_sliding_variables(ds: xr.Dataset) -> Figure:
             ax.axhline(sign * phi, color=_SURFACE_MAX, linestyle="--", linewidth=1.2,
                        label="±Φ" if sign > 0 else None)  # fmt: skip
         _line(ax, t, s[:, k], color=_AXIS_COLOURS[k], linewidth=1.0, label=f"s_{_AXES[k]}")
-        ax.set_yscale("symlog", linthresh=phi * 1e-3, linscale=0.5)
+        ax.set_yscale("symlog", linthresh=phi * 1e-3, linscale=1.0)
         top = max(float(np.nanmax(np.abs(s[:, k]))), phi) * 3.0
         ax.set_ylim(-top, top)
         inside = settling_time(t, np.abs(s[:, k]), phi)
         if not math.isnan(inside):
             ax.axvline(inside, color="0.3", linestyle=":", linewidth=1.2)
-        ax.set_title(f"s_{_AXES[k]}: inside the boundary layer for good from "
-                     f"{_fmt_time(inside)}; final {s[-1, k]:.3g} rad/s", fontsize=10)  # fmt: skip
-        ax.legend(loc="upper right", fontsize=8, ncols=3)
+        ax.set_title(f"s_{_AXES[k]}: {_settled('inside the boundary layer for good', inside)}; "
+                     f"final {s[-1, k]:.3g} rad/s", fontsize=10)  # fmt: skip
+    _figure_legend(fig, axes)
     _finish_time_axis(axes, t)
-    _suptitle(fig, ds, f"Sliding variables s = ω_e + Λ q_v,e ({_law_name(ds)}, symlog scale)")
+    scale = "symlog, linear within ±Φ/1000"
+    _suptitle(fig, ds, f"Sliding variables s = ω_e + Λ q_v,e ({_law_name(ds)}; {scale})")
     return fig
 
 
@@ -498,7 +570,7 @@ def plot_adaptation(ds: xr.Dataset) -> Figure:
     bottom.set_ylabel("JK [N m]")
     if surface is None or not _recorded(lam):
         for ax in (top, bottom):
-            _no_data(ax, "no slope or robust gain: the law has no sliding surface")
+            _no_data(ax, _no_surface(ds, "slope or robust gain"))
         _finish_time_axis(axes, t)
         _suptitle(fig, ds, f"Adaptation of Λ and JK ({_law_name(ds)})")
         return fig
@@ -580,25 +652,26 @@ def plot_disturbances(ds: xr.Dataset) -> Figure:
     slosh = dist.sloshing_ratio * cmd * np.sin(2.0 * np.pi * dist.sloshing_hz * t)[:, None]
     shortfall = (np.asarray(act.gain) - 1.0) * cmd
     constant = np.asarray(dist.environment_nm) + np.asarray(dist.residual_nm)
+    slosh_label = f"sloshing {dist.sloshing_ratio:.3g}·τ_cmd·sin(2π·{dist.sloshing_hz:.3g} Hz·t)"
     fig, axes = _figure(3, 1, size=(11.0, 9.0))
     for k in range(3):
         ax = axes[k, 0]
         a = _AXES[k]
         ax.axhline(constant[k], color="tab:green", linestyle="--", linewidth=1.3,
-                   label=f"environment + residual = {constant[k]:.3g} N m")  # fmt: skip
-        _line(ax, t, slosh[:, k], color="tab:blue", linewidth=0.9,
-              label=f"sloshing {dist.sloshing_ratio:.3g}·τ_cmd·sin(2π·{dist.sloshing_hz:.3g} Hz·t)")
+                   label="environment + residual (constant)")  # fmt: skip
+        _line(ax, t, slosh[:, k], color="tab:blue", linewidth=0.9, label=slosh_label)
         _line(ax, t, shortfall[:, k], color="tab:orange", linewidth=1.0,
-              label=f"gain shortfall −(1 − G)·τ_cmd, G = {act.gain[k]:.3g}")  # fmt: skip
+              label="actuator-gain shortfall −(1 − G)·τ_cmd")  # fmt: skip
         _line(ax, t, total[:, k], color="black", linewidth=0.9, alpha=0.8,
               label="total τ_applied − τ_cmd")  # fmt: skip
         ax.set_ylabel(f"d_{a} [N m]")
         peak = float(np.nanmax(np.abs(total[:, k]))) if _recorded(total[:, k]) else math.nan
-        title = f"axis {a}: peak |d_{a}| = {peak:.3g} N m"
+        title = (f"axis {a}: constant {constant[k]:.3g} N m, G_{a} = {act.gain[k]:.3g}; "
+                 f"peak |d_{a}| = {peak:.3g} N m")  # fmt: skip
         if surface is not None:
-            title += f" (JK_min = {surface.jk_min:.4g} N m)"
+            title += f" (robust-gain floor JK_min = {surface.jk_min:.4g} N m)"
         ax.set_title(title, fontsize=10)
-        ax.legend(loc="upper right", fontsize=8, ncols=2)
+    _figure_legend(fig, axes, ncols=4)
     _finish_time_axis(axes, t)
     _suptitle(fig, ds, "Disturbance torques of the actuator model (frame B)")
     return fig
@@ -631,18 +704,18 @@ def plot_torque_limits(ds: xr.Dataset) -> Figure:
         a = _AXES[k]
         for sign in (1.0, -1.0):
             ax.axhline(sign * act.t_max_nm, color=_HARD_LIMIT, linewidth=1.4,
-                       label=f"±T_max = {act.t_max_nm:.3g} N m" if sign > 0 else None)
+                       label=f"±T_max = {act.t_max_nm:.3g} N m" if sign > 0 else None)  # fmt: skip
             ax.axhline(sign * soft, color=_SOFT_LIMIT, linestyle="--", linewidth=1.2,
-                       label=f"±RF·T_max = {soft:.3g} N m" if sign > 0 else None)
-        _line(ax, t, cmd[:, k], color="black", linewidth=1.4, label=f"τ_cmd,{a}")
-        _line(ax, t, applied[:, k], color=_AXIS_COLOURS[k], linewidth=0.9,
-              label=f"τ_applied,{a}")  # fmt: skip
+                       label=f"±RF·T_max = {soft:.3g} N m" if sign > 0 else None)  # fmt: skip
+        _line(ax, t, cmd[:, k], color="black", linewidth=1.6, label="τ_cmd (commanded)")
+        _line(ax, t, applied[:, k], color="tab:cyan", linewidth=1.0,
+              label="τ_applied (delivered to the hub)")  # fmt: skip
         ax.set_ylim(-1.15 * act.t_max_nm, 1.15 * act.t_max_nm)
         ax.set_ylabel(f"τ_{a} [N m]")
         ax.set_title(f"axis {a}: peak |τ_cmd| = {np.nanmax(np.abs(cmd[:, k])):.4g} N m, "
                      f"|τ_applied| = {np.nanmax(np.abs(applied[:, k])):.4g} N m",
                      fontsize=10)  # fmt: skip
-        ax.legend(loc="upper right", fontsize=8, ncols=4)
+    _figure_legend(fig, axes, ncols=4)
     _finish_time_axis(axes, t)
     verdict = "PASS" if r3 else "FAIL"
     _suptitle(fig, ds, f"Control torque against its limits (R3 {verdict}: |τ_applied| ≤ T_max)")
@@ -680,16 +753,18 @@ def plot_torque_breakdown(ds: xr.Dataset) -> Figure:
         a = _AXES[k]
         for sign in (1.0, -1.0):
             ax.axhline(sign * soft, color=_SOFT_LIMIT, linestyle=":", linewidth=1.0,
-                       label=f"±RF·T_max = {soft:.3g} N m" if sign > 0 else None)
+                       label=f"±RF·T_max = {soft:.3g} N m" if sign > 0 else None)  # fmt: skip
+        recorded = [name for name, _, _ in parts if _recorded(ds[name].values[:, k])]
         for name, colour, label in parts:
-            values = np.asarray(ds[name].values[:, k], dtype=float)
-            if _recorded(values):
-                _line(ax, t, values, color=colour, linewidth=1.0, label=label)
+            if name in recorded:
+                _line(ax, t, ds[name].values[:, k], color=colour, linewidth=1.0, label=label)
+        if not recorded:
+            _no_data(ax, "breakdown not recorded for a plain-Python controller")
         _line(ax, t, cmd[:, k], color="black", linewidth=0.9, linestyle="--",
               label="τ_cmd (sum, clipped)")  # fmt: skip
         ax.set_ylabel(f"τ_{a} [N m]")
         ax.set_title(f"axis {a}", fontsize=10)
-        ax.legend(loc="upper right", fontsize=8, ncols=3)
+    _figure_legend(fig, axes, ncols=5)
     _finish_time_axis(axes, t)
     _suptitle(fig, ds, f"Breakdown of the commanded torque ({_law_name(ds)})")
     return fig
@@ -718,15 +793,16 @@ def plot_flex_torque(ds: xr.Dataset) -> Figure:
     for k in range(3):
         ax = axes[k, 0]
         a = _AXES[k]
-        _line(ax, t, applied[:, k], color="0.6", linewidth=1.0, label=f"τ_applied,{a}")
-        _line(ax, t, net[:, k], color="tab:blue", linewidth=1.1, label=f"τ_net,{a}")
+        _line(ax, t, applied[:, k], color="0.6", linewidth=1.0, label="τ_applied (actuators)")
+        _line(ax, t, net[:, k], color="tab:blue", linewidth=1.1,
+              label="τ_net = τ_applied + τ_flex")  # fmt: skip
         _line(ax, t, flex[:, k], color="tab:orange", linewidth=1.0,
-              label=f"τ_flex,{a} (joints on hub)")  # fmt: skip
+              label="τ_flex (appendage joints on the hub)")  # fmt: skip
         ax.set_ylabel(f"τ_{a} [N m]")
         ax.set_title(f"axis {a}: peak |τ_flex| = {np.nanmax(np.abs(flex[:, k])):.3g} N m, "
                      f"peak |τ_net| = {np.nanmax(np.abs(net[:, k])):.3g} N m",
                      fontsize=10)  # fmt: skip
-        ax.legend(loc="upper right", fontsize=8, ncols=3)
+    _figure_legend(fig, axes)
     _finish_time_axis(axes, t)
     _suptitle(fig, ds, "Flexible torque against net torque on the hub (frame B)")
     return fig
@@ -762,10 +838,10 @@ _MAKERS = {
     "disturbances": plot_disturbances,
     "torque_limits": plot_torque_limits,
     "torque_breakdown": plot_torque_breakdown,
-    "root_deformation": plot_root_deformation,
-    "tip_displacement": plot_tip_displacement,
+    "root_deformation": plot_slew_root_deformation,
+    "tip_displacement": plot_slew_tip_displacement,
     "flex_torque": plot_flex_torque,
-    "energy": plot_energy,
+    "energy": plot_slew_energy,
 }
 
 
