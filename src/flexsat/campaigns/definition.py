@@ -1,0 +1,176 @@
+"""Campaign definitions: a base slew, and the cases that vary it (TOML, validated).
+
+Cases come from any combination of:
+
+- ``[[cases]]``: explicit cases, each with an ``id`` and its modifiers;
+- ``[grid]``: the cartesian product of ``[[grid.axes]]``, each axis a list of
+  levels (a label and modifiers); ``grid.common`` applies to every grid case;
+- ``[random]``: ``n`` cases whose modifiers draw from distributions, one stream
+  per case spawned from ``root_seed`` (``numpy.random.SeedSequence(root).spawn``).
+
+``plant`` modifiers act on the satellite config, ``scenario`` modifiers on the slew
+scenario. Expansion happens once, in the parent process: every backend and worker
+count runs the very same resolved cases.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import itertools
+import json
+from dataclasses import dataclass
+from importlib import resources
+from pathlib import Path
+from typing import Annotated
+
+import numpy as np
+from pydantic import Field, model_validator
+
+from flexsat.campaigns.modifiers import Modifier, apply_modifiers
+from flexsat.config.load import read_toml, validate_config
+from flexsat.config.models import SatelliteConfig, _Frozen
+from flexsat.errors import ConfigError
+from flexsat.simulate.scenario import SlewScenario
+
+__all__ = [
+    "CAMPAIGN_PRESETS",
+    "CampaignDefinition",
+    "ResolvedCase",
+    "load_campaign",
+    "resolve_cases",
+]
+
+CAMPAIGN_PRESETS = ("sensitivity", "montecarlo-critical", "deployment-shock", "montecarlo-random")
+
+
+class CaseSpec(_Frozen):
+    id: Annotated[str, Field(min_length=1, max_length=80, pattern=r"^[A-Za-z0-9_.+\-]+$")]
+    plant: list[Modifier] = Field(default_factory=list)
+    scenario: list[Modifier] = Field(default_factory=list)
+
+
+class Level(_Frozen):
+    label: Annotated[str, Field(min_length=1, max_length=40, pattern=r"^[A-Za-z0-9_.+\-]+$")]
+    plant: list[Modifier] = Field(default_factory=list)
+    scenario: list[Modifier] = Field(default_factory=list)
+
+
+class Axis(_Frozen):
+    name: str
+    levels: Annotated[list[Level], Field(min_length=1)]
+
+
+class Grid(_Frozen):
+    common: Level = Field(default_factory=lambda: Level(label="common"))
+    axes: Annotated[list[Axis], Field(min_length=1)]
+    seed: Annotated[int, Field(ge=0)] = 0
+
+
+class RandomCases(_Frozen):
+    n: Annotated[int, Field(ge=1, le=1_000_000)] = 100
+    root_seed: Annotated[int, Field(ge=0)] = 0
+    plant: list[Modifier] = Field(default_factory=list)
+    scenario: list[Modifier] = Field(default_factory=list)
+
+
+class CampaignDefinition(_Frozen):
+    """A campaign: the satellite, the base slew, and how the cases vary them."""
+
+    name: str
+    description: str = ""
+    include_nominal: bool = Field(True, description="add the unmodified case 'nominal'")
+    base: dict = Field(default_factory=dict, description="SlewScenario fields for every case")
+    cases: list[CaseSpec] = Field(default_factory=list)
+    grid: Grid | None = None
+    random: RandomCases | None = None
+
+    @model_validator(mode="after")
+    def _has_cases(self) -> CampaignDefinition:
+        if not (self.cases or self.grid or self.random or self.include_nominal):
+            raise ValueError("a campaign needs cases, a grid, random cases or the nominal")
+        validate_config(self.base, source="base", model=SlewScenario)
+        return self
+
+    def fingerprint(self) -> str:
+        """Hash of the definition, to refuse resuming a store made by another one."""
+        text = json.dumps(self.model_dump(mode="json"), sort_keys=True)
+        return hashlib.sha256(text.encode()).hexdigest()[:16]
+
+
+@dataclass(frozen=True)
+class ResolvedCase:
+    """A case ready to run anywhere: validated plant config and scenario as plain dicts."""
+
+    case_id: str
+    root_seed: int
+    stream_index: int
+    plant: dict
+    scenario: dict
+    parameters: dict
+
+
+def load_campaign(name_or_path: str | Path) -> CampaignDefinition:
+    """A shipped preset by name, or a campaign TOML file."""
+    if str(name_or_path) in CAMPAIGN_PRESETS:
+        path = Path(str(resources.files("flexsat.campaigns") / "presets" / f"{name_or_path}.toml"))
+    else:
+        path = Path(name_or_path)
+        if not path.exists():
+            raise ConfigError(
+                f"campaign {str(name_or_path)!r} is neither a preset "
+                f"({', '.join(CAMPAIGN_PRESETS)}) nor a file"
+            )
+    return validate_config(read_toml(path, "campaign"), source=str(path), model=CampaignDefinition)
+
+
+def resolve_cases(
+    definition: CampaignDefinition, satellite: SatelliteConfig, n_random: int | None = None
+) -> list[ResolvedCase]:
+    """Expand and validate every case; any bad modifier is refused before a case runs.
+
+    Raises
+    ------
+    ConfigError
+        Naming the case and the problem (unknown path, invalid resulting value).
+    """
+    plant_base = satellite.model_dump(mode="json")
+    scenario_base = SlewScenario.model_validate(definition.base).model_dump(
+        mode="json", by_alias=True
+    )
+    # (id, (root seed, case index) of its random stream, plant and scenario modifiers)
+    specs: list[tuple[str, tuple[int, int], list[Modifier], list[Modifier]]] = []
+    if definition.include_nominal:
+        specs.append(("nominal", (0, 0), [], []))
+    specs += [(c.id, (0, k), c.plant, c.scenario) for k, c in enumerate(definition.cases)]
+    if definition.grid is not None:
+        grid = definition.grid
+        for k, levels in enumerate(itertools.product(*(axis.levels for axis in grid.axes))):
+            case_id = "+".join(level.label for level in levels)
+            plant = [*grid.common.plant, *(m for lv in levels for m in lv.plant)]
+            scenario = [*grid.common.scenario, *(m for lv in levels for m in lv.scenario)]
+            specs.append((case_id, (grid.seed, k), plant, scenario))
+    if definition.random is not None:
+        rnd = definition.random
+        n = rnd.n if n_random is None else n_random
+        if n < 1:
+            raise ConfigError(f"--cases must be >= 1, got {n}")
+        for i in range(n):
+            specs.append((f"random-{i:05d}", (rnd.root_seed, i), rnd.plant, rnd.scenario))
+    ids = [spec[0] for spec in specs]
+    if len(set(ids)) != len(ids):
+        raise ConfigError(f"campaign {definition.name}: duplicate case ids")
+    resolved = []
+    for case_id, (root, index), plant_mods, scenario_mods in specs:
+        # The stream SeedSequence(root).spawn(n)[index] would give, built directly.
+        rng = np.random.default_rng(np.random.SeedSequence(root, spawn_key=(index,)))
+        realised: dict = {}
+        try:
+            plant = apply_modifiers(plant_base, plant_mods, rng, realised)
+            scenario = apply_modifiers(scenario_base, scenario_mods, rng, realised)
+        except KeyError as exc:
+            raise ConfigError(f"campaign case {case_id!r}: {exc.args[0]}") from None
+        validate_config(plant, source=f"campaign case {case_id!r} (plant)")
+        source = f"campaign case {case_id!r} (scenario)"
+        validate_config(scenario, source=source, model=SlewScenario)
+        resolved.append(ResolvedCase(case_id, root, index, plant, scenario, realised))
+    return resolved

@@ -1,0 +1,147 @@
+"""Parameter modifiers: how a campaign case changes the satellite config and the scenario.
+
+A modifier names a path in the plain-dict form of a config (``hub.mass_kg``,
+``appendages[*].target_frequencies_hz.flapping``, ``initial.rate_deg_s[2]``; ``[*]``
+means every element) and either sets or scales the value there, with a fixed
+number or one drawn from a distribution. Two derived paths exist: ``hub.inertia``
+(scales the hub's inertia tensor, turning a cylinder into an explicit inertia) and
+``appendages[*].inertia`` (scales a panel's mass and so its inertia; the joints are
+re-tuned to keep their target frequencies, as the thesis does).
+"""
+
+from __future__ import annotations
+
+import copy
+import re
+from typing import Annotated, Any, Literal
+
+import numpy as np
+from pydantic import Field, model_validator
+from scipy import stats
+
+from flexsat.config.models import HubConfig, _Frozen
+
+__all__ = ["Modifier", "apply_modifiers"]
+
+_TOKEN = re.compile(r"([A-Za-z_][A-Za-z0-9_]*)|\[(\*|\d+)\]")
+
+
+class Modifier(_Frozen):
+    """Set or scale one config value, by a constant or a random draw."""
+
+    path: Annotated[str, Field(min_length=1)]
+    op: Literal["set", "scale"] = "set"
+    value: Any = None
+    uniform: tuple[float, float] | None = None
+    normal: tuple[float, float] | None = None
+    truncnormal: tuple[float, float, float, float] | None = Field(
+        None, description="(mean, std, low, high)"
+    )
+
+    @model_validator(mode="after")
+    def _one_source(self) -> Modifier:
+        given = [
+            name for name in ("value", "uniform", "normal", "truncnormal")
+            if getattr(self, name) is not None
+        ]  # fmt: skip
+        if len(given) != 1:
+            raise ValueError(
+                f"{self.path}: give exactly one of value, uniform, normal, truncnormal"
+            )
+        if self.uniform is not None and not self.uniform[0] < self.uniform[1]:
+            raise ValueError(f"{self.path}: uniform bounds must satisfy low < high")
+        if self.normal is not None and not self.normal[1] > 0:
+            raise ValueError(f"{self.path}: normal std must be > 0")
+        if self.truncnormal is not None:
+            mean, std, low, high = self.truncnormal
+            if not (std > 0 and low < high):
+                raise ValueError(f"{self.path}: truncnormal needs std > 0 and low < high")
+        return self
+
+    def draw(self, rng: np.random.Generator) -> float | Any:
+        """The number this modifier applies (constant, or one draw from ``rng``)."""
+        if self.value is not None:
+            return self.value
+        if self.uniform is not None:
+            return float(rng.uniform(*self.uniform))
+        if self.normal is not None:
+            return float(rng.normal(*self.normal))
+        mean, std, low, high = self.truncnormal
+        a, b = (low - mean) / std, (high - mean) / std
+        return float(stats.truncnorm.ppf(rng.uniform(), a, b, loc=mean, scale=std))
+
+
+def apply_modifiers(
+    data: dict, modifiers: list[Modifier], rng: np.random.Generator, realised: dict
+) -> dict:
+    """A copy of ``data`` with the modifiers applied in order.
+
+    Random values are drawn from ``rng`` once per targeted element, in order, so a
+    case is reproducible from its seed; every applied value is recorded in
+    ``realised`` under its concrete path.
+
+    Raises
+    ------
+    KeyError
+        If a path does not exist in ``data`` (the caller reports it).
+    """
+    data = copy.deepcopy(data)
+    for modifier in modifiers:
+        for concrete, parent, key in _targets(data, modifier.path):
+            value = modifier.draw(rng)
+            if key == "inertia" and concrete.startswith("hub"):
+                _scale_hub_inertia(parent, value)
+            elif key == "inertia":
+                field = "mass_kg" if parent.get("mass_kg") is not None else "surface_density_kg_m2"
+                parent[field] = parent[field] * value
+            elif modifier.op == "scale":
+                parent[key] = _scaled(parent[key], value)
+            else:
+                parent[key] = value
+            realised[concrete] = value
+    return data
+
+
+def _scaled(current: Any, factor: float) -> Any:
+    if isinstance(current, list):
+        return [_scaled(item, factor) for item in current]
+    return current * factor
+
+
+def _scale_hub_inertia(hub: dict, factor: float) -> None:
+    inertia = HubConfig.model_validate(hub).inertia() * factor
+    hub.pop("radius_m", None)
+    hub.pop("height_m", None)
+    hub["inertia_kg_m2"] = inertia.tolist()
+
+
+def _targets(data: dict, path: str):
+    """(concrete path, parent container, key) for every element the path names."""
+    tokens = _TOKEN.findall(path)
+    if "".join(name or f"[{index}]" for name, index in tokens) != path.replace(".", ""):
+        raise KeyError(f"malformed path {path!r}")
+    nodes = [("", data)]
+    for k, (name, index) in enumerate(tokens):
+        last = k == len(tokens) - 1
+        following = []
+        for prefix, node in nodes:
+            if name:
+                if not isinstance(node, dict) or (name not in node and name != "inertia"):
+                    raise KeyError(f"no {name!r} at {prefix or 'the top level'} of {path!r}")
+                concrete = f"{prefix}.{name}" if prefix else name
+                if last:
+                    yield concrete, node, name
+                else:
+                    following.append((concrete, node[name]))
+            else:
+                if not isinstance(node, list):
+                    raise KeyError(f"{prefix!r} is not a list in {path!r}")
+                indices = range(len(node)) if index == "*" else [int(index)]
+                for i in indices:
+                    if i >= len(node):
+                        raise KeyError(f"index {i} out of range at {prefix!r} in {path!r}")
+                    if last:
+                        yield f"{prefix}[{i}]", node, i
+                    else:
+                        following.append((f"{prefix}[{i}]", node[i]))
+        nodes = following

@@ -1,0 +1,149 @@
+"""Running campaign cases: a local process pool (default) or a Dask cluster.
+
+Cases are resolved in the parent (:func:`resolve_cases`), so every backend and
+worker count runs the same inputs and the stored rows are identical bit for bit.
+A case that raises or diverges is stored as failed with its message; the campaign
+goes on.
+"""
+
+from __future__ import annotations
+
+import os
+import time
+import traceback
+from collections.abc import Iterator
+from concurrent.futures import ProcessPoolExecutor, as_completed
+from pathlib import Path
+
+from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
+
+from flexsat.campaigns.definition import CampaignDefinition, ResolvedCase, resolve_cases
+from flexsat.campaigns.store import CampaignStore
+from flexsat.config.models import SatelliteConfig
+
+__all__ = ["run_campaign", "run_case"]
+
+
+def run_case(case: ResolvedCase) -> dict:
+    """Run one resolved case; never raises: failures come back as a failed row."""
+    from flexsat.analysis.requirements import slew_metrics
+    from flexsat.config.models import SatelliteConfig
+    from flexsat.dynamics.plant import Plant
+    from flexsat.simulate import SlewScenario, run_slew
+
+    row = {
+        "case_id": case.case_id,
+        "root_seed": case.root_seed,
+        "stream_index": case.stream_index,
+        "parameters": case.parameters,
+    }
+    start = time.perf_counter()
+    try:
+        plant = Plant.from_config(SatelliteConfig.model_validate(case.plant))
+        scenario = SlewScenario.model_validate(case.scenario)
+        result = run_slew(plant, scenario, progress=False)
+        req = scenario.requirements
+        metrics = slew_metrics(
+            result.dataset, req.pointing_deg, req.jitter_deg_s, scenario.actuator.t_max_nm
+        )
+        metrics.pop("wall_time_s")
+        status, message = metrics.pop("status"), metrics.pop("message")
+        row.update(status=status, error=message, metrics=metrics)
+    except Exception as exc:  # a failed case is data, not a crash of the campaign
+        last = traceback.extract_tb(exc.__traceback__)[-1]
+        row.update(status="failed", error=f"{type(exc).__name__}: {exc} ({last.name})", metrics={})
+    row["case_wall_time_s"] = time.perf_counter() - start
+    return row
+
+
+def run_campaign(
+    definition: CampaignDefinition,
+    satellite: SatelliteConfig,
+    out: str | Path,
+    workers: int | None = None,
+    resume: bool = False,
+    n_random: int | None = None,
+    scheduler: str | None = None,
+    dask_local: int | None = None,
+    progress: bool = True,
+) -> dict:
+    """Run (or finish) a campaign into the store at ``out``.
+
+    Parameters
+    ----------
+    workers : int, optional
+        Local worker processes; default all cores. 1 runs in this process.
+    resume : bool
+        Skip the cases already in the store (refused if the store was made by a
+        different definition).
+    scheduler : str, optional
+        Address of a running Dask scheduler (``tcp://host:port``).
+    dask_local : int, optional
+        Start a Dask LocalCluster with this many single-threaded worker processes.
+
+    Returns
+    -------
+    dict
+        ``cases``, ``ran`` (this call), ``failed``, ``wall_time_s``, the store paths.
+    """
+    cases = resolve_cases(definition, satellite, n_random)
+    store = CampaignStore(out)
+    store.open(definition.fingerprint(), definition.name, resume)
+    done = store.finished()
+    todo = [case for case in cases if case.case_id not in done]
+    start = time.perf_counter()
+    failed = 0
+    columns = (TextColumn(f"campaign {definition.name}"), BarColumn(), MofNCompleteColumn(),
+               TextColumn("failed {task.fields[failed]}"), TimeRemainingColumn())  # fmt: skip
+    with Progress(*columns, disable=not progress, transient=True) as bar:
+        task = bar.add_task("cases", total=len(cases), completed=len(cases) - len(todo), failed=0)
+        for row in _execute(todo, workers, scheduler, dask_local):
+            store.write_case(row)
+            failed += row["status"] != "ok"
+            bar.update(task, advance=1, failed=failed)
+    parquet, csv = store.write_tables()
+    return {
+        "campaign": definition.name,
+        "cases": len(cases),
+        "ran": len(todo),
+        "failed": sum(row["status"] != "ok" for row in store.rows()),
+        "wall_time_s": time.perf_counter() - start,
+        "parquet": str(parquet),
+        "csv": str(csv),
+    }
+
+
+def _execute(todo, workers, scheduler, dask_local) -> Iterator[dict]:
+    if scheduler or dask_local:
+        yield from _dask(todo, scheduler, dask_local)
+        return
+    workers = workers or os.cpu_count() or 1
+    if workers == 1:
+        for case in todo:
+            yield run_case(case)
+        return
+    with ProcessPoolExecutor(max_workers=workers) as pool:
+        futures = [pool.submit(run_case, case) for case in todo]
+        for future in as_completed(futures):
+            yield future.result()
+
+
+def _dask(todo, scheduler, dask_local) -> Iterator[dict]:
+    from dask.distributed import Client, LocalCluster
+    from dask.distributed import as_completed as dask_completed
+
+    cluster = None
+    if scheduler is None:
+        cluster = LocalCluster(
+            n_workers=dask_local, threads_per_worker=1, processes=True,
+            host="127.0.0.1", dashboard_address=None,
+        )  # fmt: skip
+    client = Client(cluster if cluster is not None else scheduler)
+    try:
+        futures = client.map(run_case, todo, pure=False)
+        for future in dask_completed(futures):
+            yield future.result()
+    finally:
+        client.close()
+        if cluster is not None:
+            cluster.close()
