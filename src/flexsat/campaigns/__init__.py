@@ -7,7 +7,7 @@ from flexsat.campaigns.definition import (
     load_campaign,
     resolve_cases,
 )
-from flexsat.campaigns.runner import run_campaign, run_case
+from flexsat.campaigns.runner import replay_case, run_campaign, run_case, summarize
 from flexsat.campaigns.store import CampaignStore
 
 __all__ = [
@@ -16,7 +16,9 @@ __all__ = [
     "CampaignStore",
     "ResolvedCase",
     "load_campaign",
+    "replay_case",
     "resolve_cases",
     "run_campaign",
     "run_case",
+    "summarize",
 ]

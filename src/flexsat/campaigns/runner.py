@@ -8,6 +8,7 @@ goes on.
 
 from __future__ import annotations
 
+import json
 import os
 import time
 import traceback
@@ -21,7 +22,47 @@ from flexsat.campaigns.definition import CampaignDefinition, ResolvedCase, resol
 from flexsat.campaigns.store import CampaignStore
 from flexsat.config.models import SatelliteConfig
 
-__all__ = ["run_campaign", "run_case"]
+__all__ = ["replay_case", "run_campaign", "run_case", "summarize"]
+
+
+def replay_case(store: str | Path, case_id: str):
+    """Re-run one stored case alone from its stored inputs; returns its ``Result``."""
+    from flexsat.config.models import SatelliteConfig
+    from flexsat.dynamics.plant import Plant
+    from flexsat.errors import ConfigError
+    from flexsat.simulate import SlewScenario, run_slew
+
+    path = CampaignStore(store).cases_dir / f"{case_id}.json"
+    if not path.exists():
+        raise ConfigError(f"no case {case_id!r} in {store}")
+    inputs = json.loads(path.read_text())["inputs"]
+    plant = Plant.from_config(SatelliteConfig.model_validate(inputs["plant"]))
+    return run_slew(plant, SlewScenario.model_validate(inputs["scenario"]))
+
+
+def summarize(store: str | Path) -> dict:
+    """Pass rates and the worst cases of a stored campaign."""
+    rows = CampaignStore(store).rows()
+    n = len(rows)
+
+    def rate(key: str) -> float:
+        return sum(bool(r["metrics"].get(key)) for r in rows) / n if n else float("nan")
+
+    errors = [
+        (r["metrics"]["final_pointing_error_deg"], r["case_id"])
+        for r in rows
+        if r["status"] == "ok" and r["metrics"].get("final_pointing_error_deg") is not None
+    ]
+    worst = sorted(errors, reverse=True)[:5]
+    return {
+        "cases": n,
+        "failed": sum(r["status"] != "ok" for r in rows),
+        "r1_pass_rate": rate("r1_pass"),
+        "r2_pass_rate": rate("r2_pass"),
+        "r3_pass_rate": rate("r3_pass"),
+        "worst_final_pointing_error_deg": worst[0][0] if worst else float("nan"),
+        "worst_cases": [{"case_id": c, "final_pointing_error_deg": e} for e, c in worst],
+    }
 
 
 def run_case(case: ResolvedCase) -> dict:
@@ -36,6 +77,7 @@ def run_case(case: ResolvedCase) -> dict:
         "root_seed": case.root_seed,
         "stream_index": case.stream_index,
         "parameters": case.parameters,
+        "inputs": {"plant": case.plant, "scenario": case.scenario},  # for replay
     }
     start = time.perf_counter()
     try:

@@ -59,7 +59,8 @@ class CampaignStore:
 
     def table(self) -> pd.DataFrame:
         """One row per stored case, sorted by case id; list values become columns."""
-        frame = pd.json_normalize(self.rows(), sep=".")
+        rows = [{k: v for k, v in row.items() if k != "inputs"} for row in self.rows()]
+        frame = pd.json_normalize(rows, sep=".")
         for column in list(frame.columns):
             if frame[column].map(lambda v: isinstance(v, list)).any():
                 expanded = pd.DataFrame(frame[column].tolist(), index=frame.index)

@@ -260,6 +260,87 @@ def slew(
         raise typer.Exit(1)
 
 
+@app.command()
+def campaign(
+    name: Annotated[
+        str,
+        typer.Argument(
+            help="Preset (sensitivity, montecarlo-critical, deployment-shock, "
+            "montecarlo-random), a campaign TOML file, or 'replay STORE CASE_ID'."
+        ),
+    ],
+    replay_args: Annotated[
+        list[str] | None, typer.Argument(help="With 'replay': the store folder and case id.")
+    ] = None,
+    config: ConfigOption = None,
+    workers: Annotated[
+        int | None, typer.Option(min=1, help="Local worker processes (default: all cores).")
+    ] = None,
+    scheduler: Annotated[
+        str | None, typer.Option(help="Dask scheduler address, e.g. tcp://127.0.0.1:8786.")
+    ] = None,
+    dask_local: Annotated[
+        int | None, typer.Option(min=1, help="Start a Dask LocalCluster with N workers.")
+    ] = None,
+    cases: Annotated[
+        int | None, typer.Option(help="Number of random cases (random campaigns).")
+    ] = None,
+    duration: Annotated[
+        float | None, typer.Option(help="Override every case's duration [s] (quick looks).")
+    ] = None,
+    out: Annotated[
+        Path | None, typer.Option(help="Store folder (default out/campaigns/NAME).")
+    ] = None,
+    resume: Annotated[bool, typer.Option(help="Skip the cases already in the store.")] = False,
+    json_output: JsonOption = False,
+) -> None:
+    """Robustness campaign: many slews of a varied plant, stored case by case (Parquet, CSV).
+
+    An interrupted campaign resumes with --resume without recomputing finished
+    cases. 'flexsat campaign replay STORE CASE_ID' re-runs one stored case alone.
+    """
+    from flexsat.campaigns import load_campaign, replay_case, run_campaign, summarize
+    from flexsat.campaigns.definition import CampaignDefinition
+    from flexsat.config import load_config, validate_config
+
+    if name == "replay":
+        if not replay_args or len(replay_args) != 2:
+            raise FlexsatError("usage: flexsat campaign replay STORE CASE_ID")
+        store, case_id = replay_args
+        result = replay_case(store, case_id)
+        target = Path(store) / "replays" / f"{case_id}.nc"
+        result.to_netcdf(target)
+        _console.print(f"replayed {case_id}: {result.dataset.attrs['status']}; wrote {target}")
+        return
+    if scheduler and dask_local:
+        raise FlexsatError("give either --scheduler or --dask-local, not both")
+    definition = load_campaign(name)
+    if duration is not None:
+        data = definition.model_dump(mode="json")
+        data["base"] = {**data["base"], "duration_s": duration}
+        definition = validate_config(data, source="--duration", model=CampaignDefinition)
+    store = out or Path("out") / "campaigns" / definition.name
+    run = run_campaign(
+        definition, load_config(config), store, workers=workers, resume=resume, n_random=cases,
+        scheduler=scheduler, dask_local=dask_local, progress=not json_output,
+    )  # fmt: skip
+    summary = {**summarize(store), "wall_time_s": run["wall_time_s"], "ran": run["ran"],
+               "parquet": run["parquet"], "csv": run["csv"]}  # fmt: skip
+    if json_output:
+        typer.echo(json.dumps(_jsonable(summary)))
+        return
+    table = Table(title=f"Campaign {definition.name}: {summary['cases']} cases")
+    table.add_column("metric", no_wrap=True)
+    table.add_column("value", justify="right")
+    for key in ("cases", "ran", "failed", "r1_pass_rate", "r2_pass_rate", "r3_pass_rate",
+                "worst_final_pointing_error_deg", "wall_time_s"):  # fmt: skip
+        table.add_row(key, _shown(summary[key]))
+    _console.print(table)
+    for worst in summary["worst_cases"]:
+        _console.print(f"  worst: {worst['case_id']}  {worst['final_pointing_error_deg']:.4g} deg")
+    _console.print(f"wrote {summary['parquet']} and {summary['csv']}")
+
+
 def _parse_triple(text: str, option: str) -> list[float]:
     try:
         values = [float(v) for v in text.split(",")]
