@@ -139,8 +139,10 @@ def run_slew(
         "time", np.degrees(column["theta_err"]),
         {"units": "deg", "description": "2 asin |q_v,e|: absolute pointing error"},
     )  # fmt: skip
+    with np.errstate(over="ignore", invalid="ignore"):  # a diverged run's last state
+        rate_error = np.degrees(np.linalg.norm(ds["omega"].values, axis=1))
     ds["rate_error_deg_s"] = (
-        "time", np.degrees(np.linalg.norm(ds["omega"].values, axis=1)),
+        "time", rate_error,
         {"units": "deg/s", "description": "|omega - omega_d|: residual rate (jitter)"},
     )  # fmt: skip
     return Result(ds)
