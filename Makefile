@@ -26,6 +26,7 @@ bench: $(STAMP)
 	$(BIN)/python bench/bench_dynamics.py
 	$(BIN)/python bench/bench_openloop.py
 	$(BIN)/python bench/bench_slew.py
+	$(BIN)/python bench/bench_campaigns.py
 
 lint: $(STAMP)
 	$(BIN)/ruff check src tests bench examples
