@@ -19,10 +19,19 @@ from pathlib import Path
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
 
 from flexsat.campaigns.definition import CampaignDefinition, ResolvedCase, resolve_cases
-from flexsat.campaigns.store import CampaignStore
+from flexsat.campaigns.store import HISTORY_UNITS, CampaignStore
 from flexsat.config.models import SatelliteConfig
 
-__all__ = ["replay_case", "run_campaign", "run_case", "summarize"]
+__all__ = [
+    "HISTORY_DT_S",
+    "HISTORY_KEY",
+    "HISTORY_UNITS",
+    "case_history",
+    "replay_case",
+    "run_campaign",
+    "run_case",
+    "summarize",
+]
 
 
 def replay_case(store: str | Path, case_id: str):
@@ -65,8 +74,48 @@ def summarize(store: str | Path) -> dict:
     }
 
 
+HISTORY_KEY = "history"
+"""Key of the decimated time history in a :func:`run_case` row (not stored in the table)."""
+
+HISTORY_DT_S = 0.1
+"""Sampling interval of the stored case histories [s]."""
+
+
+def case_history(ds, dt: float = HISTORY_DT_S) -> dict:
+    """Time history of a slew decimated to every ``dt`` seconds, as plain lists.
+
+    Keys are those of :data:`HISTORY_UNITS`: ``tau_cmd`` and ``jk`` are lists of
+    [x, y, z] per sample, ``tip_displacement_max`` the largest tip-displacement
+    magnitude over the appendages [m]. Variables a dataset lacks are left out.
+    A partial (failed) run gives the history up to where it stopped.
+    """
+    import numpy as np
+
+    t = np.asarray(ds["time"].values, dtype=float)
+    if t.size == 0:
+        return {"time": []}
+    grid = np.arange(t[0], t[-1] + 0.5 * dt, dt)
+    index = np.unique(np.clip(np.searchsorted(t, grid - 1e-9 * dt), 0, t.size - 1))
+    history = {"time": t[index].tolist()}
+    for name in ("pointing_error_deg", "rate_error_deg_s", "tau_cmd", "total_energy",
+                 "lambda_act", "jk"):  # fmt: skip
+        if name in ds:
+            history[name] = np.asarray(ds[name].values, dtype=float)[index].tolist()
+    if "tip_displacement" in ds:
+        tips = np.asarray(ds["tip_displacement"].values, dtype=float)[index]
+        magnitude = np.linalg.norm(tips, axis=-1)  # (time, appendage)
+        if magnitude.ndim == 2 and magnitude.shape[1]:
+            history["tip_displacement_max"] = magnitude.max(axis=1).tolist()
+    return history
+
+
 def run_case(case: ResolvedCase) -> dict:
-    """Run one resolved case; never raises: failures come back as a failed row."""
+    """Run one resolved case; never raises: failures come back as a failed row.
+
+    The row also holds, under :data:`HISTORY_KEY`, the decimated time history of
+    the case (:func:`case_history`); :func:`run_campaign` stores it apart from the
+    table. A case that fails before simulating has no history.
+    """
     from flexsat.analysis.requirements import slew_metrics
     from flexsat.config.models import SatelliteConfig
     from flexsat.dynamics.plant import Plant
@@ -84,6 +133,7 @@ def run_case(case: ResolvedCase) -> dict:
         plant = Plant.from_config(SatelliteConfig.model_validate(case.plant))
         scenario = SlewScenario.model_validate(case.scenario)
         result = run_slew(plant, scenario, progress=False)
+        row[HISTORY_KEY] = case_history(result.dataset)
         req = scenario.requirements
         metrics = slew_metrics(
             result.dataset, req.pointing_deg, req.jitter_deg_s, scenario.actuator.t_max_nm
@@ -140,6 +190,9 @@ def run_campaign(
     with Progress(*columns, disable=not progress, transient=True) as bar:
         task = bar.add_task("cases", total=len(cases), completed=len(cases) - len(todo), failed=0)
         for row in _execute(todo, workers, scheduler, dask_local):
+            history = row.pop(HISTORY_KEY, None)
+            if history is not None:  # before the case: a stored case has its history
+                store.write_history(row["case_id"], history, status=row["status"])
             store.write_case(row)
             failed += row["status"] != "ok"
             bar.update(task, advance=1, failed=failed)

@@ -3,7 +3,9 @@
 Each finished case is written to ``cases/<id>.json`` through a temporary file and
 an atomic rename, so killing the process at any moment loses at most the cases in
 flight and never leaves a half-written row. ``results.parquet`` (and
-``results.csv`` beside it, for people) are rebuilt from the case files.
+``results.csv`` beside it, for people) are rebuilt from the case files. The
+decimated time history of each case is kept apart, in ``histories/<id>.nc``
+(NetCDF, also written through a temporary name and an atomic rename).
 """
 
 from __future__ import annotations
@@ -14,11 +16,35 @@ import os
 import tempfile
 from pathlib import Path
 
+import numpy as np
 import pandas as pd
+import xarray as xr
 
 from flexsat.errors import ConfigError
 
-__all__ = ["CampaignStore"]
+__all__ = ["HISTORY_UNITS", "CampaignStore"]
+
+HISTORY_UNITS = {
+    "time": "s",
+    "pointing_error_deg": "deg",
+    "rate_error_deg_s": "deg/s",
+    "tau_cmd": "N m",
+    "tip_displacement_max": "m",
+    "total_energy": "J",
+    "lambda_act": "rad/s",
+    "jk": "N m",
+}
+"""Variables of a stored case history and their units."""
+
+_HISTORY_DESCRIPTIONS = {
+    "pointing_error_deg": "2 asin |q_v,e|: absolute pointing error",
+    "rate_error_deg_s": "|omega - omega_d|: residual rate (jitter)",
+    "tau_cmd": "commanded body torque, frame B",
+    "tip_displacement_max": "largest panel tip displacement magnitude over the appendages",
+    "total_energy": "T + U",
+    "lambda_act": "Lambda_act",
+    "jk": "robust torque gain JK per axis",
+}
 
 
 class CampaignStore:
@@ -27,6 +53,7 @@ class CampaignStore:
     def __init__(self, root: str | Path) -> None:
         self.root = Path(root)
         self.cases_dir = self.root / "cases"
+        self.histories_dir = self.root / "histories"
 
     def open(self, fingerprint: str, name: str, resume: bool) -> None:
         """Create the store, or check it belongs to the same campaign when resuming."""
@@ -53,6 +80,49 @@ class CampaignStore:
 
     def write_case(self, row: dict) -> None:
         _write_atomic(self.cases_dir / f"{row['case_id']}.json", json.dumps(_clean(row)))
+
+    def write_history(self, case_id: str, data: dict, status: str = "ok") -> Path:
+        """Store a case's time history (plain lists keyed as :data:`HISTORY_UNITS`).
+
+        Written to ``histories/<case_id>.nc`` through a temporary file and an atomic
+        rename. ``tau_cmd`` and ``jk`` are (time, axis); the rest are (time,).
+        """
+        self.histories_dir.mkdir(parents=True, exist_ok=True)
+        ds = xr.Dataset(
+            coords={"time": ("time", np.asarray(data.get("time", []), dtype=float),
+                             {"units": HISTORY_UNITS["time"]}),
+                    "axis": ("axis", ["x", "y", "z"])},
+            attrs={"case_id": case_id, "status": status,
+                   "title": f"flexsat campaign case {case_id!r} (decimated history)"},
+        )  # fmt: skip
+        for name, unit in HISTORY_UNITS.items():
+            if name == "time" or name not in data:
+                continue
+            values = np.asarray(data[name], dtype=float)
+            dims = ("time", "axis") if name in ("tau_cmd", "jk") else ("time",)
+            values = values.reshape(-1, 3) if len(dims) == 2 else values
+            attrs = {"units": unit, "description": _HISTORY_DESCRIPTIONS[name]}
+            ds[name] = (dims, values, attrs)
+        path = self.histories_dir / f"{case_id}.nc"
+        fd, tmp = tempfile.mkstemp(dir=self.histories_dir, suffix=".partial")
+        os.close(fd)
+        try:
+            ds.to_netcdf(tmp)
+            os.replace(tmp, path)
+        finally:
+            if os.path.exists(tmp):
+                os.remove(tmp)
+        return path
+
+    def histories(self) -> dict[str, xr.Dataset]:
+        """Stored case histories by case id (loaded into memory)."""
+        if not self.histories_dir.exists():
+            return {}
+        loaded = {}
+        for path in sorted(self.histories_dir.glob("*.nc")):
+            with xr.open_dataset(path) as ds:
+                loaded[path.stem] = ds.load()
+        return loaded
 
     def rows(self) -> list[dict]:
         return [json.loads(p.read_text()) for p in sorted(self.cases_dir.glob("*.json"))]

@@ -326,6 +326,7 @@ def campaign(
     )  # fmt: skip
     summary = {**summarize(store), "wall_time_s": run["wall_time_s"], "ran": run["ran"],
                "parquet": run["parquet"], "csv": run["csv"]}  # fmt: skip
+    summary["figures"] = [str(path) for path in _campaign_figures(store)]
     if json_output:
         typer.echo(json.dumps(_jsonable(summary)))
         return
@@ -339,6 +340,18 @@ def campaign(
     for worst in summary["worst_cases"]:
         _console.print(f"  worst: {worst['case_id']}  {worst['final_pointing_error_deg']:.4g} deg")
     _console.print(f"wrote {summary['parquet']} and {summary['csv']}")
+    for path in summary["figures"]:
+        _console.print(f"wrote {path}")
+
+
+def _campaign_figures(store: Path) -> list[Path]:
+    """Envelope and summary figures of a stored campaign; none if no case succeeded."""
+    from flexsat.plots.campaign import write_campaign_figures
+
+    try:
+        return write_campaign_figures(store)
+    except ValueError:  # no successful case history to draw
+        return []
 
 
 def _parse_triple(text: str, option: str) -> list[float]:

@@ -1,0 +1,401 @@
+"""Campaign figures: envelopes of every case's time history and a summary table.
+
+Each envelope figure draws the min–max band of all successful cases of a campaign
+(from the decimated histories in ``histories/<id>.nc``, see
+:class:`flexsat.campaigns.store.CampaignStore`) with the nominal case's line over
+it, in the style of the thesis's robustness figures: pointing error and residual
+rate on log axes with the R1 and R2 bands, commanded torque per axis with the
+saturation limits ±RF·T_max, tip displacement, total energy, Λ_act and JK.
+The summary table gives the pass rates R1/R2/R3 and the five worst cases with
+their parameters.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import xarray as xr
+from matplotlib.figure import Figure
+
+from flexsat.campaigns.runner import summarize
+from flexsat.campaigns.store import CampaignStore
+from flexsat.plots.openloop import _AXES, _AXIS_COLOURS, _figure, _finish_time_axis, _positive
+from flexsat.plots.slew import _BAND
+
+__all__ = [
+    "CAMPAIGN_FIGURES",
+    "campaign_envelope",
+    "plot_envelope_energy",
+    "plot_envelope_gains",
+    "plot_envelope_pointing",
+    "plot_envelope_rate",
+    "plot_envelope_tip",
+    "plot_envelope_torque",
+    "plot_envelopes",
+    "plot_summary_table",
+    "write_campaign_figures",
+]
+
+_NOMINAL = "nominal"
+_ENVELOPE_ALPHA = 0.25
+
+
+class _Campaign:
+    """What the figures need from a store: ok histories, the nominal id, the limits."""
+
+    def __init__(self, store_dir: str | Path) -> None:
+        store = CampaignStore(store_dir)
+        self.root = store.root
+        self.rows = {row["case_id"]: row for row in store.rows()}
+        ok = {cid for cid, row in self.rows.items() if row["status"] == "ok"}
+        self.histories = {cid: ds for cid, ds in store.histories().items() if cid in ok}
+        if not self.histories:
+            raise ValueError(f"{store.root} holds no successful case history to plot")
+        marker = store.root / "campaign.json"
+        self.name = json.loads(marker.read_text())["name"] if marker.exists() else store.root.name
+        self.nominal = _NOMINAL if _NOMINAL in self.histories else sorted(self.histories)[0]
+        scenario = self.rows[self.nominal].get("inputs", {}).get("scenario", {})
+        requirements = scenario.get("requirements", {})
+        actuator = scenario.get("actuator", {})
+        self.pointing_deg = float(requirements.get("pointing_deg", 0.05))
+        self.jitter_deg_s = float(requirements.get("jitter_deg_s", 1e-3))
+        self.torque_limit = float(actuator.get("reduction_factor", 0.95)) * float(
+            actuator.get("t_max_nm", 2.0)
+        )
+
+    @property
+    def time(self) -> np.ndarray:
+        return np.asarray(self.histories[self.nominal]["time"].values, dtype=float)
+
+    def title(self, fig: Figure, what: str) -> None:
+        fig.suptitle(
+            f"{what}\ncampaign {self.name!r}: {len(self.histories)} successful cases "
+            f"(band: min–max), line: case {self.nominal!r}",
+            fontsize=11,
+        )
+
+
+def _load(store_dir) -> _Campaign:
+    return store_dir if isinstance(store_dir, _Campaign) else _Campaign(store_dir)
+
+
+def campaign_envelope(
+    histories: dict[str, xr.Dataset], name: str, t: np.ndarray, axis: int | None = None
+) -> tuple[np.ndarray, np.ndarray]:
+    """(min, max) over the cases of one history variable on the times ``t``.
+
+    Each case is interpolated linearly onto ``t`` (a no-op for cases sharing its
+    times); a case contributes nothing outside its own time span. Times no case
+    covers come back NaN.
+    """
+    columns = []
+    for ds in histories.values():
+        if name not in ds:
+            continue
+        values = np.asarray(ds[name].values, dtype=float)
+        if axis is not None:
+            values = values[:, axis]
+        own = np.asarray(ds["time"].values, dtype=float)
+        if own.size == 0:
+            continue
+        column = np.interp(t, own, values)
+        column[(t < own[0] - 1e-9) | (t > own[-1] + 1e-9)] = np.nan
+        columns.append(column)
+    if not columns:
+        nan = np.full(t.shape, np.nan)
+        return nan, nan
+    stack = np.vstack(columns)
+    finite = np.isfinite(stack)
+    covered = finite.any(axis=0)
+    lo = np.where(finite, stack, np.inf).min(axis=0)
+    hi = np.where(finite, stack, -np.inf).max(axis=0)
+    return np.where(covered, lo, np.nan), np.where(covered, hi, np.nan)
+
+
+def _nominal(campaign: _Campaign, name: str, axis: int | None = None) -> np.ndarray:
+    ds = campaign.histories[campaign.nominal]
+    if name not in ds:
+        return np.full(campaign.time.shape, np.nan)
+    values = np.asarray(ds[name].values, dtype=float)
+    return values[:, axis] if axis is not None else values
+
+
+def _band_and_line(
+    ax,
+    campaign: _Campaign,
+    name: str,
+    *,
+    axis: int | None = None,
+    scale: float = 1.0,
+    colour: str = "black",
+    log: bool = False,
+) -> None:
+    t = campaign.time
+    lo, hi = campaign_envelope(campaign.histories, name, t, axis)
+    line = _nominal(campaign, name, axis)
+    lo, hi, line = scale * lo, scale * hi, scale * line
+    if log:
+        lo, hi, line = _positive(lo), _positive(hi), _positive(line)
+    ax.fill_between(
+        t, lo, hi, color=colour, alpha=_ENVELOPE_ALPHA, linewidth=0, label="all cases (min–max)"
+    )
+    ax.plot(t, line, color=colour, linewidth=1.1, label=f"{campaign.nominal}")
+    if log:
+        ax.set_yscale("log")
+
+
+def _requirement(ax, bound: float, tag: str, unit: str) -> None:
+    ax.axhspan(
+        ax.get_ylim()[0],
+        bound,
+        color=_BAND,
+        alpha=0.15,
+        linewidth=0,
+        label=f"{tag} band: < {bound:.3g} {unit}",
+    )
+    ax.axhline(bound, color=_BAND, linewidth=1.4, label=f"{tag}: {bound:.3g} {unit}")
+
+
+def _log_panel(
+    campaign: _Campaign,
+    name: str,
+    bound: float,
+    tag: str,
+    unit: str,
+    ylabel: str,
+    what: str,
+    colour: str,
+) -> Figure:
+    fig, axes = _figure(1, 1, size=(11.0, 5.5))
+    ax = axes[0, 0]
+    _band_and_line(ax, campaign, name, colour=colour, log=True)
+    bottom, top = ax.get_ylim()
+    ax.set_ylim(min(bottom, bound / 3.0), max(top, bound * 3.0))
+    _requirement(ax, bound, tag, unit)
+    ax.set_ylabel(ylabel)
+    ax.legend(loc="upper right", fontsize=8)
+    _finish_time_axis(axes, campaign.time)
+    campaign.title(fig, what)
+    return fig
+
+
+def plot_envelope_pointing(store_dir: str | Path) -> Figure:
+    """Pointing error [deg] of every case (log) with the R1 band."""
+    c = _load(store_dir)
+    return _log_panel(
+        c,
+        "pointing_error_deg",
+        c.pointing_deg,
+        "R1",
+        "deg",
+        "pointing error [deg] (log)",
+        "Pointing error envelope (R1)",
+        "black",
+    )
+
+
+def plot_envelope_rate(store_dir: str | Path) -> Figure:
+    """Residual rate |ω − ω_d| [deg/s] of every case (log) with the R2 band."""
+    c = _load(store_dir)
+    return _log_panel(
+        c,
+        "rate_error_deg_s",
+        c.jitter_deg_s,
+        "R2",
+        "deg/s",
+        "residual rate [deg/s] (log)",
+        "Residual rate envelope (R2)",
+        "tab:blue",
+    )
+
+
+def plot_envelope_torque(store_dir: str | Path) -> Figure:
+    """Commanded torque per axis [N m] of every case with the limits ±RF·T_max."""
+    c = _load(store_dir)
+    fig, axes = _figure(3, 1, size=(11.0, 8.5))
+    for k in range(3):
+        ax = axes[k, 0]
+        _band_and_line(ax, c, "tau_cmd", axis=k, colour=_AXIS_COLOURS[k])
+        for sign in (1.0, -1.0):
+            ax.axhline(
+                sign * c.torque_limit,
+                color="0.3",
+                linestyle="--",
+                linewidth=1.0,
+                label=f"±RF·T_max = ±{c.torque_limit:.3g} N m" if sign > 0 else None,
+            )
+        ax.set_ylim(-1.15 * c.torque_limit, 1.15 * c.torque_limit)
+        ax.set_ylabel(f"τ_cmd,{_AXES[k]} [N m]")
+        ax.legend(loc="upper right", fontsize=8)
+    _finish_time_axis(axes, c.time)
+    c.title(fig, "Commanded torque envelope per axis")
+    return fig
+
+
+def _single(c: _Campaign, name: str, scale: float, ylabel: str, what: str, colour: str) -> Figure:
+    fig, axes = _figure(1, 1, size=(11.0, 5.5))
+    _band_and_line(axes[0, 0], c, name, scale=scale, colour=colour)
+    axes[0, 0].set_ylabel(ylabel)
+    axes[0, 0].legend(loc="upper right", fontsize=8)
+    _finish_time_axis(axes, c.time)
+    c.title(fig, what)
+    return fig
+
+
+def plot_envelope_tip(store_dir: str | Path) -> Figure:
+    """Largest panel tip displacement magnitude [mm] of every case."""
+    return _single(
+        _load(store_dir),
+        "tip_displacement_max",
+        1e3,
+        "max tip displacement |δ| [mm]",
+        "Tip displacement envelope",
+        "tab:purple",
+    )
+
+
+def plot_envelope_energy(store_dir: str | Path) -> Figure:
+    """Total energy T + U [J] of every case."""
+    return _single(
+        _load(store_dir),
+        "total_energy",
+        1.0,
+        "total energy [J]",
+        "Total energy envelope",
+        "tab:orange",
+    )
+
+
+def plot_envelope_gains(store_dir: str | Path) -> Figure:
+    """Adaptive gains of every case: Λ_act [rad/s] and JK per axis [N m]."""
+    c = _load(store_dir)
+    fig, axes = _figure(4, 1, size=(11.0, 10.0))
+    _band_and_line(axes[0, 0], c, "lambda_act", colour="black")
+    axes[0, 0].set_ylabel("Λ_act [rad/s]")
+    for k in range(3):
+        _band_and_line(axes[k + 1, 0], c, "jk", axis=k, colour=_AXIS_COLOURS[k])
+        axes[k + 1, 0].set_ylabel(f"JK_{_AXES[k]} [N m]")
+    for ax in axes[:, 0]:
+        ax.legend(loc="upper right", fontsize=8)
+    _finish_time_axis(axes, c.time)
+    c.title(fig, "Adaptive gain envelopes: Λ_act and JK")
+    return fig
+
+
+_ENVELOPES = {
+    "envelope_pointing": plot_envelope_pointing,
+    "envelope_rate": plot_envelope_rate,
+    "envelope_torque": plot_envelope_torque,
+    "envelope_tip_displacement": plot_envelope_tip,
+    "envelope_energy": plot_envelope_energy,
+    "envelope_gains": plot_envelope_gains,
+}
+
+
+def plot_envelopes(store_dir: str | Path) -> list[Figure]:
+    """Every envelope figure of a stored campaign, in the order of :data:`CAMPAIGN_FIGURES`."""
+    campaign = _load(store_dir)
+    return [make(campaign) for make in _ENVELOPES.values()]
+
+
+def _parameters(row: dict) -> str:
+    parameters = row.get("parameters") or {}
+    if not parameters:
+        return "(nominal)"
+    text = ", ".join(
+        f"{key} = {value:.4g}" if isinstance(value, float) else f"{key} = {value}"
+        for key, value in parameters.items()
+    )
+    return text if len(text) <= 90 else text[:87] + "..."
+
+
+def plot_summary_table(store_dir: str | Path) -> Figure:
+    """Pass rates R1/R2/R3 and the five worst cases (final pointing error) with parameters."""
+    store = CampaignStore(store_dir)
+    summary = summarize(store.root)
+    rows = {row["case_id"]: row for row in store.rows()}
+    fig = Figure(figsize=(12.0, 5.5), layout="constrained")
+    top, bottom = fig.subplots(2, 1, gridspec_kw={"height_ratios": [1, 1.6]})
+    for ax in (top, bottom):
+        ax.set_axis_off()
+
+    def percent(value: float) -> str:
+        return "—" if value != value else f"{100.0 * value:.1f} %"
+
+    rates = [
+        [
+            str(summary["cases"]),
+            str(summary["failed"]),
+            percent(summary["r1_pass_rate"]),
+            percent(summary["r2_pass_rate"]),
+            percent(summary["r3_pass_rate"]),
+        ]
+    ]
+    table = top.table(
+        cellText=rates,
+        colLabels=["cases", "failed", "R1 pass", "R2 pass", "R3 pass"],
+        loc="center",
+        cellLoc="center",
+    )
+    table.scale(1.0, 1.6)
+    top.set_title("Pass rates", fontsize=10)
+    worst = [
+        [
+            w["case_id"],
+            f"{w['final_pointing_error_deg']:.4g}",
+            _parameters(rows.get(w["case_id"], {})),
+        ]
+        for w in summary["worst_cases"]
+    ]
+    if worst:
+        table = bottom.table(
+            cellText=worst,
+            colLabels=["case", "final pointing error [deg]", "parameters"],
+            loc="upper center",
+            cellLoc="left",
+            colWidths=[0.15, 0.18, 0.67],
+        )
+        table.auto_set_font_size(False)
+        table.set_fontsize(8)
+        table.scale(1.0, 1.5)
+    else:
+        bottom.text(0.5, 0.5, "no successful case", ha="center", va="center")
+    bottom.set_title("Five worst cases (largest final pointing error)", fontsize=10)
+    marker = store.root / "campaign.json"
+    name = json.loads(marker.read_text())["name"] if marker.exists() else store.root.name
+    fig.suptitle(f"Campaign {name!r}: summary", fontsize=11)
+    return fig
+
+
+CAMPAIGN_FIGURES = (*_ENVELOPES, "summary_table")
+"""Names (without ``.png``) of the files :func:`write_campaign_figures` writes, in order."""
+
+
+def write_campaign_figures(
+    store_dir: str | Path, out_dir: str | Path | None = None, *, dpi: int = 120
+) -> list[Path]:
+    """Write every campaign figure as PNG (default folder ``<store_dir>/figures``).
+
+    Files, in the order of :data:`CAMPAIGN_FIGURES`: ``envelope_pointing.png``,
+    ``envelope_rate.png``, ``envelope_torque.png``, ``envelope_tip_displacement.png``,
+    ``envelope_energy.png``, ``envelope_gains.png`` and ``summary_table.png``.
+
+    Returns
+    -------
+    list of Path
+        The files written.
+    """
+    out = Path(out_dir) if out_dir is not None else Path(store_dir) / "figures"
+    out.mkdir(parents=True, exist_ok=True)
+    campaign = _Campaign(store_dir)
+    makers = {**_ENVELOPES, "summary_table": lambda _: plot_summary_table(store_dir)}
+    written = []
+    for name in CAMPAIGN_FIGURES:
+        fig = makers[name](campaign)
+        path = out / f"{name}.png"
+        fig.savefig(path, dpi=dpi)
+        fig.clear()
+        written.append(path)
+    return written
