@@ -93,7 +93,7 @@ def _describe(error: dict[str, Any], model: type[BaseModel]) -> str:
     if kind in ("model_type", "dict_type"):
         return f"{location}: expected a TOML table (section), got {error.get('input')!r}"
     message = error["msg"].removeprefix("Value error, ")
-    if "input" in error:
+    if "input" in error and error["loc"] and not isinstance(error["input"], dict):
         return f"{location}: {message} (got {error['input']!r})"
     return f"{location}: {message}"
 

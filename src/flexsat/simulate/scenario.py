@@ -7,7 +7,7 @@ this boundary are in degrees (fields ending in ``_deg``), everything else SI.
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Annotated, Literal
+from typing import Annotated, ClassVar, Literal
 
 from pydantic import Field, model_validator
 
@@ -90,76 +90,25 @@ class InitialState(_Frozen):
         return self
 
 
-class OpenLoopScenario(_Frozen):
-    """An open-loop run. The default is the thesis's (section 3.3): at rest,
-    1 N m about body Z for 0 <= t < 10 s, then free, to 120 s, RK4 at 1 ms."""
+class _TimedRun(_Frozen):
+    """Duration, RK4 step and recording rate shared by every kind of run."""
 
-    name: str = "thesis-openloop"
+    name: str = "run"
     duration_s: Annotated[float, Field(gt=0.0, le=1e6, allow_inf_nan=False)] = 120.0
     dt_s: Annotated[float, Field(gt=0.0, le=0.1, allow_inf_nan=False)] = 1e-3
     record_dt_s: Annotated[float, Field(gt=0.0, allow_inf_nan=False)] = 1e-2
-    solver: Literal["rk4", "dop853"] = "rk4"
-    rtol: Annotated[float, Field(gt=0.0, lt=1.0)] = 1e-10
-    atol: Annotated[float, Field(gt=0.0, lt=1.0)] = 1e-12
-    initial: InitialState = Field(default_factory=InitialState)
-    torque: list[TorqueSegment] = Field(
-        default_factory=lambda: [TorqueSegment(start_s=0.0, end_s=10.0, torque_nm=(0, 0, 1.0))]
-    )
-    disturbance_torque_nm: Vector3 = Field(_ZERO3, description="constant body torque [N m]")
+
+    _MULTIPLES_OF_DT: ClassVar[tuple[str, ...]] = ("record_dt_s",)
 
     @model_validator(mode="after")
-    def _steps(self) -> OpenLoopScenario:
-        ratio = self.record_dt_s / self.dt_s
-        if ratio < 1.0 - 1e-9 or abs(ratio - round(ratio)) > 1e-6 * ratio:
-            raise ValueError(
-                f"record_dt_s must be a whole multiple of dt_s ({self.dt_s}), "
-                f"got {self.record_dt_s}"
-            )
-        if self.duration_s < self.dt_s:
-            raise ValueError(f"duration_s must be at least dt_s ({self.dt_s})")
-        return self
-
-    @property
-    def n_steps(self) -> int:
-        return round(self.duration_s / self.dt_s)
-
-    @property
-    def record_every(self) -> int:
-        return round(self.record_dt_s / self.dt_s)
-
-
-class Requirements(_Frozen):
-    """Pointing requirements checked on every slew (thesis sec. 5.1.1)."""
-
-    pointing_deg: Positive = Field(0.05, description="R1: absolute pointing error [deg]")
-    jitter_deg_s: Positive = Field(1e-3, description="R2: residual rate [deg/s]")
-
-
-class SlewScenario(_Frozen):
-    """A closed-loop rest-to-rest slew. The default is the thesis's (section 5.1):
-    from the identity to 45 deg on roll, pitch and yaw, ASMC, disturbances at their
-    maximum, 120 s, RK4 at 1 ms with the controller at every step."""
-
-    name: str = "thesis-slew"
-    duration_s: Annotated[float, Field(gt=0.0, le=1e6, allow_inf_nan=False)] = 120.0
-    dt_s: Annotated[float, Field(gt=0.0, le=0.1, allow_inf_nan=False)] = 1e-3
-    control_dt_s: Annotated[float, Field(gt=0.0, le=10.0, allow_inf_nan=False)] = 1e-3
-    record_dt_s: Annotated[float, Field(gt=0.0, allow_inf_nan=False)] = 1e-2
-    initial: InitialState = Field(default_factory=InitialState)
-    target_euler_deg: Vector3 = Field(
-        (45.0, 45.0, 45.0), description="target ZYX Euler angles (roll, pitch, yaw) [deg]"
-    )
-    controller: ControllerConfig = Field(default_factory=ASMCConfig)
-    actuator: ActuatorConfig = Field(default_factory=ActuatorConfig)
-    disturbances: DisturbanceConfig = Field(default_factory=DisturbanceConfig)
-    requirements: Requirements = Field(default_factory=Requirements)
-
-    @model_validator(mode="after")
-    def _steps(self) -> SlewScenario:
-        for field in ("control_dt_s", "record_dt_s"):
+    def _steps(self) -> _TimedRun:
+        for field in self._MULTIPLES_OF_DT:
             ratio = getattr(self, field) / self.dt_s
             if ratio < 1.0 - 1e-9 or abs(ratio - round(ratio)) > 1e-6 * ratio:
-                raise ValueError(f"{field} must be a whole multiple of dt_s ({self.dt_s})")
+                raise ValueError(
+                    f"{field} must be a whole multiple of dt_s ({self.dt_s}), "
+                    f"got {getattr(self, field)}"
+                )
         if self.duration_s < self.record_dt_s:
             raise ValueError(f"duration_s must be at least record_dt_s ({self.record_dt_s})")
         return self
@@ -169,12 +118,53 @@ class SlewScenario(_Frozen):
         return round(self.duration_s / self.dt_s)
 
     @property
-    def control_every(self) -> int:
-        return round(self.control_dt_s / self.dt_s)
-
-    @property
     def record_every(self) -> int:
         return round(self.record_dt_s / self.dt_s)
+
+
+class OpenLoopScenario(_TimedRun):
+    """An open-loop run. The default is the thesis's (section 3.3): at rest,
+    1 N m about body Z for 0 <= t < 10 s, then free, to 120 s, RK4 at 1 ms."""
+
+    name: str = "thesis-openloop"
+    solver: Literal["rk4", "dop853"] = "rk4"
+    rtol: Annotated[float, Field(gt=0.0, lt=1.0)] = 1e-10
+    atol: Annotated[float, Field(gt=0.0, lt=1.0)] = 1e-12
+    initial: InitialState = Field(default_factory=InitialState)
+    torque: list[TorqueSegment] = Field(
+        default_factory=lambda: [TorqueSegment(start_s=0.0, end_s=10.0, torque_nm=(0, 0, 1.0))]
+    )
+    disturbance_torque_nm: Vector3 = Field(_ZERO3, description="constant body torque [N m]")
+
+
+class Requirements(_Frozen):
+    """Pointing requirements checked on every slew (thesis sec. 5.1.1)."""
+
+    pointing_deg: Positive = Field(0.05, description="R1: absolute pointing error [deg]")
+    jitter_deg_s: Positive = Field(1e-3, description="R2: residual rate [deg/s]")
+
+
+class SlewScenario(_TimedRun):
+    """A closed-loop rest-to-rest slew. The default is the thesis's (section 5.1):
+    from the identity to 45 deg on roll, pitch and yaw, ASMC, disturbances at their
+    maximum, 120 s, RK4 at 1 ms with the controller at every step."""
+
+    name: str = "thesis-slew"
+    control_dt_s: Annotated[float, Field(gt=0.0, le=10.0, allow_inf_nan=False)] = 1e-3
+    initial: InitialState = Field(default_factory=InitialState)
+    target_euler_deg: Vector3 = Field(
+        (45.0, 45.0, 45.0), description="target ZYX Euler angles (roll, pitch, yaw) [deg]"
+    )
+    controller: ControllerConfig = Field(default_factory=ASMCConfig)
+    actuator: ActuatorConfig = Field(default_factory=ActuatorConfig)
+    disturbances: DisturbanceConfig = Field(default_factory=DisturbanceConfig)
+    requirements: Requirements = Field(default_factory=Requirements)
+
+    _MULTIPLES_OF_DT: ClassVar[tuple[str, ...]] = ("control_dt_s", "record_dt_s")
+
+    @property
+    def control_every(self) -> int:
+        return round(self.control_dt_s / self.dt_s)
 
 
 def load_slew(path: str | Path | None = None) -> SlewScenario:
