@@ -57,6 +57,15 @@ def _version(value: bool) -> None:
         raise typer.Exit()
 
 
+def _announce_compilation() -> None:
+    """Say so on stderr when the compiled kernels are not cached yet (first run)."""
+    from flexsat.dynamics import kernels
+
+    cache = Path(kernels.__file__).parent / "__pycache__"
+    if not any(cache.glob("kernels.*.nbi")):
+        _errors.print("compiling the dynamics kernels (first run only, cached on disk)...")
+
+
 @app.callback()
 def _root(
     version: Annotated[
@@ -85,6 +94,7 @@ def modal(
     from flexsat.config import load_config
     from flexsat.dynamics.plant import Plant
 
+    _announce_compilation()
     analysis = modal_analysis(Plant.from_config(load_config(config)))
     summary = analysis.to_dict()
     if animate:
@@ -152,6 +162,7 @@ def openloop(
     from flexsat.dynamics.plant import Plant
     from flexsat.simulate import OpenLoopScenario, load_scenario, run_openloop
 
+    _announce_compilation()
     plant = Plant.from_config(load_config(config))
     chosen = load_scenario(scenario)
     overrides = {
@@ -213,6 +224,7 @@ def slew(
     from flexsat.dynamics.plant import Plant
     from flexsat.simulate import SlewScenario, load_slew
 
+    _announce_compilation()
     plant = Plant.from_config(load_config(config))
     chosen = load_slew(scenario)
     overrides: dict = {}
