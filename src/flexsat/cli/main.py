@@ -179,12 +179,7 @@ def openloop(
     result = run_openloop(plant, chosen, progress=None if not json_output else False)
     metrics = openloop_metrics(result.dataset)
     if out is not None:
-        out.mkdir(parents=True, exist_ok=True)
-        files = [result.to_netcdf(out / "result.nc")]
-        if result.ok:
-            files += _openloop_figures(result, plant, out)
-        (out / "metrics.json").write_text(json.dumps(_jsonable(metrics), indent=2))
-        metrics["files"] = [str(p) for p in [*files, out / "metrics.json"]]
+        _write_run(result, metrics, out, lambda: _openloop_figures(result, plant, out))
     if json_output:
         typer.echo(json.dumps(_jsonable(metrics)))
     else:
@@ -387,13 +382,19 @@ def _fly(plant, scenario, out: Path | None, quiet: bool) -> tuple[dict, bool, st
         result.dataset, req.pointing_deg, req.jitter_deg_s, scenario.actuator.t_max_nm
     )
     if out is not None:
-        out.mkdir(parents=True, exist_ok=True)
-        files = [result.to_netcdf(out / "result.nc")]
-        if result.ok:
-            files += _slew_figures(result, out)
-        (out / "metrics.json").write_text(json.dumps(_jsonable(metrics), indent=2))
-        metrics["files"] = [str(p) for p in [*files, out / "metrics.json"]]
+        _write_run(result, metrics, out, lambda: _slew_figures(result, out))
     return metrics, result.ok, result.message
+
+
+def _write_run(result, metrics: dict, out: Path, figures) -> None:
+    """result.nc (always, a failed run's history too), the figures if it succeeded, and
+    metrics.json into ``out``; the written paths are added to ``metrics["files"]``."""
+    out.mkdir(parents=True, exist_ok=True)
+    files = [result.to_netcdf(out / "result.nc")]
+    if result.ok:
+        files += figures()
+    (out / "metrics.json").write_text(json.dumps(_jsonable(metrics), indent=2))
+    metrics["files"] = [str(p) for p in [*files, out / "metrics.json"]]
 
 
 def _slew_figures(result, out: Path) -> list[Path]:
