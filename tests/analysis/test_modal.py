@@ -7,8 +7,8 @@ import pytest
 
 from flexsat.analysis.modal import modal_analysis
 from flexsat.dynamics.plant import Plant
+from flexsat.study.thesis import TABLE_3_3, TRANSLATION_MODES_MIN_HZ
 from tests.conftest import three_panels, two_different_panels
-from tests.reference import TABLE_3_3, TRANSLATION_MODES_MIN_HZ
 
 
 @pytest.fixture(scope="module")

@@ -9,8 +9,8 @@ from flexsat.dynamics.plant import Plant
 from flexsat.dynamics.rigid import gyroscopic_torque, rigid_inertia
 from flexsat.dynamics.symmetry import mirror_operator
 from flexsat.errors import SimulationError
+from flexsat.study.thesis import J_TOT_NOMINAL, PRINTED_2DP, appendix_b_mass_matrix
 from tests.conftest import random_state
-from tests.reference import J_TOT_NOMINAL, PRINTED_2DP, appendix_b_mass_matrix
 
 N_STATES = 25
 

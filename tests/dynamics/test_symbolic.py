@@ -20,7 +20,7 @@ from flexsat.dynamics.symbolic import (
     derive,
     reference_model,
 )
-from tests.reference import PRINTED_2DP, appendix_b_mass_matrix
+from flexsat.study.thesis import PRINTED_2DP, appendix_b_mass_matrix
 
 N_DOF = 18
 

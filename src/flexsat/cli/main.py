@@ -19,6 +19,7 @@ from rich.table import Table
 
 from flexsat import __version__
 from flexsat.errors import FlexsatError
+from flexsat.study.outputs import jsonable
 
 __all__ = ["app", "main"]
 
@@ -90,27 +91,19 @@ def modal(
     ] = None,
 ) -> None:
     """Modal analysis of the coupled satellite: frequencies, mode shapes and classification."""
-    from flexsat.analysis.modal import modal_analysis
     from flexsat.config import load_config
     from flexsat.dynamics.plant import Plant
+    from flexsat.study.outputs import write_modal
 
     _announce_compilation()
-    analysis = modal_analysis(Plant.from_config(load_config(config)))
-    summary = analysis.to_dict()
-    if animate:
-        bad = [k for k in animate if not 1 <= k <= len(analysis.modes)]
-        if bad:
-            n_modes = len(analysis.modes)
-            raise FlexsatError(f"--animate: mode index must be in 1..{n_modes}, got {bad}")
-    if out is not None:
-        from flexsat.plots.modal import write_modal_figures
-
-        out.mkdir(parents=True, exist_ok=True)
-        (out / "modal.json").write_text(json.dumps(summary, indent=2))
-        written = write_modal_figures(analysis, out, mode_indices=animate)
-        summary["files"] = [str(p) for p in [out / "modal.json", *written]]
+    plant = Plant.from_config(load_config(config))
+    n_modes = len(plant.dof_names())
+    bad = [k for k in animate or [] if not 1 <= k <= n_modes]
+    if bad:
+        raise FlexsatError(f"--animate: mode index must be in 1..{n_modes}, got {bad}")
+    _, summary = write_modal(plant, out, animate)
     if json_output:
-        typer.echo(json.dumps(_jsonable(summary)))
+        typer.echo(json.dumps(jsonable(summary)))
         return
     _print_modal(summary)
 
@@ -157,10 +150,10 @@ def openloop(
     A run that diverges stops cleanly: its history up to the failure is saved (with
     --out) and the command exits with code 1 after naming the time.
     """
-    from flexsat.analysis.openloop import openloop_metrics
     from flexsat.config import load_config, validate_config
     from flexsat.dynamics.plant import Plant
-    from flexsat.simulate import OpenLoopScenario, load_scenario, run_openloop
+    from flexsat.simulate import OpenLoopScenario, load_scenario
+    from flexsat.study.outputs import fly_openloop
 
     _announce_compilation()
     plant = Plant.from_config(load_config(config))
@@ -176,12 +169,9 @@ def openloop(
         chosen = validate_config(
             {**chosen.model_dump(), **overrides}, source="options", model=OpenLoopScenario
         )
-    result = run_openloop(plant, chosen, progress=None if not json_output else False)
-    metrics = openloop_metrics(result.dataset)
-    if out is not None:
-        _write_run(result, metrics, out, lambda: _openloop_figures(result, plant, out))
+    result, metrics = fly_openloop(plant, chosen, out, progress=None if not json_output else False)
     if json_output:
-        typer.echo(json.dumps(_jsonable(metrics)))
+        typer.echo(json.dumps(jsonable(metrics)))
     else:
         _print_metrics(metrics)
     if not result.ok:
@@ -255,7 +245,7 @@ def slew(
             failed.append(message)
     if json_output:
         payload = results if controller == "all" else next(iter(results.values()))
-        typer.echo(json.dumps(_jsonable(payload)))
+        typer.echo(json.dumps(jsonable(payload)))
     elif controller == "all":
         _print_comparison(results)
     else:
@@ -306,9 +296,10 @@ def campaign(
     An interrupted campaign resumes with --resume without recomputing finished
     cases. 'flexsat campaign replay STORE CASE_ID' re-runs one stored case alone.
     """
-    from flexsat.campaigns import load_campaign, replay_case, run_campaign, summarize
+    from flexsat.campaigns import load_campaign, replay_case
     from flexsat.campaigns.definition import CampaignDefinition
     from flexsat.config import load_config, validate_config
+    from flexsat.study.outputs import fly_campaign
 
     if name == "replay":
         if not replay_args or len(replay_args) != 2:
@@ -327,15 +318,12 @@ def campaign(
         data["base"] = {**data["base"], "duration_s": duration}
         definition = validate_config(data, source="--duration", model=CampaignDefinition)
     store = out or Path("out") / "campaigns" / definition.name
-    run = run_campaign(
+    summary = fly_campaign(
         definition, load_config(config), store, workers=workers, resume=resume, n_random=cases,
         scheduler=scheduler, dask_local=dask_local, progress=not json_output,
     )  # fmt: skip
-    summary = {**summarize(store), "wall_time_s": run["wall_time_s"], "ran": run["ran"],
-               "parquet": run["parquet"], "csv": run["csv"]}  # fmt: skip
-    summary["figures"] = [str(path) for path in _campaign_figures(store)]
     if json_output:
-        typer.echo(json.dumps(_jsonable(summary)))
+        typer.echo(json.dumps(jsonable(summary)))
         return
     table = Table(title=f"Campaign {definition.name}: {summary['cases']} cases")
     table.add_column("metric", no_wrap=True)
@@ -351,14 +339,38 @@ def campaign(
         _console.print(f"wrote {path}")
 
 
-def _campaign_figures(store: Path) -> list[Path]:
-    """Envelope and summary figures of a stored campaign; none if no case succeeded."""
-    from flexsat.plots.campaign import write_campaign_figures
+@app.command()
+def study(
+    config: ConfigOption = None,
+    out: Annotated[Path, typer.Option(help="Output folder of the study.")] = Path("out"),
+    quick: Annotated[
+        bool, typer.Option(help="Skip the campaigns: modal, open loop, slews and animation.")
+    ] = False,
+    workers: Annotated[
+        int | None, typer.Option(min=1, help="Campaign worker processes (default: all cores).")
+    ] = None,
+) -> None:
+    """The thesis study end to end, then an HTML report: OUT/report.html.
 
-    try:
-        return write_campaign_figures(store)
-    except ValueError:  # no successful case history to draw
-        return []
+    Modal analysis, open-loop validation, the nominal slew with ASMC, the controller
+    comparison (ASMC, SMC, PD), the slew animation and, unless --quick, the three
+    thesis campaigns. A part that fails is reported in its section and the others
+    go on; the command then exits with code 1.
+    """
+    from flexsat.config import load_config
+    from flexsat.study import run_study
+
+    _announce_compilation()
+    cfg = load_config(config)
+    source = str(config) if config is not None else "the built-in nominal case"
+    manifest = run_study(
+        cfg, out, quick=quick, config_source=source, workers=workers, console=_errors
+    )
+    failed = [part["title"] for part in manifest["parts"] if part["status"] == "failed"]
+    _console.print(f"report: {manifest['report']}")
+    if failed:
+        _errors.print(f"[bold red]error:[/] failed parts: {', '.join(failed)}", highlight=False)
+        raise typer.Exit(1)
 
 
 def _parse_triple(text: str, option: str) -> list[float]:
@@ -373,34 +385,10 @@ def _parse_triple(text: str, option: str) -> list[float]:
 
 def _fly(plant, scenario, out: Path | None, quiet: bool) -> tuple[dict, bool, str]:
     """Run one slew, write its files, return (metrics, ok, message)."""
-    from flexsat.analysis.requirements import slew_metrics
-    from flexsat.simulate import run_slew
+    from flexsat.study.outputs import fly_slew
 
-    result = run_slew(plant, scenario, progress=None if not quiet else False)
-    req = scenario.requirements
-    metrics = slew_metrics(
-        result.dataset, req.pointing_deg, req.jitter_deg_s, scenario.actuator.t_max_nm
-    )
-    if out is not None:
-        _write_run(result, metrics, out, lambda: _slew_figures(result, out))
+    result, metrics = fly_slew(plant, scenario, out, progress=None if not quiet else False)
     return metrics, result.ok, result.message
-
-
-def _write_run(result, metrics: dict, out: Path, figures) -> None:
-    """result.nc (always, a failed run's history too), the figures if it succeeded, and
-    metrics.json into ``out``; the written paths are added to ``metrics["files"]``."""
-    out.mkdir(parents=True, exist_ok=True)
-    files = [result.to_netcdf(out / "result.nc")]
-    if result.ok:
-        files += figures()
-    (out / "metrics.json").write_text(json.dumps(_jsonable(metrics), indent=2))
-    metrics["files"] = [str(p) for p in [*files, out / "metrics.json"]]
-
-
-def _slew_figures(result, out: Path) -> list[Path]:
-    from flexsat.plots.slew import write_slew_figures
-
-    return write_slew_figures(result.dataset, out)
 
 
 def _print_comparison(results: dict) -> None:
@@ -412,24 +400,6 @@ def _print_comparison(results: dict) -> None:
     for key in keys:
         table.add_row(key, *(_shown(results[kind][key]) for kind in results))
     _console.print(table)
-
-
-def _openloop_figures(result, plant, out: Path) -> list[Path]:
-    from flexsat.analysis.modal import modal_analysis
-    from flexsat.plots.openloop import write_openloop_figures
-
-    return write_openloop_figures(result.dataset, modal_analysis(plant), out)
-
-
-def _jsonable(value):
-    """Strict JSON: NaN (a quantity that does not exist, e.g. never settled) -> null."""
-    if isinstance(value, float) and not np.isfinite(value):
-        return None
-    if isinstance(value, dict):
-        return {key: _jsonable(item) for key, item in value.items()}
-    if isinstance(value, list):
-        return [_jsonable(item) for item in value]
-    return value
 
 
 def _shown(value) -> str:
@@ -456,22 +426,10 @@ def config_show(config: ConfigOption = None, json_output: JsonOption = False) ->
     """Validate a config and print it with the derived mass, inertia and joint tuning."""
     from flexsat.config import load_config
     from flexsat.dynamics.plant import Plant
+    from flexsat.study.outputs import derived_properties
 
     cfg = load_config(config)
-    plant = Plant.from_config(cfg)
-    derived = {
-        "hub_inertia_kg_m2": plant.hub_J.tolist(),
-        "appendages": [
-            {
-                "name": app_cfg.name,
-                "mass_kg": float(plant.panel_mass[i]),
-                "centroidal_inertia_kg_m2": plant.panel_J[i].tolist(),
-                "stiffness": plant.stiffness[i].tolist(),
-                "damping": plant.damping[i].tolist(),
-            }
-            for i, app_cfg in enumerate(cfg.appendages)
-        ],
-    }
+    derived = derived_properties(Plant.from_config(cfg))
     payload = {"config": cfg.model_dump(mode="json"), "derived": derived}
     if json_output:
         typer.echo(json.dumps(payload))

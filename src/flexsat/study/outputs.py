@@ -1,0 +1,217 @@
+"""Run one analysis and write its files: what the CLI commands and the study share.
+
+Each function computes a result, its metrics (plain JSON-ready dicts, SI units, keys
+ending in their unit) and, given a folder, writes ``metrics.json`` (or
+``modal.json``), the NetCDF result and the figures there. The JSON written here is
+the one source of the numbers that the CLI prints and the study report shows.
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Callable
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+if TYPE_CHECKING:  # the CLI imports this module at start-up: keep numba out of it
+    from flexsat.dynamics.plant import Plant
+
+__all__ = [
+    "derived_properties",
+    "fly_campaign",
+    "fly_openloop",
+    "fly_slew",
+    "jsonable",
+    "write_json",
+    "write_modal",
+]
+
+
+def jsonable(value):
+    """Strict JSON: NaN (a quantity that does not exist, e.g. never settled) -> null."""
+    if isinstance(value, float) and not np.isfinite(value):
+        return None
+    if isinstance(value, dict):
+        return {key: jsonable(item) for key, item in value.items()}
+    if isinstance(value, list | tuple):
+        return [jsonable(item) for item in value]
+    return value
+
+
+def write_json(path: str | Path, payload: dict) -> Path:
+    """Write ``payload`` as strict, indented JSON (to a temporary name, then moved)."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    partial = path.with_suffix(path.suffix + ".partial")
+    partial.write_text(json.dumps(jsonable(payload), indent=2, allow_nan=False))
+    partial.replace(path)
+    return path
+
+
+def derived_properties(plant: Plant) -> dict:
+    """What flexsat derives from a config: hub inertia, panel masses, joint tuning.
+
+    Returns
+    -------
+    dict
+        ``hub_inertia_kg_m2`` (3x3), and per appendage ``mass_kg``,
+        ``centroidal_inertia_kg_m2`` (3x3), ``stiffness`` and ``damping`` (6 joint
+        DOFs in the order of :meth:`Plant.dof_names`; N m/rad, N m s/rad for
+        rotations, N/m, N s/m for translations).
+    """
+    return {
+        "hub_inertia_kg_m2": plant.hub_J.tolist(),
+        "appendages": [
+            {
+                "name": app_cfg.name,
+                "mass_kg": float(plant.panel_mass[i]),
+                "centroidal_inertia_kg_m2": plant.panel_J[i].tolist(),
+                "stiffness": plant.stiffness[i].tolist(),
+                "damping": plant.damping[i].tolist(),
+            }
+            for i, app_cfg in enumerate(plant.config.appendages)
+        ],
+    }
+
+
+def write_modal(plant: Plant, out: Path | None = None, animate: list[int] | None = None):
+    """Modal analysis; with ``out``, ``modal.json`` and the modal figures there.
+
+    Returns
+    -------
+    analysis : flexsat.analysis.modal.ModalAnalysis
+    summary : dict
+        ``analysis.to_dict()``, plus ``files`` (written paths) when ``out`` is given.
+    """
+    from flexsat.analysis.modal import modal_analysis
+    from flexsat.plots.modal import write_modal_figures
+
+    analysis = modal_analysis(plant)
+    summary = analysis.to_dict()
+    if out is not None:
+        json_path = write_json(Path(out) / "modal.json", summary)
+        written = write_modal_figures(analysis, Path(out), mode_indices=animate)
+        summary["files"] = [str(p) for p in [json_path, *written]]
+    return analysis, summary
+
+
+def fly_openloop(plant: Plant, scenario=None, out: Path | None = None, progress=None):
+    """Open-loop run and its metrics; with ``out``, result.nc, figures, metrics.json.
+
+    Parameters
+    ----------
+    plant : Plant
+    scenario : OpenLoopScenario, optional
+        Default: the thesis's 1 N m yaw pulse.
+    out : Path, optional
+    progress : bool or None
+        Progress bar: None shows it on a terminal only.
+
+    Returns
+    -------
+    result : Result
+    metrics : dict
+        :func:`flexsat.analysis.openloop.openloop_metrics`, plus ``files``.
+    """
+    from flexsat.analysis.modal import modal_analysis
+    from flexsat.analysis.openloop import openloop_metrics
+    from flexsat.plots.openloop import write_openloop_figures
+    from flexsat.simulate import OpenLoopScenario, run_openloop
+
+    result = run_openloop(plant, scenario or OpenLoopScenario(), progress=progress)
+    metrics = openloop_metrics(result.dataset)
+    if out is not None:
+        _write_run(
+            result,
+            metrics,
+            Path(out),
+            lambda: write_openloop_figures(result.dataset, modal_analysis(plant), Path(out)),
+        )
+    return result, metrics
+
+
+def fly_slew(plant: Plant, scenario=None, out: Path | None = None, progress=None):
+    """Closed-loop slew and its requirement metrics; with ``out``, its files there.
+
+    Parameters
+    ----------
+    plant : Plant
+    scenario : SlewScenario, optional
+        Default: the thesis's 45/45/45 deg ASMC slew.
+    out : Path, optional
+    progress : bool or None
+
+    Returns
+    -------
+    result : Result
+    metrics : dict
+        :func:`flexsat.analysis.requirements.slew_metrics` (R1-R3 from the
+        scenario's requirements), plus ``files``.
+    """
+    from flexsat.analysis.requirements import slew_metrics
+    from flexsat.plots.slew import write_slew_figures
+    from flexsat.simulate import SlewScenario, run_slew
+
+    scenario = scenario or SlewScenario()
+    result = run_slew(plant, scenario, progress=progress)
+    req = scenario.requirements
+    metrics = slew_metrics(
+        result.dataset, req.pointing_deg, req.jitter_deg_s, scenario.actuator.t_max_nm
+    )
+    if out is not None:
+        _write_run(result, metrics, Path(out), lambda: write_slew_figures(result.dataset, out))
+    return result, metrics
+
+
+def _write_run(result, metrics: dict, out: Path, figures: Callable[[], list[Path]]) -> None:
+    """result.nc (always, a failed run's history too), the figures if it succeeded, and
+    metrics.json into ``out``; the written paths are added to ``metrics["files"]``."""
+    out.mkdir(parents=True, exist_ok=True)
+    files = [result.to_netcdf(out / "result.nc")]
+    if result.ok:
+        files += figures()
+    metrics["files"] = [str(p) for p in [*files, out / "metrics.json"]]
+    write_json(out / "metrics.json", metrics)
+
+
+def fly_campaign(definition, config, store: Path, *, progress: bool = True, **backend) -> dict:
+    """Run a campaign into ``store``; write and return its summary with the figures.
+
+    Parameters
+    ----------
+    definition : CampaignDefinition
+    config : SatelliteConfig
+        The base plant the campaign varies.
+    store : Path
+        Campaign store folder (resumable: see :func:`flexsat.campaigns.run_campaign`).
+    progress : bool
+        Show a progress bar.
+    **backend
+        ``workers``, ``scheduler``, ``dask_local``, ``resume``, ``n_random``: passed on.
+
+    Returns
+    -------
+    dict
+        :func:`flexsat.campaigns.summarize` plus ``wall_time_s``, ``ran``,
+        ``parquet``, ``csv`` and ``figures``; also written to ``store/summary.json``.
+    """
+    from flexsat.campaigns import run_campaign, summarize
+    from flexsat.plots.campaign import write_campaign_figures
+
+    run = run_campaign(definition, config, store, progress=progress, **backend)
+    summary = {
+        **summarize(store),
+        "wall_time_s": run["wall_time_s"],
+        "ran": run["ran"],
+        "parquet": str(run["parquet"]),
+        "csv": str(run["csv"]),
+    }
+    try:
+        figures = write_campaign_figures(store)
+    except ValueError:  # no successful case history to draw
+        figures = []
+    summary["figures"] = [str(path) for path in figures]
+    write_json(Path(store) / "summary.json", summary)
+    return summary

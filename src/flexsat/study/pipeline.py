@@ -1,0 +1,267 @@
+"""The thesis study end to end: every part in turn, each timed, each allowed to fail.
+
+:func:`run_study` runs the parts of :data:`PARTS` in order (configuration, modal
+analysis, open-loop validation, the ASMC slew, the controller comparison, the slew
+animation and, unless ``quick``, the three thesis campaigns), writes each part's
+outputs under its own folder, and keeps ``study.json``, the manifest, up to date
+after every part: status (ok, failed, skipped), wall time, the files written and,
+for a failed part, the error and its traceback. A failed part does not stop the
+others (a part whose input failed is marked failed with that reason). Finally it
+writes ``report.html`` from the manifest and the parts' JSON files.
+"""
+
+from __future__ import annotations
+
+import datetime as dt
+import time
+import traceback
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from rich.console import Console
+
+from flexsat import __version__
+from flexsat.config.models import SatelliteConfig
+from flexsat.study.outputs import (
+    derived_properties,
+    fly_campaign,
+    fly_openloop,
+    fly_slew,
+    write_json,
+    write_modal,
+)
+
+__all__ = ["CAMPAIGNS", "CONTROLLERS", "PARTS", "Part", "StudyContext", "run_study"]
+
+CONTROLLERS = ("asmc", "smc", "pd")
+"""The nominal slew's laws: the thesis's ASMC and the two baselines it is compared with."""
+
+CAMPAIGNS = ("sensitivity", "montecarlo-critical", "deployment-shock")
+"""The thesis's three campaigns (chapter 5), in the order of the report."""
+
+MANIFEST = "study.json"
+REPORT = "report.html"
+
+
+@dataclass
+class StudyContext:
+    """What every part gets: the satellite, the output folder and the options."""
+
+    config: SatelliteConfig
+    out: Path
+    quick: bool = False
+    progress: bool | None = None
+    workers: int | None = None
+    results: dict = field(default_factory=dict)  # part name -> its returned outputs
+
+    @property
+    def plant(self):
+        from flexsat.dynamics.plant import Plant
+
+        if "plant" not in self.results:
+            self.results["plant"] = Plant.from_config(self.config)
+        return self.results["plant"]
+
+
+@dataclass(frozen=True)
+class Part:
+    """One section of the study: a name (its folder), a title, and the function."""
+
+    name: str
+    title: str
+    run: Callable[[StudyContext], dict]
+    needs: tuple[str, ...] = ()
+    full_only: bool = False  # skipped with --quick
+
+
+def _relative(ctx: StudyContext, paths) -> list[str]:
+    return [Path(p).resolve().relative_to(ctx.out.resolve()).as_posix() for p in paths]
+
+
+def _configuration(ctx: StudyContext) -> dict:
+    payload = {"config": ctx.config.model_dump(mode="json"), **derived_properties(ctx.plant)}
+    path = write_json(ctx.out / "configuration" / "configuration.json", payload)
+    return {"json": _relative(ctx, [path])[0]}
+
+
+def _modal(ctx: StudyContext) -> dict:
+    _, summary = write_modal(ctx.plant, ctx.out / "modal")
+    files = _relative(ctx, summary["files"])
+    return {"json": files[0], "figures": files[1:]}
+
+
+def _openloop(ctx: StudyContext) -> dict:
+    result, metrics = fly_openloop(ctx.plant, None, ctx.out / "openloop", ctx.progress)
+    result.raise_for_status()
+    files = _relative(ctx, metrics["files"])
+    return {"json": files[-1], "result": files[0], "figures": files[1:-1]}
+
+
+def _slew_with(ctx: StudyContext, kind: str) -> dict:
+    from flexsat.simulate import SlewScenario
+
+    scenario = SlewScenario.model_validate({"controller": {"kind": kind}})
+    result, metrics = fly_slew(ctx.plant, scenario, ctx.out / "slew" / kind, ctx.progress)
+    result.raise_for_status()
+    files = _relative(ctx, metrics["files"])
+    return {"json": files[-1], "result": files[0], "figures": files[1:-1]}
+
+
+def _slew(ctx: StudyContext) -> dict:
+    return _slew_with(ctx, "asmc")
+
+
+def _comparison(ctx: StudyContext) -> dict:
+    from flexsat.plots.comparison import write_comparison_figure
+    from flexsat.simulate.result import Result
+
+    runs = {"asmc": ctx.results["slew"]}
+    runs.update({kind: _slew_with(ctx, kind) for kind in CONTROLLERS[1:]})
+    datasets = {
+        kind: Result.from_netcdf(ctx.out / run["result"]).dataset for kind, run in runs.items()
+    }
+    figure = write_comparison_figure(datasets, ctx.out / "comparison" / "comparison.png")
+    return {
+        "runs": {kind: run["json"] for kind, run in runs.items()},
+        "figures": _relative(ctx, [figure]),
+    }
+
+
+def _animation(ctx: StudyContext) -> dict:
+    from flexsat.plots.animation import write_animation
+    from flexsat.simulate.result import Result
+
+    result = Result.from_netcdf(ctx.out / ctx.results["slew"]["result"])
+    path = write_animation(result, ctx.out / "slew" / "asmc" / "animation.gif")
+    return {"figures": _relative(ctx, [path])}
+
+
+def _campaigns(ctx: StudyContext) -> dict:
+    from flexsat.campaigns import load_campaign
+
+    summaries = {}
+    for name in CAMPAIGNS:
+        store = ctx.out / "campaigns" / name
+        fly_campaign(
+            load_campaign(name),
+            ctx.config,
+            store,
+            progress=ctx.progress is not False,
+            workers=ctx.workers,
+            resume=True,
+        )
+        summaries[name] = _relative(ctx, [store / "summary.json"])[0]
+    return {"summaries": summaries}
+
+
+PARTS = (
+    Part("configuration", "Configuration", _configuration),
+    Part("modal", "Modal analysis", _modal),
+    Part("openloop", "Open-loop validation", _openloop),
+    Part("slew", "Nominal slew with ASMC", _slew),
+    Part("comparison", "Controller comparison", _comparison, needs=("slew",)),
+    Part("animation", "Slew animation", _animation, needs=("slew",)),
+    Part("campaigns", "Robustness campaigns", _campaigns, full_only=True),
+)
+"""The study's parts, in the order they run and appear in the report."""
+
+
+def run_study(
+    config: SatelliteConfig,
+    out: str | Path,
+    *,
+    quick: bool = False,
+    config_source: str = "built-in nominal case",
+    progress: bool | None = None,
+    workers: int | None = None,
+    console: Console | None = None,
+) -> dict:
+    """Run the study into ``out`` and write ``out/report.html``.
+
+    Parameters
+    ----------
+    config : SatelliteConfig
+        The satellite studied (campaigns vary it; the controller keeps the nominal
+        design model).
+    out : str or Path
+        Output folder (created). Each part writes under ``out/<part name>/``.
+    quick : bool
+        Skip the campaigns (the parts marked ``full_only``).
+    config_source : str
+        Where the config came from, shown in the report.
+    progress : bool or None
+        Progress bars of the runs: None shows them on a terminal only.
+    workers : int, optional
+        Campaign worker processes (default: all cores).
+    console : rich.console.Console, optional
+        Where each part's outcome is announced; default: standard error.
+
+    Returns
+    -------
+    dict
+        The manifest (also in ``out/study.json``) with ``report`` added: the
+        report's path.
+    """
+    from flexsat.study.report import write_report
+
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    console = console or Console(stderr=True)
+    ctx = StudyContext(config, out, quick, progress, workers)
+    manifest = {
+        "flexsat_version": __version__,
+        "created_utc": dt.datetime.now(dt.UTC).strftime("%Y-%m-%d %H:%M:%S UTC"),
+        "config_name": config.name,
+        "config_source": config_source,
+        "quick": quick,
+        "parts": [],
+    }
+    start = time.perf_counter()
+    for part in PARTS:
+        entry = _run_part(part, ctx)
+        manifest["parts"].append(entry)
+        manifest["total_wall_time_s"] = time.perf_counter() - start
+        write_json(out / MANIFEST, manifest)
+        _announce(console, part, entry)
+    report = write_report(out)
+    manifest["report"] = str(report)
+    return manifest
+
+
+def _run_part(part: Part, ctx: StudyContext) -> dict:
+    entry = {
+        "name": part.name,
+        "title": part.title,
+        "status": "ok",
+        "wall_time_s": 0.0,
+        "outputs": {},
+        "error": None,
+        "traceback": None,
+    }
+    if part.full_only and ctx.quick:
+        entry["status"] = "skipped"
+        entry["error"] = "skipped with --quick; run the study without it for this part"
+        return entry
+    missing = [name for name in part.needs if name not in ctx.results]
+    if missing:
+        entry["status"] = "failed"
+        entry["error"] = f"not run: it needs the {', '.join(missing)} part, which failed"
+        return entry
+    start = time.perf_counter()
+    try:
+        entry["outputs"] = ctx.results[part.name] = part.run(ctx)
+    except Exception as exc:  # a failed part is reported; the study goes on
+        entry["status"] = "failed"
+        entry["error"] = f"{type(exc).__name__}: {exc}"
+        entry["traceback"] = traceback.format_exc()
+    entry["wall_time_s"] = time.perf_counter() - start
+    return entry
+
+
+def _announce(console: Console, part: Part, entry: dict) -> None:
+    style = {"ok": "green", "failed": "bold red", "skipped": "yellow"}[entry["status"]]
+    line = f"[{style}]{entry['status']:>7}[/] {part.title} ({entry['wall_time_s']:.1f} s)"
+    if entry["status"] != "ok":
+        line += f": {entry['error']}"
+    console.print(line, highlight=False)

@@ -1,0 +1,520 @@
+"""The study report: one self-contained HTML file written from the study's outputs.
+
+:func:`write_report` reads ``study.json`` (the manifest of :func:`run_study`) and the
+JSON files each part wrote, and embeds the figures (PNG, GIF) as data URIs, so the
+file renders offline and can be mailed as it is. Every number shown is read from
+those JSON files, never recomputed: each table cell that holds one carries
+``data-source`` (the JSON file, relative to the study folder), ``data-path`` (the
+key path in it, ``/``-separated) and ``data-value`` (the value as JSON), so a reader
+or a test can trace it back. A part that failed shows its error and traceback in
+its section; the sections of the other parts are written as usual.
+
+Sections follow the thesis: the configuration (section 3.1), the model's M(0) and
+rigid inertia (appendix B), the coupled modes (table 3.3), the open-loop validation
+(section 3.3), the ASMC slew and its requirements (section 5.1), the controller
+comparison, and the campaigns (chapter 5).
+"""
+
+from __future__ import annotations
+
+import base64
+import html
+import json
+import platform
+from collections.abc import Callable
+from pathlib import Path
+
+import numpy as np
+
+from flexsat.study import thesis
+
+__all__ = ["format_value", "write_report"]
+
+_MIME = {".png": "image/png", ".gif": "image/gif", ".svg": "image/svg+xml"}
+
+
+def format_value(value) -> str:
+    """How the report shows a JSON value: 4 significant digits, booleans as pass/fail.
+
+    Parameters
+    ----------
+    value : float, int, bool, str, list or None
+        A value as read from a study JSON file (None is a quantity that does not
+        exist, e.g. a settling time never reached).
+
+    Returns
+    -------
+    str
+    """
+    if value is None:
+        return "—"
+    if isinstance(value, bool):
+        return "pass" if value else "fail"
+    if isinstance(value, int):
+        return str(value)
+    if isinstance(value, float):
+        if value == 0.0:
+            return "0"
+        if 1e-3 <= abs(value) < 1e5:
+            return f"{value:.4g}"
+        return f"{value:.3e}"
+    if isinstance(value, list) and value and all(isinstance(v, list) for v in value):
+        return "[" + "; ".join(format_value(row) for row in value) + "]"  # matrix, by rows
+    if isinstance(value, list):
+        return ", ".join(format_value(v) for v in value)
+    return str(value)
+
+
+class _Source:
+    """One JSON output of the study, and the table cells that show its values."""
+
+    def __init__(self, root: Path, relative: str) -> None:
+        self.relative = relative
+        self.data = json.loads((root / relative).read_text())
+
+    def get(self, *path):
+        node = self.data
+        for key in path:
+            node = node[key]
+        return node
+
+    def cell(self, *path, tag: str = "td") -> str:
+        value = self.get(*path)
+        css = "num"
+        if isinstance(value, bool):
+            css = "pass" if value else "fail"
+        return (
+            f'<{tag} class="{css}" data-source="{html.escape(self.relative)}" '
+            f'data-path="{html.escape("/".join(str(p) for p in path))}" '
+            f"data-value='{html.escape(json.dumps(value), quote=True)}'>"
+            f"{html.escape(format_value(value))}</{tag}>"
+        )
+
+
+def _esc(text) -> str:
+    return html.escape(str(text))
+
+
+def _table(header: list[str], rows: list[list[str]], caption: str = "") -> str:
+    """Rows are lists of ready cells (``<td>...</td>``) or plain text (escaped)."""
+
+    def cell(item: str) -> str:
+        return item if item.startswith(("<td", "<th")) else f"<td>{_esc(item)}</td>"
+
+    head = "".join(f"<th>{_esc(h)}</th>" for h in header)
+    body = "".join("<tr>" + "".join(cell(c) for c in row) + "</tr>" for row in rows)
+    cap = f"<caption>{_esc(caption)}</caption>" if caption else ""
+    return f"<table>{cap}<thead><tr>{head}</tr></thead><tbody>{body}</tbody></table>"
+
+
+def _figure(root: Path, relative: str, caption: str = "") -> str:
+    path = root / relative
+    data = base64.b64encode(path.read_bytes()).decode("ascii")
+    mime = _MIME[path.suffix.lower()]
+    text = caption or path.stem.replace("_", " ")
+    return (
+        f'<figure><img src="data:{mime};base64,{data}" alt="{_esc(text)}" loading="eager">'
+        f"<figcaption>{_esc(text)} <span class='file'>({_esc(relative)})</span></figcaption>"
+        "</figure>"
+    )
+
+
+def _figures(root: Path, files: list[str]) -> str:
+    return '<div class="figures">' + "".join(_figure(root, f) for f in files) + "</div>"
+
+
+# -- sections -------------------------------------------------------------------------
+
+
+def _configuration(root: Path, outputs: dict, context: dict) -> str:
+    src = _Source(root, outputs["json"])
+    config = src.get("config")
+    parts = [
+        f"<p>Configuration <b>{_esc(config['name'])}</b>, from {_esc(context['source'])}."
+        " Every parameter as validated, then what flexsat derives from them.</p>"
+    ]
+    hub_rows = [
+        [".".join(path), src.cell("config", "hub", *path)] for path in _leaves(config["hub"])
+    ]
+    parts.append(_table(["hub parameter", "value"], hub_rows, "Hub (SI units; see key names)"))
+    names = [a["name"] for a in config["appendages"]]
+    rows = [
+        [".".join(path), *(src.cell("config", "appendages", i, *path) for i in range(len(names)))]
+        for path in _leaves(config["appendages"][0])
+        if path != ("name",)
+    ]
+    parts.append(_table(["appendage parameter", *names], rows, "Appendages"))
+    parts.append(
+        _table(
+            ["", "value"],
+            [["hub inertia [kg m²] (rows)", src.cell("hub_inertia_kg_m2")]],
+            "Derived: hub inertia about the hub centre of mass",
+        )
+    )
+    derived = [
+        [key, *(src.cell("appendages", i, key) for i in range(len(names)))]
+        for key in ("mass_kg", "centroidal_inertia_kg_m2", "stiffness", "damping")
+    ]
+    parts.append(
+        _table(
+            ["derived", *names],
+            derived,
+            "Derived per appendage: mass, centroidal inertia, joint stiffness and damping "
+            "(joint DOFs ρ_x, ρ_y, ρ_z [N m/rad, N m s/rad], η_x, η_y, η_z [N/m, N s/m])",
+        )
+    )
+    return "".join(parts)
+
+
+def _leaves(data: dict, prefix: tuple = ()) -> list[tuple]:
+    """Key paths to the non-dict values of a nested dict, in order."""
+    paths = []
+    for key, value in data.items():
+        if isinstance(value, dict):
+            paths += _leaves(value, (*prefix, key))
+        else:
+            paths.append((*prefix, key))
+    return paths
+
+
+def _matrix(src: _Source, rows: range, cols: range, caption: str) -> str:
+    body = [[str(i + 1), *(src.cell("mass_matrix", i, j) for j in cols)] for i in rows]
+    return _table(["row", *(str(j + 1) for j in cols)], body, caption)
+
+
+def _model(root: Path, outputs: dict, context: dict) -> str:
+    src = _Source(root, outputs["json"])
+    M = np.asarray(src.get("mass_matrix"))
+    n_app = (M.shape[0] - 6) // 6
+    parts = [
+        "<p>The mass matrix M(q) at q = 0 (thesis appendix B), in the DOF order "
+        f"{_esc(', '.join(src.get('dof_names')))}; and the rigid design inertia.</p>"
+    ]
+    parts.append(_matrix(src, range(6), range(6), "M(0) hub block, eq. B.2"))
+    for k in range(n_app):
+        cols = range(6 + 6 * k, 12 + 6 * k)
+        parts.append(_matrix(src, range(6), cols, f"M(0) hub–appendage {k + 1} coupling"))
+        parts.append(_matrix(src, cols, cols, f"M(0) appendage {k + 1} block"))
+    if context["nominal"]:
+        deviation = float(np.abs(M - thesis.appendix_b_mass_matrix()).max())
+        verdict = "within" if deviation <= thesis.PRINTED_2DP else "OUTSIDE"
+        parts.append(
+            f"<p class='check'>Largest deviation from appendix B: {deviation:.2g} "
+            f"({verdict} the ±0.005 of its two printed decimals).</p>"
+        )
+    j_rows = [
+        [axis, src.cell("rigid_inertia", i, i), f"{thesis.J_TOT_NOMINAL[i, i]:.2f}"]
+        for i, axis in enumerate("xyz")
+    ]
+    parts.append(
+        _table(
+            ["axis", "J_tot [kg m²] flexsat", "thesis (section 3.1)"],
+            j_rows,
+            "Rigid design inertia J_tot (diagonal) about the hub centre of mass",
+        )
+    )
+    return "".join(parts)
+
+
+def _modal(root: Path, outputs: dict, context: dict) -> str:
+    src = _Source(root, outputs["json"])
+    reference = {row[0]: row for row in thesis.TABLE_3_3}
+    rows = []
+    for i, mode in enumerate(src.get("modes")):
+        if mode["frequency_hz"] == 0.0:
+            continue
+        ref = reference.get(mode["index"])
+        if ref is not None:
+            theirs = [f"{ref[1]:.2f}", ref[2], ref[3], ref[4] or "—"]
+        elif mode["index"] > 12 and len(src.get("modes")) == 18:
+            theirs = [f"≥ {thesis.TRANSLATION_MODES_MIN_HZ:.0f}", "translation", "", ""]
+        else:
+            theirs = ["", "", "", ""]
+        cells = [
+            src.cell("modes", i, key)
+            for key in ("index", "frequency_hz", "kind", "symmetry", "hub_dof")
+        ]
+        rows.append([*cells, *theirs])
+    header = [
+        "mode",
+        "f [Hz]",
+        "kind",
+        "symmetry",
+        "hub DOF",
+        "thesis f [Hz]",
+        "thesis kind",
+        "thesis symmetry",
+        "thesis hub DOF",
+    ]
+    caption = "Coupled modes at q = 0 beside thesis table 3.3 (rigid-body modes omitted)"
+    parts = [_table(header, rows, caption)]
+    if not context["nominal"]:
+        parts.append(
+            "<p class='note'>The thesis columns are its nominal case; this "
+            "configuration differs from it.</p>"
+        )
+    parts.append(_figures(root, outputs["figures"]))
+    return "".join(parts)
+
+
+def _compare_rows(src: _Source, reference: dict) -> list[list[str]]:
+    rows = []
+    for key in src.data:
+        if key in ("files", "message", "status", "controller"):
+            continue
+        ref = reference.get(key)
+        theirs = [format_value(ref[0]), ref[1]] if ref else ["", ""]
+        rows.append([key, src.cell(key), *theirs])
+    return rows
+
+
+def _openloop(root: Path, outputs: dict, context: dict) -> str:
+    src = _Source(root, outputs["json"])
+    parts = [
+        "<p>1 N m about the body Z axis for 10 s, then free, to 120 s (thesis section "
+        "3.3). Vector quantities are given x, y, z; the thesis's value is the z "
+        "component where it is a vector.</p>",
+        _table(
+            ["metric", "flexsat", "thesis", "thesis source"],
+            _compare_rows(src, thesis.OPEN_LOOP),
+            "Open-loop metrics",
+        ),
+        _figures(root, outputs["figures"]),
+    ]
+    return "".join(parts)
+
+
+def _slew(root: Path, outputs: dict, context: dict) -> str:
+    src = _Source(root, outputs["json"])
+    verdicts = [
+        ["R1 pointing", src.cell("r1_pass"), src.cell("final_pointing_error_deg"), "< 0.05 deg"],
+        ["R2 jitter", src.cell("r2_pass"), src.cell("final_rate_error_deg_s"), "< 1e-3 deg/s"],
+        ["R3 torque", src.cell("r3_pass"), src.cell("max_abs_torque_nm"), "≤ 2 N m per axis"],
+    ]
+    parts = [
+        "<p>The nominal 45/45/45 deg slew with the adaptive sliding-mode law "
+        "(thesis section 5.1), 120 s, disturbances at their maximum.</p>",
+        _table(
+            ["requirement", "verdict", "value at the end / peak", "bound"],
+            verdicts,
+            "Requirements (bounds of the thesis scenario)",
+        ),
+        _table(
+            ["metric", "flexsat", "thesis", "thesis source"],
+            _compare_rows(src, thesis.CLOSED_LOOP),
+            "Slew metrics",
+        ),
+        _figures(root, outputs["figures"]),
+    ]
+    return "".join(parts)
+
+
+def _comparison(root: Path, outputs: dict, context: dict) -> str:
+    sources = {kind: _Source(root, rel) for kind, rel in outputs["runs"].items()}
+    first = next(iter(sources.values()))
+    keys = [k for k in first.data if k not in ("files", "message", "controller")]
+    rows = [[key, *(src.cell(key) for src in sources.values())] for key in keys]
+    header = ["metric", *(kind.upper() for kind in sources)]
+    return "".join(
+        [
+            "<p>The same slew, plant and disturbances flown by the thesis's ASMC and the two "
+            "baselines (classic SMC, PD) with their default gains.</p>",
+            _table(header, rows, "Controller comparison"),
+            _figures(root, outputs["figures"]),
+        ]
+    )
+
+
+def _animation(root: Path, outputs: dict, context: dict) -> str:
+    return (
+        "<p>The ASMC slew in 3D: hub, panels with their joint deformation magnified "
+        "(factor in the frame), body axes and time.</p>" + _figures(root, outputs["figures"])
+    )
+
+
+def _campaigns(root: Path, outputs: dict, context: dict) -> str:
+    parts = []
+    for name, rel in outputs["summaries"].items():
+        src = _Source(root, rel)
+        keys = (
+            "cases",
+            "ran",
+            "failed",
+            "r1_pass_rate",
+            "r2_pass_rate",
+            "r3_pass_rate",
+            "worst_final_pointing_error_deg",
+            "wall_time_s",
+        )
+        rows = [[key, src.cell(key)] for key in keys]
+        rows += [
+            [
+                f"worst case {i + 1}: {w['case_id']}",
+                src.cell("worst_cases", i, "final_pointing_error_deg"),
+            ]
+            for i, w in enumerate(src.get("worst_cases"))
+        ]
+        store = Path(rel).parent.as_posix()
+        parts.append(f"<h3>{_esc(name)}</h3>")
+        parts.append(
+            _table(
+                ["metric", "value"],
+                rows,
+                f"Campaign {name} (store {store}: results.parquet, results.csv)",
+            )
+        )
+        figures = [Path(f) for f in src.get("figures")]
+        parts.append(_figures(root, [(Path(store) / f.name).as_posix() for f in figures]))
+    return "".join(parts)
+
+
+_SECTIONS: dict[str, Callable[[Path, dict, dict], str]] = {
+    "configuration": _configuration,
+    "model": _model,
+    "modal": _modal,
+    "openloop": _openloop,
+    "slew": _slew,
+    "comparison": _comparison,
+    "animation": _animation,
+    "campaigns": _campaigns,
+}
+
+# The model section is drawn from the modal part's outputs (M(0) and J_tot are there).
+_SECTION_PART = {"model": "modal"}
+_SECTION_TITLE = {"model": "Model: M(0) and rigid inertia"}
+
+
+# -- page -----------------------------------------------------------------------------
+
+
+def _section(root: Path, name: str, entry: dict | None, context: dict) -> str:
+    title = _SECTION_TITLE.get(name, entry["title"] if entry else name)
+    anchor = f'<section id="{name}"><h2>{_esc(title)}</h2>'
+    if entry is None:
+        return anchor + "<p class='error'>This part did not run (the study stopped).</p></section>"
+    status = entry["status"]
+    head = (
+        f"<p class='meta'><span class='badge {status}'>{status}</span> "
+        f"wall time {entry['wall_time_s']:.1f} s</p>"
+    )
+    if status == "skipped":
+        return anchor + head + f"<p class='note'>{_esc(entry['error'])}</p></section>"
+    if status == "failed":
+        trace = f"<pre>{_esc(entry['traceback'])}</pre>" if entry.get("traceback") else ""
+        return (
+            anchor + head + f"<div class='error'><p>This part failed: {_esc(entry['error'])}"
+            f"</p>{trace}</div></section>"
+        )
+    try:
+        body = _SECTIONS[name](root, entry["outputs"], context)
+    except Exception as exc:  # an unreadable output is shown, the report still written
+        body = f"<div class='error'><p>This section could not be drawn: {_esc(repr(exc))}</p></div>"
+    return anchor + head + body + "</section>"
+
+
+def _summary(manifest: dict) -> str:
+    rows = []
+    for entry in manifest["parts"]:
+        name = entry["name"]
+        rows.append(
+            [
+                f"<td><a href='#{name}'>{_esc(entry['title'])}</a></td>",
+                f"<td><span class='badge {entry['status']}'>{entry['status']}</span></td>",
+                f"{entry['wall_time_s']:.1f}",
+            ]
+        )
+    rows.append(["total", "", f"{manifest.get('total_wall_time_s', 0.0):.1f}"])
+    return _table(["part", "status", "wall time [s]"], rows, "Parts of the study")
+
+
+def write_report(study_dir: str | Path) -> Path:
+    """Write ``study_dir/report.html`` from the study's manifest and outputs.
+
+    Parameters
+    ----------
+    study_dir : str or Path
+        A folder written by :func:`flexsat.study.run_study` (it holds ``study.json``).
+
+    Returns
+    -------
+    Path
+        The report's path.
+    """
+    from flexsat.config import nominal
+    from flexsat.config.models import SatelliteConfig
+
+    root = Path(study_dir)
+    manifest = json.loads((root / "study.json").read_text())
+    entries = {entry["name"]: entry for entry in manifest["parts"]}
+    context = {"source": manifest["config_source"], "nominal": False}
+    config_entry = entries.get("configuration")
+    if config_entry and config_entry["status"] == "ok":
+        data = _Source(root, config_entry["outputs"]["json"]).get("config")
+        context["nominal"] = SatelliteConfig.model_validate(data) == nominal()
+    sections = [
+        _section(root, name, entries.get(_SECTION_PART.get(name, name)), context)
+        for name in _SECTIONS
+    ]
+    toc = "".join(
+        f"<li><a href='#{name}'>{_esc(_SECTION_TITLE.get(name, entry['title']))}</a></li>"
+        for name in _SECTIONS
+        if (entry := entries.get(_SECTION_PART.get(name, name))) is not None
+    )
+    failed = [e["title"] for e in manifest["parts"] if e["status"] == "failed"]
+    banner = (
+        f"<p class='problem'>Failed parts: {_esc(', '.join(failed))}.</p>"
+        if failed
+        else "<p class='success'>Every part that ran succeeded.</p>"
+    )
+    title = f"flexsat study — {manifest['config_name']}"
+    page = f"""<!doctype html>
+<html lang="en"><head><meta charset="utf-8">
+<meta name="viewport" content="width=device-width, initial-scale=1">
+<title>{_esc(title)}</title><style>{_CSS}</style></head>
+<body><header><h1>{_esc(title)}</h1>
+<p class="meta">flexsat {_esc(manifest["flexsat_version"])} · Python
+{_esc(platform.python_version())} · {_esc(manifest["created_utc"])} ·
+configuration from {_esc(manifest["config_source"])}{" · quick study" if manifest["quick"] else ""}
+</p>{banner}{_summary(manifest)}<nav><ol>{toc}</ol></nav></header>
+<main>{"".join(sections)}</main>
+<footer><p>Every number above is read from the JSON files next to this report
+(data-source and data-path on each cell). Units are SI unless a key or heading says
+otherwise.</p></footer></body></html>
+"""
+    path = root / "report.html"
+    partial = path.with_suffix(".html.partial")
+    partial.write_text(page, encoding="utf-8")
+    partial.replace(path)
+    return path
+
+
+_CSS = """
+body{font-family:system-ui,sans-serif;margin:0 auto;max-width:1200px;padding:1rem 2rem;
+  color:#222;line-height:1.4}
+h1{font-size:1.7rem;margin-bottom:.2rem}
+h2{border-bottom:2px solid #ccd;padding-bottom:.2rem;margin-top:2.5rem}
+h3{margin-top:1.5rem}
+table{border-collapse:collapse;margin:1rem 0;font-size:.85rem}
+caption{text-align:left;font-weight:600;padding:.3rem 0}
+th,td{border:1px solid #ccd;padding:.2rem .5rem;vertical-align:top}
+th{background:#eef}
+td.num{text-align:right;font-variant-numeric:tabular-nums}
+td.pass{color:#0a6b2d;font-weight:600}
+td.fail{color:#b00020;font-weight:600}
+.badge{border-radius:.3rem;padding:.05rem .4rem;font-size:.8rem;color:#fff}
+.badge.ok{background:#0a6b2d}
+.badge.failed{background:#b00020}
+.badge.skipped{background:#a66a00}
+.error,.problem{color:#b00020}
+.error pre{color:#222;background:#fbeaea;padding:.5rem;overflow-x:auto;font-size:.75rem}
+.success{color:#0a6b2d}
+.note{color:#555;font-style:italic}
+.meta{color:#555}
+.check{font-weight:600}
+.figures{display:grid;grid-template-columns:repeat(auto-fill,minmax(520px,1fr));gap:1rem}
+figure{margin:0}
+figure img{max-width:100%;height:auto;border:1px solid #eee}
+figcaption{font-size:.8rem;color:#555}
+.file{color:#999}
+footer{margin-top:3rem;color:#777;font-size:.8rem}
+"""
