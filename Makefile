@@ -4,7 +4,7 @@ VENV   := .venv
 BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.installed
 
-.PHONY: demo test bench lint clean
+.PHONY: demo test bench lint clean chromium
 
 $(STAMP): pyproject.toml
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
@@ -13,12 +13,20 @@ $(STAMP): pyproject.toml
 	touch $(STAMP)
 
 demo: $(STAMP)
-	$(BIN)/flexsat modal --out out/modal
-	$(BIN)/flexsat openloop --out out/openloop
-	$(BIN)/flexsat slew --out out/slew
-	@echo "Study of the nominal case written to out/: modal/ (modes), openloop/ (open-loop validation), slew/ (ASMC slew, R1-R3)"
+	$(BIN)/flexsat study --quick --out out
+	@echo "Report of the nominal study: $(CURDIR)/out/report.html"
 
-test: $(STAMP)
+# The report's browser test renders it in Debian's Chromium, installed here when missing
+# (as root, or with sudo); if that fails the test says so and is skipped.
+chromium:
+	@command -v chromium >/dev/null 2>&1 || command -v chromium-browser >/dev/null 2>&1 || { \
+	  SUDO=$$([ "$$(id -u)" = 0 ] || echo sudo); \
+	  echo "installing Chromium for the report's browser test..."; \
+	  { $$SUDO env DEBIAN_FRONTEND=noninteractive apt-get install -y -q chromium || \
+	    { $$SUDO apt-get update -q && $$SUDO env DEBIAN_FRONTEND=noninteractive apt-get install -y -q chromium; }; } >/dev/null 2>&1 || \
+	  echo "Chromium could not be installed: the report's browser test will be skipped."; }
+
+test: $(STAMP) chromium
 	$(BIN)/ruff check src tests bench examples
 	$(BIN)/python -m pytest -q
 
