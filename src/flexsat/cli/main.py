@@ -258,6 +258,60 @@ def slew(
 
 
 @app.command()
+def animate(
+    result: Annotated[Path, typer.Argument(help="A result.nc written by openloop or slew.")],
+    output: Annotated[
+        Path | None,
+        typer.Option(
+            "--output", "-o", help="GIF or MP4 (needs ffmpeg) to write. Default: RESULT as .gif."
+        ),
+    ] = None,
+    magnification: Annotated[
+        float | None,
+        typer.Option(
+            min=0.0,
+            help="Panel-deformation magnification (1: true scale). Default: chosen so the "
+            "peak tip displacement shows as 15 % of the panel length.",
+        ),
+    ] = None,
+    fps: Annotated[int, typer.Option(min=1, help="Playback rate, frames per second.")] = 20,
+    max_frames: Annotated[
+        int, typer.Option(min=2, help="Most frames, picked evenly over the run.")
+    ] = 150,
+) -> None:
+    """3-D animation of a run: the satellite turning, its panels' deformation magnified."""
+    from flexsat.plots.animation import result_plant, run_frames, write_animation
+    from flexsat.simulate.result import Result
+
+    if not result.exists():
+        raise FlexsatError(f"{result}: file not found")
+    try:
+        run = Result.from_netcdf(result)
+        plant = result_plant(run)
+    except FlexsatError as exc:  # not a flexsat result, or its stored config refused
+        raise FlexsatError(f"{result}: {exc}") from None
+    except (OSError, ValueError):  # not NetCDF, or unreadable
+        raise FlexsatError(f"{result}: not a readable NetCDF file") from None
+    target = output if output is not None else result.with_suffix(".gif")
+    frames = run_frames(
+        run, magnification=magnification, max_frames=max_frames, fps=fps, plant=plant
+    )
+    try:
+        written = write_animation(
+            run, target, magnification=frames.magnification, fps=fps, max_frames=max_frames
+        )
+    except OSError as exc:
+        raise FlexsatError(f"cannot write {target}: {exc.strerror or exc}") from None
+    _console.print(
+        f"wrote {written} ({len(frames)} frames, t = {frames.time[0]:.4g} to "
+        f"{frames.time[-1]:.4g} s, deformation ×{frames.magnification:.4g})",
+        highlight=False,
+        markup=False,
+        soft_wrap=True,
+    )
+
+
+@app.command()
 def campaign(
     name: Annotated[
         str,

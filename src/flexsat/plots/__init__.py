@@ -1,5 +1,14 @@
 """Figures of flexsat: satellite geometry for drawing, modal-analysis plots and animations."""
 
+from flexsat.plots.animation import (
+    DEFAULT_FPS,
+    DEFAULT_MAX_FRAMES,
+    RunFrames,
+    auto_magnification,
+    result_plant,
+    run_frames,
+    write_animation,
+)
 from flexsat.plots.geometry import (
     HubOutline,
     SatelliteGeometry,
@@ -44,12 +53,16 @@ from flexsat.plots.slew import (
 )
 
 __all__ = [
+    "DEFAULT_FPS",
+    "DEFAULT_MAX_FRAMES",
     "DEFAULT_PEAK_FRACTION",
     "OPENLOOP_FIGURES",
     "SLEW_FIGURES",
     "HubOutline",
+    "RunFrames",
     "SatelliteGeometry",
     "animate_mode",
+    "auto_magnification",
     "default_animated_modes",
     "hub_outline",
     "mode_amplitude",
@@ -73,8 +86,11 @@ __all__ = [
     "plot_torque_breakdown",
     "plot_torque_limits",
     "plot_torques",
+    "result_plant",
     "rot_zyx",
+    "run_frames",
     "satellite_geometry",
+    "write_animation",
     "write_modal_figures",
     "write_openloop_figures",
     "write_slew_figures",

@@ -17,17 +17,14 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
-from matplotlib.animation import PillowWriter
 from matplotlib.axes import Axes
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
-from matplotlib.ticker import MaxNLocator
-from mpl_toolkits.mplot3d.art3d import Poly3DCollection
-from PIL import Image
 
 from flexsat.analysis.modal import ModalAnalysis, Mode
 from flexsat.dynamics.plant import Plant
+from flexsat.plots._scene import CanvasPillowWriter, SatelliteDrawing, frame_view
 from flexsat.plots.geometry import SatelliteGeometry, satellite_geometry
 
 __all__ = [
@@ -60,7 +57,6 @@ _KIND_COLOUR = {
 }
 _SYMMETRY_MARKER = {"symmetric": "o", "antisymmetric": "s", "none": "^"}
 _SYMMETRY_SHORT = {"symmetric": "sym.", "antisymmetric": "antisym.", "none": "no parity"}
-_AXIS_COLOURS = ("tab:red", "tab:green", "tab:blue")
 
 
 # -- interaction map -------------------------------------------------------------------
@@ -323,57 +319,6 @@ def _shape(analysis: ModalAnalysis, mode_index: int) -> np.ndarray:
     return np.asarray(analysis.shapes[:, int(mode_index) - 1], dtype=float)
 
 
-class _SatelliteDrawing:
-    """Line artists for a :class:`SatelliteGeometry` on 3-D axes, updatable per frame."""
-
-    def __init__(self, ax, geom: SatelliteGeometry, *, colour: str, linestyle: str = "-",
-                 linewidth: float = 1.4, fill: str | None = None, body_axes: bool = False,
-                 label: str | None = None) -> None:  # fmt: skip
-        kw = {"color": colour, "linestyle": linestyle, "linewidth": linewidth}
-        self.hub = [ax.plot(*line.T, **kw)[0] for line in geom.hub_lines]
-        self.arms = [ax.plot(*arm.T, **kw)[0] for arm in geom.arms]
-        self.panels = [ax.plot(*_closed(p).T, **kw)[0] for p in geom.panels]
-        self.panels[0].set_label(label)
-        self.fill = None
-        if fill:
-            self.fill = Poly3DCollection(list(geom.panels), facecolor=fill, alpha=0.4,
-                                         edgecolor="none")  # fmt: skip
-            ax.add_collection3d(self.fill)
-        self.axes = []
-        if body_axes:
-            for k, c in enumerate(_AXIS_COLOURS):
-                seg = np.stack([geom.centre, geom.centre + geom.axes[k]])
-                self.axes.append(ax.plot(*seg.T, color=c, linewidth=2.0,
-                                         label="XYZ"[k] + "_B")[0])  # fmt: skip
-
-    def update(self, geom: SatelliteGeometry) -> None:
-        for art, line in zip(self.hub, geom.hub_lines, strict=True):
-            art.set_data_3d(*line.T)
-        for art, arm in zip(self.arms, geom.arms, strict=True):
-            art.set_data_3d(*arm.T)
-        for art, p in zip(self.panels, geom.panels, strict=True):
-            art.set_data_3d(*_closed(p).T)
-        if self.fill is not None:
-            self.fill.set_verts(list(geom.panels))
-        for k, art in enumerate(self.axes):
-            art.set_data_3d(*np.stack([geom.centre, geom.centre + geom.axes[k]]).T)
-
-    def artists(self) -> list:
-        fill = [] if self.fill is None else [self.fill]
-        return [*self.hub, *self.arms, *fill, *self.panels, *self.axes]
-
-    def draw(self, ax) -> None:
-        """Draw the artists onto the canvas (for blitting; projection as last drawn)."""
-        if self.fill is not None:
-            self.fill.do_3d_projection()
-        for art in self.artists():
-            ax.draw_artist(art)
-
-
-def _closed(corners: np.ndarray) -> np.ndarray:
-    return np.concatenate([corners, corners[:1]])
-
-
 def animate_mode(
     analysis: ModalAnalysis,
     mode_index: int,
@@ -444,21 +389,12 @@ def animate_mode(
         lo, hi = np.minimum(lo, glo), np.maximum(hi, ghi)
     # Same scale on every axis (1 m is 1 m), limits fixed over the period; a flat
     # satellite keeps some depth so out-of-plane motion stays visible.
-    centre, half = 0.5 * (lo + hi), 0.55 * (hi - lo)
-    half = np.maximum(half, 0.3 * half.max())
-    for k, (setter, axis) in enumerate(((ax.set_xlim, ax.xaxis), (ax.set_ylim, ax.yaxis),
-                                        (ax.set_zlim, ax.zaxis))):  # fmt: skip
-        setter(centre[k] - half[k], centre[k] + half[k])
-        axis.set_major_locator(MaxNLocator(nbins=max(2, int(8 * half[k] / half.max()))))
-        axis.set_label_text(f"{'XYZ'[k]}_N [m]", fontsize=8)
-    ax.set_box_aspect(tuple(half), zoom=1.2)
-    ax.view_init(elev=22.0, azim=-38.0)
-    ax.tick_params(labelsize=7)
+    frame_view(ax, lo, hi, min_depth=0.3)
 
-    _SatelliteDrawing(ax, rest, colour="0.6", linestyle="--", linewidth=0.9,
-                      label="undeformed")  # fmt: skip
-    moving = _SatelliteDrawing(ax, shots[0], colour="0.1", fill="goldenrod", body_axes=True,
-                               label="mode shape (magnified)")  # fmt: skip
+    SatelliteDrawing(ax, rest, colour="0.6", linestyle="--", linewidth=0.9,
+                     label="undeformed")  # fmt: skip
+    moving = SatelliteDrawing(ax, shots[0], colour="0.1", fill="goldenrod", body_axes=True,
+                              label="mode shape (magnified)")  # fmt: skip
     ax.legend(loc="upper left", fontsize=7, framealpha=0.8)
     fig.suptitle(_animation_title(mode, a, float(peak[worst]), length), fontsize=9, y=0.985)
     clock = fig.text(0.01, 0.015, "", fontsize=8, color="0.3", animated=True)
@@ -470,7 +406,7 @@ def animate_mode(
         art.set_animated(True)
     canvas.draw()
     background = canvas.copy_from_bbox(fig.bbox)
-    writer = _CanvasPillowWriter(fps=fps)
+    writer = CanvasPillowWriter(fps=fps)
     with writer.saving(fig, str(path), dpi=fig.dpi):
         for k, geom in enumerate(shots):
             canvas.restore_region(background)
@@ -484,34 +420,6 @@ def animate_mode(
             writer.grab_frame()
     fig.clear()
     return path
-
-
-class _CanvasPillowWriter(PillowWriter):
-    """A :class:`PillowWriter` that takes each frame from the Agg canvas as it stands.
-
-    The caller renders the frame (here by blitting); ``grab_frame`` copies the
-    canvas buffer instead of redrawing the whole figure through ``savefig``.
-    """
-
-    def grab_frame(self, **savefig_kwargs) -> None:
-        canvas = self.fig.canvas
-        size = canvas.get_width_height(physical=True)
-        image = Image.frombuffer("RGBA", size, canvas.buffer_rgba(), "raw", "RGBA", 0, 1)
-        self._frames.append(image.convert("RGB"))
-
-    def finish(self) -> None:
-        # One palette for the whole GIF, from a few frames spread over the period:
-        # much faster than an adaptive palette per frame, and no colour flicker.
-        frames = self._frames
-        picks = sorted({0, len(frames) // 4, len(frames) // 2, 3 * len(frames) // 4})
-        width, height = frames[0].size
-        montage = Image.new("RGB", (width, height * len(picks)))
-        for row, k in enumerate(picks):
-            montage.paste(frames[k], (0, row * height))
-        palette = montage.quantize(colors=255, method=Image.Quantize.MEDIANCUT)
-        indexed = [f.quantize(palette=palette, dither=Image.Dither.NONE) for f in frames]
-        indexed[0].save(self.outfile, save_all=True, append_images=indexed[1:],
-                        duration=int(1000 / self.fps), loop=0)  # fmt: skip
 
 
 def _animation_title(mode: Mode, a: float, peak: float, length: float) -> str:
