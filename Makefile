@@ -30,11 +30,11 @@ test: $(STAMP) chromium
 	$(BIN)/ruff check src tests bench examples
 	$(BIN)/python -m pytest -q
 
+# Every benchmark and the table of performance targets (docs/performance.md); the
+# optional `bench` extra adds Basilisk, the peer flexsat is compared with.
 bench: $(STAMP)
-	$(BIN)/python bench/bench_dynamics.py
-	$(BIN)/python bench/bench_openloop.py
-	$(BIN)/python bench/bench_slew.py
-	$(BIN)/python bench/bench_campaigns.py
+	$(BIN)/python -m pip install --quiet -e '.[dev,bench]'
+	$(BIN)/python bench/run_all.py
 
 lint: $(STAMP)
 	$(BIN)/ruff check src tests bench examples

@@ -111,14 +111,16 @@ def startup_seconds(cache_dir: str) -> float:
     return float(result.stdout.strip())
 
 
-def main() -> None:
+def main(argv: list[str] | None = None) -> dict:
+    """Print the table and the start-up times; return them (us per call, s)."""
+    del argv  # no options
     console = Console()
     table = Table(title="flexsat dynamics kernels: microseconds per evaluation (one core)")
     table.add_column("evaluation")
     sizes = (2, 8)
     results = {n: measure(n) for n in sizes}
     for n in sizes:
-        table.add_column(f"{n} appendages ({6 + 6 * n} DOF) [us]", justify="right")
+        table.add_column(f"{n} appendages ({6 + 6 * n} DOF), us", justify="right")
     for name in results[sizes[0]]:
         table.add_row(name, *(f"{results[n][name]:.2f}" for n in sizes))
     console.print(table)
@@ -127,6 +129,7 @@ def main() -> None:
         warm = startup_seconds(cache)
     console.print(f"import + plant + first calls, empty numba cache (compiles): {cold:.2f} s")
     console.print(f"import + plant + first calls, numba cache filled:           {warm:.2f} s")
+    return {"per_call_us": results, "startup_cold_s": cold, "startup_cached_s": warm}
 
 
 if __name__ == "__main__":

@@ -209,6 +209,14 @@ def main(argv=None):
         f"Machine: {platform.processor() or platform.machine()}, {os.cpu_count()} CPUs, "
         f"Python {platform.python_version()}, NumPy {np.__version__}."
     )
+    return {
+        "quick": args.quick,
+        "flexsat_rk4": flex_rk4,
+        "flexsat_dop853": flex_dop,
+        "baseline_rk4": base_rk4,
+        "baseline_solve_ivp": base_ivp,
+        "eval_us": {"flexsat_rk4_loop": flex_us, **per_call},
+    }
 
 
 if __name__ == "__main__":

@@ -30,7 +30,9 @@ def _best(fn, repeats: int = 3) -> float:
     return best
 
 
-def main() -> None:
+def main(argv: list[str] | None = None) -> dict:
+    """Print the table; return each row's wall time per 120 s [s] and us per step."""
+    del argv  # no options
     plant = Plant.from_config(nominal())
     rows = []
     wall = _best(lambda: run_openloop(plant, OpenLoopScenario()))
@@ -52,11 +54,15 @@ def main() -> None:
     table = Table(title="Closed-loop slew, nominal case, RK4 dt = 1 ms, whole run incl. recording")
     for column in ("run", "simulated s", "wall s", "wall per 120 s", "us per step"):
         table.add_column(column, justify="right" if column != "run" else "left")
+    numbers = {}
     for name, simulated, wall in rows:
         per_120 = wall * 120.0 / simulated
+        per_step = 1e6 * wall / (simulated / 1e-3)
+        numbers[name] = {"wall_per_120_s": per_120, "us_per_step": per_step}
         table.add_row(name, f"{simulated:.0f}", f"{wall:.3f}", f"{per_120:.3f}",
-                      f"{1e6 * wall / (simulated / 1e-3):.2f}")  # fmt: skip
+                      f"{per_step:.2f}")  # fmt: skip
     Console().print(table)
+    return numbers
 
 
 if __name__ == "__main__":

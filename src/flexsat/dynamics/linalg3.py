@@ -3,6 +3,9 @@
 Vectors are 3-tuples and matrices are 3-tuples of row 3-tuples, so numba keeps
 them in registers: no heap allocation happens in the inner loop. Written by hand
 because numpy's small-array operations allocate on every call inside numba.
+Compiled with ``error_model="numpy"`` like the kernels (see
+:mod:`flexsat.dynamics.kernels`): the divisions in :func:`euler_rate_matrix_inv` are
+not zero-tested; callers check ``cos(theta)`` first.
 
 Rotation convention (thesis eq. 2.25): ``rot_zyx(phi, theta, psi) = Rz(psi) Ry(theta)
 Rx(phi)`` maps body components to parent components, and the body rate is
@@ -38,27 +41,27 @@ __all__ = [
 ]
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def add(a, b):
     return (a[0] + b[0], a[1] + b[1], a[2] + b[2])
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def sub(a, b):
     return (a[0] - b[0], a[1] - b[1], a[2] - b[2])
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def scale(s, a):
     return (s * a[0], s * a[1], s * a[2])
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def dot(a, b):
     return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def cross(a, b):
     return (
         a[1] * b[2] - a[2] * b[1],
@@ -67,13 +70,13 @@ def cross(a, b):
     )
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def mv(m, x):
     """m @ x."""
     return (dot(m[0], x), dot(m[1], x), dot(m[2], x))
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def mtv(m, x):
     """m.T @ x."""
     return (
@@ -83,7 +86,7 @@ def mtv(m, x):
     )
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def transpose(m):
     return (
         (m[0][0], m[1][0], m[2][0]),
@@ -92,7 +95,7 @@ def transpose(m):
     )
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def mm(a, b):
     """a @ b."""
     bt = transpose(b)
@@ -103,19 +106,19 @@ def mm(a, b):
     )
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def mtm(a, b):
     """a.T @ b."""
     return mm(transpose(a), b)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def skew(v):
     """[v]x, the matrix with skew(v) @ x == cross(v, x)."""
     return ((0.0, -v[2], v[1]), (v[2], 0.0, -v[0]), (-v[1], v[0], 0.0))
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def rot_zyx(phi, theta, psi):
     """Rz(psi) Ry(theta) Rx(phi): body (child) components to parent components (eq. 2.25)."""
     c1, s1 = cos(phi), sin(phi)
@@ -128,7 +131,7 @@ def rot_zyx(phi, theta, psi):
     )
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def euler_rate_matrix(phi, theta):
     """S(Theta) of eq. 2.28: body rate = S @ ZYX Euler-angle rates."""
     c1, s1 = cos(phi), sin(phi)
@@ -136,7 +139,7 @@ def euler_rate_matrix(phi, theta):
     return ((1.0, 0.0, -s2), (0.0, c1, c2 * s1), (0.0, -s1, c2 * c1))
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def euler_rate_matrix_inv(phi, theta):
     """S(Theta)^-1; singular at theta = +-90 deg (the caller checks cos(theta))."""
     c1, s1 = cos(phi), sin(phi)
@@ -145,7 +148,7 @@ def euler_rate_matrix_inv(phi, theta):
     return ((1.0, s1 * t2, c1 * t2), (0.0, c1, -s1), (0.0, s1 / c2, c1 / c2))
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def euler_rate_bias(phi, theta, dphi, dtheta, dpsi):
     """dS/dt @ Theta_dot: the part of the body angular acceleration not from Theta_ddot."""
     c1, s1 = cos(phi), sin(phi)
@@ -157,13 +160,13 @@ def euler_rate_bias(phi, theta, dphi, dtheta, dpsi):
     )
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def load_v3(a, i):
     """Row i of an (n, 3) array as a tuple."""
     return (a[i, 0], a[i, 1], a[i, 2])
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def load_m33(a, i):
     """Matrix i of an (n, 3, 3) array as nested tuples."""
     return (
@@ -173,13 +176,13 @@ def load_m33(a, i):
     )
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def load_seg(x, k):
     """x[k:k+3] as a tuple."""
     return (x[k], x[k + 1], x[k + 2])
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def scale_m(s, m):
     """s * m for a 3x3 matrix."""
     return (scale(s, m[0]), scale(s, m[1]), scale(s, m[2]))

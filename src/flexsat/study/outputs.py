@@ -115,20 +115,19 @@ def fly_openloop(plant: Plant, scenario=None, out: Path | None = None, progress=
     metrics : dict
         :func:`flexsat.analysis.openloop.openloop_metrics`, plus ``files``.
     """
-    from flexsat.analysis.modal import modal_analysis
     from flexsat.analysis.openloop import openloop_metrics
-    from flexsat.plots.openloop import write_openloop_figures
     from flexsat.simulate import OpenLoopScenario, run_openloop
+
+    def figures() -> list[Path]:  # matplotlib is imported only when figures are drawn
+        from flexsat.analysis.modal import modal_analysis
+        from flexsat.plots.openloop import write_openloop_figures
+
+        return write_openloop_figures(result.dataset, modal_analysis(plant), Path(out))
 
     result = run_openloop(plant, scenario or OpenLoopScenario(), progress=progress)
     metrics = openloop_metrics(result.dataset)
     if out is not None:
-        _write_run(
-            result,
-            metrics,
-            Path(out),
-            lambda: write_openloop_figures(result.dataset, modal_analysis(plant), Path(out)),
-        )
+        _write_run(result, metrics, Path(out), figures)
     return result, metrics
 
 
@@ -151,8 +150,12 @@ def fly_slew(plant: Plant, scenario=None, out: Path | None = None, progress=None
         scenario's requirements), plus ``files``.
     """
     from flexsat.analysis.requirements import slew_metrics
-    from flexsat.plots.slew import write_slew_figures
     from flexsat.simulate import SlewScenario, run_slew
+
+    def figures() -> list[Path]:
+        from flexsat.plots.slew import write_slew_figures
+
+        return write_slew_figures(result.dataset, Path(out))
 
     scenario = scenario or SlewScenario()
     result = run_slew(plant, scenario, progress=progress)
@@ -161,7 +164,7 @@ def fly_slew(plant: Plant, scenario=None, out: Path | None = None, progress=None
         result.dataset, req.pointing_deg, req.jitter_deg_s, scenario.actuator.t_max_nm
     )
     if out is not None:
-        _write_run(result, metrics, Path(out), lambda: write_slew_figures(result.dataset, out))
+        _write_run(result, metrics, Path(out), figures)
     return result, metrics
 
 
