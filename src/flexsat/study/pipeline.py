@@ -140,10 +140,10 @@ def _animation(ctx: StudyContext) -> dict:
 def _campaigns(ctx: StudyContext) -> dict:
     from flexsat.campaigns import load_campaign
 
-    summaries = {}
+    summaries, figures = {}, []
     for name in CAMPAIGNS:
         store = ctx.out / "campaigns" / name
-        fly_campaign(
+        summary = fly_campaign(
             load_campaign(name),
             ctx.config,
             store,
@@ -152,7 +152,8 @@ def _campaigns(ctx: StudyContext) -> dict:
             resume=True,
         )
         summaries[name] = _relative(ctx, [store / "summary.json"])[0]
-    return {"summaries": summaries}
+        figures += _relative(ctx, summary["figures"])
+    return {"summaries": summaries, "figures": figures}
 
 
 PARTS = (

@@ -363,8 +363,7 @@ def _campaigns(root: Path, outputs: dict, context: dict) -> str:
                 f"Campaign {name} (store {store}: results.parquet, results.csv)",
             )
         )
-        figures = [Path(f) for f in src.get("figures")]
-        parts.append(_figures(root, [(Path(store) / f.name).as_posix() for f in figures]))
+        parts.append(_figures(root, [f for f in outputs["figures"] if f.startswith(store + "/")]))
     return "".join(parts)
 
 
