@@ -11,7 +11,6 @@ decimated time history of each case is kept apart, in ``histories/<id>.nc``
 from __future__ import annotations
 
 import json
-import math
 import os
 import tempfile
 from pathlib import Path
@@ -21,6 +20,7 @@ import pandas as pd
 import xarray as xr
 
 from flexsat.errors import ConfigError
+from flexsat.jsonable import jsonable
 
 __all__ = ["HISTORY_UNITS", "CampaignStore"]
 
@@ -79,7 +79,7 @@ class CampaignStore:
         return {p.stem for p in self.cases_dir.glob("*.json")}
 
     def write_case(self, row: dict) -> None:
-        _write_atomic(self.cases_dir / f"{row['case_id']}.json", json.dumps(_clean(row)))
+        _write_atomic(self.cases_dir / f"{row['case_id']}.json", json.dumps(jsonable(row)))
 
     def write_history(self, case_id: str, data: dict, status: str = "ok") -> Path:
         """Store a case's time history (plain lists keyed as :data:`HISTORY_UNITS`).
@@ -148,17 +148,6 @@ class CampaignStore:
             writer(tmp, index=False)
             os.replace(tmp, path)
         return parquet, csv
-
-
-def _clean(value):
-    """JSON-safe: NaN and inf become null."""
-    if isinstance(value, float) and not math.isfinite(value):
-        return None
-    if isinstance(value, dict):
-        return {k: _clean(v) for k, v in value.items()}
-    if isinstance(value, list | tuple):
-        return [_clean(v) for v in value]
-    return value
 
 
 def _write_atomic(path: Path, text: str) -> None:

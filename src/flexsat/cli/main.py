@@ -19,7 +19,7 @@ from rich.table import Table
 
 from flexsat import __version__
 from flexsat.errors import FlexsatError
-from flexsat.study.outputs import jsonable
+from flexsat.jsonable import jsonable
 
 __all__ = ["app", "main"]
 

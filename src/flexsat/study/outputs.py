@@ -13,7 +13,7 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-import numpy as np
+from flexsat.jsonable import jsonable
 
 if TYPE_CHECKING:  # the CLI imports this module at start-up: keep numba out of it
     from flexsat.dynamics.plant import Plant
@@ -23,21 +23,9 @@ __all__ = [
     "fly_campaign",
     "fly_openloop",
     "fly_slew",
-    "jsonable",
     "write_json",
     "write_modal",
 ]
-
-
-def jsonable(value):
-    """Strict JSON: NaN (a quantity that does not exist, e.g. never settled) -> null."""
-    if isinstance(value, float) and not np.isfinite(value):
-        return None
-    if isinstance(value, dict):
-        return {key: jsonable(item) for key, item in value.items()}
-    if isinstance(value, list | tuple):
-        return [jsonable(item) for item in value]
-    return value
 
 
 def write_json(path: str | Path, payload: dict) -> Path:
