@@ -21,8 +21,7 @@ from matplotlib.figure import Figure
 
 from flexsat.campaigns.runner import summarize
 from flexsat.campaigns.store import CampaignStore
-from flexsat.plots.openloop import _AXES, _AXIS_COLOURS, _figure, _finish_time_axis, _positive
-from flexsat.plots.slew import _BAND
+from flexsat.plots import style
 
 __all__ = [
     "CAMPAIGN_FIGURES",
@@ -137,7 +136,7 @@ def _band_and_line(
     line = _nominal(campaign, name, axis)
     lo, hi, line = scale * lo, scale * hi, scale * line
     if log:
-        lo, hi, line = _positive(lo), _positive(hi), _positive(line)
+        lo, hi, line = style.positive(lo), style.positive(hi), style.positive(line)
     ax.fill_between(
         t, lo, hi, color=colour, alpha=_ENVELOPE_ALPHA, linewidth=0, label="all cases (min–max)"
     )
@@ -150,12 +149,12 @@ def _requirement(ax, bound: float, tag: str, unit: str) -> None:
     ax.axhspan(
         ax.get_ylim()[0],
         bound,
-        color=_BAND,
+        color=style.BAND,
         alpha=0.15,
         linewidth=0,
         label=f"{tag} band: < {bound:.3g} {unit}",
     )
-    ax.axhline(bound, color=_BAND, linewidth=1.4, label=f"{tag}: {bound:.3g} {unit}")
+    ax.axhline(bound, color=style.BAND, linewidth=1.4, label=f"{tag}: {bound:.3g} {unit}")
 
 
 def _log_panel(
@@ -168,7 +167,7 @@ def _log_panel(
     what: str,
     colour: str,
 ) -> Figure:
-    fig, axes = _figure(1, 1, size=(11.0, 5.5))
+    fig, axes = style.figure(1, 1, size=(11.0, 5.5))
     ax = axes[0, 0]
     _band_and_line(ax, campaign, name, colour=colour, log=True)
     bottom, top = ax.get_ylim()
@@ -176,7 +175,7 @@ def _log_panel(
     _requirement(ax, bound, tag, unit)
     ax.set_ylabel(ylabel)
     ax.legend(loc="upper right", fontsize=8)
-    _finish_time_axis(axes, campaign.time)
+    style.finish_time_axis(axes, campaign.time)
     campaign.title(fig, what)
     return fig
 
@@ -214,10 +213,10 @@ def plot_envelope_rate(store_dir: str | Path) -> Figure:
 def plot_envelope_torque(store_dir: str | Path) -> Figure:
     """Commanded torque per axis [N m] of every case with the limits ±RF·T_max."""
     c = _load(store_dir)
-    fig, axes = _figure(3, 1, size=(11.0, 8.5))
+    fig, axes = style.figure(3, 1, size=(11.0, 8.5))
     for k in range(3):
         ax = axes[k, 0]
-        _band_and_line(ax, c, "tau_cmd", axis=k, colour=_AXIS_COLOURS[k])
+        _band_and_line(ax, c, "tau_cmd", axis=k, colour=style.AXIS_COLOURS[k])
         for sign in (1.0, -1.0):
             ax.axhline(
                 sign * c.torque_limit,
@@ -227,19 +226,19 @@ def plot_envelope_torque(store_dir: str | Path) -> Figure:
                 label=f"±RF·T_max = ±{c.torque_limit:.3g} N m" if sign > 0 else None,
             )
         ax.set_ylim(-1.15 * c.torque_limit, 1.15 * c.torque_limit)
-        ax.set_ylabel(f"τ_cmd,{_AXES[k]} [N m]")
+        ax.set_ylabel(f"τ_cmd,{style.AXES[k]} [N m]")
         ax.legend(loc="upper right", fontsize=8)
-    _finish_time_axis(axes, c.time)
+    style.finish_time_axis(axes, c.time)
     c.title(fig, "Commanded torque envelope per axis")
     return fig
 
 
 def _single(c: _Campaign, name: str, scale: float, ylabel: str, what: str, colour: str) -> Figure:
-    fig, axes = _figure(1, 1, size=(11.0, 5.5))
+    fig, axes = style.figure(1, 1, size=(11.0, 5.5))
     _band_and_line(axes[0, 0], c, name, scale=scale, colour=colour)
     axes[0, 0].set_ylabel(ylabel)
     axes[0, 0].legend(loc="upper right", fontsize=8)
-    _finish_time_axis(axes, c.time)
+    style.finish_time_axis(axes, c.time)
     c.title(fig, what)
     return fig
 
@@ -271,15 +270,15 @@ def plot_envelope_energy(store_dir: str | Path) -> Figure:
 def plot_envelope_gains(store_dir: str | Path) -> Figure:
     """Adaptive gains of every case: Λ_act [rad/s] and JK per axis [N m]."""
     c = _load(store_dir)
-    fig, axes = _figure(4, 1, size=(11.0, 10.0))
+    fig, axes = style.figure(4, 1, size=(11.0, 10.0))
     _band_and_line(axes[0, 0], c, "lambda_act", colour="black")
     axes[0, 0].set_ylabel("Λ_act [rad/s]")
     for k in range(3):
-        _band_and_line(axes[k + 1, 0], c, "jk", axis=k, colour=_AXIS_COLOURS[k])
-        axes[k + 1, 0].set_ylabel(f"JK_{_AXES[k]} [N m]")
+        _band_and_line(axes[k + 1, 0], c, "jk", axis=k, colour=style.AXIS_COLOURS[k])
+        axes[k + 1, 0].set_ylabel(f"JK_{style.AXES[k]} [N m]")
     for ax in axes[:, 0]:
         ax.legend(loc="upper right", fontsize=8)
-    _finish_time_axis(axes, c.time)
+    style.finish_time_axis(axes, c.time)
     c.title(fig, "Adaptive gain envelopes: Λ_act and JK")
     return fig
 
@@ -388,14 +387,6 @@ def write_campaign_figures(
         The files written.
     """
     out = Path(out_dir) if out_dir is not None else Path(store_dir) / "figures"
-    out.mkdir(parents=True, exist_ok=True)
     campaign = _Campaign(store_dir)
     makers = {**_ENVELOPES, "summary_table": lambda _: plot_summary_table(store_dir)}
-    written = []
-    for name in CAMPAIGN_FIGURES:
-        fig = makers[name](campaign)
-        path = out / f"{name}.png"
-        fig.savefig(path, dpi=dpi)
-        fig.clear()
-        written.append(path)
-    return written
+    return style.write_figures(out, CAMPAIGN_FIGURES, lambda name: makers[name](campaign), dpi=dpi)

@@ -13,7 +13,7 @@ import numpy as np
 import xarray as xr
 from matplotlib.figure import Figure
 
-from flexsat.plots.openloop import _figure, _finish_time_axis, _line, _positive, _time
+from flexsat.plots import style
 from flexsat.simulate.scenario import SlewScenario
 
 __all__ = ["plot_controller_comparison", "write_comparison_figure"]
@@ -39,17 +39,17 @@ def plot_controller_comparison(datasets: dict[str, xr.Dataset]) -> Figure:
     first = next(iter(datasets.values()))
     scenario = SlewScenario.model_validate_json(first.attrs["scenario"])
     req = scenario.requirements
-    fig, axes = _figure(3, 1, size=(11.0, 10.0))
+    fig, axes = style.figure(3, 1, size=(11.0, 10.0))
     panels = (
         ("pointing_error_deg", "pointing error [deg] (log)", req.pointing_deg, "R1"),
         ("rate_error_deg_s", "residual rate |ω − ω_d| [deg/s] (log)", req.jitter_deg_s, "R2"),
     )
     for ax, (name, label, bound, tag) in zip(axes[:2, 0], panels, strict=True):
         for (law, ds), colour in zip(datasets.items(), _COLOURS, strict=False):
-            _line(
+            style.line(
                 ax,
-                _time(ds),
-                _positive(ds[name].values),
+                style.time_s(ds),
+                style.positive(ds[name].values),
                 color=colour,
                 linewidth=1.0,
                 label=f"{law.upper()}: final {float(ds[name].values[-1]):.3g}",
@@ -67,7 +67,7 @@ def plot_controller_comparison(datasets: dict[str, xr.Dataset]) -> Figure:
     ax = axes[2, 0]
     for (law, ds), colour in zip(datasets.items(), _COLOURS, strict=False):
         norm = np.linalg.norm(np.asarray(ds["tau_applied"].values), axis=1)
-        _line(ax, _time(ds), norm, color=colour, linewidth=1.0, label=law.upper())
+        style.line(ax, style.time_s(ds), norm, color=colour, linewidth=1.0, label=law.upper())
     limit = scenario.actuator.t_max_nm
     ax.axhline(
         limit * np.sqrt(3.0),
@@ -78,7 +78,7 @@ def plot_controller_comparison(datasets: dict[str, xr.Dataset]) -> Figure:
     )
     ax.set_ylabel("|τ applied| [N m]")
     ax.legend(loc="upper right", fontsize=8)
-    _finish_time_axis(axes, _time(first))
+    style.finish_time_axis(axes, style.time_s(first))
     fig.suptitle(
         f"Controller comparison: the same slew, plant and disturbances\n"
         f"{first.attrs.get('title', '')}",
@@ -91,9 +91,4 @@ def write_comparison_figure(
     datasets: dict[str, xr.Dataset], path: str | Path, *, dpi: int = 120
 ) -> Path:
     """Write :func:`plot_controller_comparison` to ``path`` (PNG); returns the path."""
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig = plot_controller_comparison(datasets)
-    fig.savefig(path, dpi=dpi)
-    fig.clear()
-    return path
+    return style.save_figure(plot_controller_comparison(datasets), path, dpi=dpi)

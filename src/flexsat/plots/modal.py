@@ -24,6 +24,7 @@ from matplotlib.lines import Line2D
 
 from flexsat.analysis.modal import ModalAnalysis, Mode
 from flexsat.dynamics.plant import Plant
+from flexsat.plots import style
 from flexsat.plots._scene import CanvasPillowWriter, SatelliteDrawing, frame_view
 from flexsat.plots.geometry import SatelliteGeometry, satellite_geometry
 
@@ -485,13 +486,8 @@ def write_modal_figures(
     chosen = default_animated_modes(analysis) if mode_indices is None else list(mode_indices)
     for k in chosen:
         _shape(analysis, k)  # validate every index before writing anything
-    written = []
-    for name, plot in (("interaction_map.png", plot_interaction_map),
-                       ("frequencies.png", plot_frequencies)):  # fmt: skip
-        fig = plot(analysis)
-        fig.savefig(out / name, dpi=150)
-        fig.clear()
-        written.append(out / name)
+    static = {"interaction_map": plot_interaction_map, "frequencies": plot_frequencies}
+    written = style.write_figures(out, static, lambda name: static[name](analysis), dpi=150)
     for k in chosen:
         written.append(animate_mode(analysis, int(k), out / f"mode_{int(k)}.gif",
                                     frames=frames, fps=fps))  # fmt: skip

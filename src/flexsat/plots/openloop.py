@@ -30,7 +30,6 @@ from pathlib import Path
 
 import numpy as np
 import xarray as xr
-from matplotlib.axes import Axes
 from matplotlib.colors import Normalize
 from matplotlib.figure import Figure
 from matplotlib.patches import Patch
@@ -45,6 +44,7 @@ from flexsat.analysis.spectrogram import (
     coupled_frequencies,
     spectrogram,
 )
+from flexsat.plots import style
 
 __all__ = [
     "OPENLOOP_FIGURES",
@@ -60,12 +60,8 @@ __all__ = [
     "write_openloop_figures",
 ]
 
-_AXES = ("x", "y", "z")
-_AXIS_COLOURS = ("tab:red", "tab:green", "tab:blue")
-_EULER = (("roll", "φ"), ("pitch", "θ"), ("yaw", "ψ"))
 _ROOT_ROTATION = ("flapping", "torsion", "in-plane")  # rho_x, rho_y, rho_z (mount frame)
 _APPENDAGE_STYLES = ("-", "--", "-.", ":")
-_MAX_LINE_POINTS = 8000  # longer records are drawn as a min/max envelope of this size
 _RIPPLE_MIN_HZ = 0.05
 _SPECTROGRAM_RANGE_DB = 80.0
 _TORQUE_SHADE = "0.9"
@@ -74,19 +70,9 @@ _TORQUE_SHADE = "0.9"
 # -- helpers ---------------------------------------------------------------------------
 
 
-def _figure(nrows: int, ncols: int = 1, *, size=(11.0, 7.5), sharex=True, **grid) -> tuple:
-    fig = Figure(figsize=size, layout="constrained")
-    axes = fig.subplots(nrows, ncols, sharex=sharex, squeeze=False, gridspec_kw=grid or None)
-    return fig, axes
-
-
-def _time(ds: xr.Dataset) -> np.ndarray:
-    return np.asarray(ds["time"].values, dtype=float)
-
-
 def _torque_intervals(ds: xr.Dataset) -> list[tuple[float, float]]:
     """[start, end) of each stretch of records in which a torque is commanded [s]."""
-    t = _time(ds)
+    t = style.time_s(ds)
     on = np.abs(np.asarray(ds["tau_cmd"].values)).max(axis=1) > 0.0
     edges = np.diff(np.concatenate([[0], on.astype(np.int8), [0]]))
     starts, ends = np.nonzero(edges == 1)[0], np.nonzero(edges == -1)[0]
@@ -95,7 +81,7 @@ def _torque_intervals(ds: xr.Dataset) -> list[tuple[float, float]]:
 
 def _free_from(ds: xr.Dataset) -> float | None:
     """Time the last commanded torque ends, or None if one is still on at the end [s]."""
-    t = _time(ds)
+    t = style.time_s(ds)
     intervals = _torque_intervals(ds)
     if not intervals:
         return float(t[0])
@@ -120,52 +106,6 @@ def _torque_patches(ds: xr.Dataset) -> list[Patch]:
     return [Patch(color=_TORQUE_SHADE, label="torque commanded")] if _shaded(ds) else []
 
 
-def _suptitle(fig: Figure, ds: xr.Dataset, what: str) -> None:
-    scenario = ds.attrs.get("title", "flexsat open-loop run")
-    line = f"{what}\n{scenario}"
-    if ds.attrs.get("status", "ok") != "ok":
-        line += f"  —  FAILED: {ds.attrs.get('message', '')}"
-    fig.suptitle(line, fontsize=11)
-
-
-def _envelope(t: np.ndarray, y: np.ndarray, max_points: int = _MAX_LINE_POINTS) -> tuple:
-    """(t, y) thinned to about ``max_points`` keeping each bucket's min and max.
-
-    Unlike plain striding this keeps the peaks of an oscillation faster than the
-    thinned sampling, so the drawn envelope is the true one.
-    """
-    n = t.size
-    if n <= max_points:
-        return t, y
-    size = int(np.ceil(2 * n / max_points))
-    m = n // size
-    head = y[: m * size].reshape(m, size)
-    base = np.arange(m) * size
-    lo = base + np.argmin(head, axis=1)
-    hi = base + np.argmax(head, axis=1)
-    keep = np.concatenate([np.sort(np.stack([lo, hi], axis=1), axis=1).ravel(),
-                           np.arange(m * size, n)])  # fmt: skip
-    return t[keep], y[keep]
-
-
-def _line(ax: Axes, t: np.ndarray, y: np.ndarray, **kw):
-    return ax.plot(*_envelope(t, np.asarray(y, dtype=float)), **kw)[0]
-
-
-def _finish_time_axis(axes, t: np.ndarray) -> None:
-    for ax in np.ravel(axes):
-        ax.grid(True, color="0.85", linewidth=0.6)
-        ax.set_xlim(t[0], t[-1])
-    for ax in np.atleast_2d(axes)[-1]:
-        ax.set_xlabel("time t [s]")
-
-
-def _positive(values: np.ndarray) -> np.ndarray:
-    """Values with non-positive entries masked (NaN), for a log axis."""
-    values = np.asarray(values, dtype=float)
-    return np.where(values > 0.0, values, np.nan)
-
-
 # -- attitude --------------------------------------------------------------------------
 
 
@@ -185,23 +125,27 @@ def plot_attitude(ds: xr.Dataset) -> Figure:
     -------
     matplotlib.figure.Figure
     """
-    t = _time(ds)
+    t = style.time_s(ds)
     euler = np.asarray(ds["euler_deg"].values)
     rate = np.degrees(np.asarray(ds["omega"].values))
-    fig, axes = _figure(2, 3, size=(13.0, 6.5))
+    fig, axes = style.figure(2, 3, size=(13.0, 6.5))
     _shade_torque(axes, ds)
     for k in range(3):
-        name, symbol = _EULER[k]
-        _line(axes[0, k], t, euler[:, k], color=_AXIS_COLOURS[k], label=f"{symbol} ({name})")
+        name, symbol = style.EULER[k]
+        style.line(
+            axes[0, k], t, euler[:, k], color=style.AXIS_COLOURS[k], label=f"{symbol} ({name})"
+        )
         axes[0, k].set_ylabel(f"{name} {symbol} [deg]")
         axes[0, k].set_title(f"{name} angle {symbol}", fontsize=10)
-        _line(axes[1, k], t, rate[:, k], color=_AXIS_COLOURS[k], label=f"ω_{_AXES[k]}")
-        axes[1, k].set_ylabel(f"ω_{_AXES[k]} [deg/s]")
-        axes[1, k].set_title(f"body rate ω_{_AXES[k]} (frame B)", fontsize=10)
+        style.line(
+            axes[1, k], t, rate[:, k], color=style.AXIS_COLOURS[k], label=f"ω_{style.AXES[k]}"
+        )
+        axes[1, k].set_ylabel(f"ω_{style.AXES[k]} [deg/s]")
+        axes[1, k].set_title(f"body rate ω_{style.AXES[k]} (frame B)", fontsize=10)
     if _shaded(ds):
         axes[0, 0].legend(handles=_torque_patches(ds), loc="upper left", fontsize=8)
-    _finish_time_axis(axes, t)
-    _suptitle(fig, ds, "Hub attitude (ZYX Euler angles) and body rates")
+    style.finish_time_axis(axes, t)
+    style.suptitle(fig, ds, "Hub attitude (ZYX Euler angles) and body rates")
     return fig
 
 
@@ -217,21 +161,21 @@ def plot_quaternion(ds: xr.Dataset) -> Figure:
     -------
     matplotlib.figure.Figure
     """
-    t = _time(ds)
+    t = style.time_s(ds)
     quat = np.asarray(ds["quaternion"].values)
-    fig, axes = _figure(1, 1, size=(11.0, 5.0))
+    fig, axes = style.figure(1, 1, size=(11.0, 5.0))
     ax = axes[0, 0]
     _shade_torque(axes, ds)
-    colours = ("black", *_AXIS_COLOURS)
+    colours = ("black", *style.AXIS_COLOURS)
     names = ("q0 (scalar)", "q1 (x)", "q2 (y)", "q3 (z)")
     for k in range(4):
-        _line(ax, t, quat[:, k], color=colours[k], label=names[k])
+        style.line(ax, t, quat[:, k], color=colours[k], label=names[k])
     ax.set_ylabel("quaternion component [-]")
     ax.set_ylim(-1.1, 1.1)
     handles, _ = ax.get_legend_handles_labels()
     ax.legend(handles=[*handles, *_torque_patches(ds)], loc="lower left", fontsize=8, ncols=5)
-    _finish_time_axis(axes, t)
-    _suptitle(fig, ds, "Hub attitude quaternion (scalar first, frame B to N)")
+    style.finish_time_axis(axes, t)
+    style.suptitle(fig, ds, "Hub attitude quaternion (scalar first, frame B to N)")
     return fig
 
 
@@ -261,7 +205,7 @@ def plot_angular_acceleration(ds: xr.Dataset, analysis: ModalAnalysis | None = N
     -------
     matplotlib.figure.Figure
     """
-    t = _time(ds)
+    t = style.time_s(ds)
     acc = np.asarray(ds["omega_dot"].values)
     units = ds["omega_dot"].attrs.get("units", "rad/s^2")
     fig = Figure(figsize=(11.0, 10.5), layout="constrained")
@@ -270,13 +214,14 @@ def plot_angular_acceleration(ds: xr.Dataset, analysis: ModalAnalysis | None = N
     close, decay = lower.subplots(1, 2)
     _shade_torque([*axes, close], ds)
     for k, ax in enumerate(axes):
-        _line(ax, t, acc[:, k], color=_AXIS_COLOURS[k], linewidth=0.9,
-              label=f"ω̇_{_AXES[k]}")  # fmt: skip
-        ax.set_ylabel(f"ω̇_{_AXES[k]} [{units}]")
+        style.line(
+            ax, t, acc[:, k], color=style.AXIS_COLOURS[k], linewidth=0.9, label=f"ω̇_{style.AXES[k]}"
+        )
+        ax.set_ylabel(f"ω̇_{style.AXES[k]} [{units}]")
         handles, _ = ax.get_legend_handles_labels()
         ax.legend(handles=handles + (_torque_patches(ds) if k == 0 else []), loc="upper right",
                   fontsize=8)  # fmt: skip
-    _finish_time_axis(np.array(axes)[:, None], t)
+    style.finish_time_axis(np.array(axes)[:, None], t)
     for ax in axes[:2]:
         ax.tick_params(labelbottom=False)
 
@@ -291,17 +236,24 @@ def plot_angular_acceleration(ds: xr.Dataset, analysis: ModalAnalysis | None = N
         for ax in (close, decay):
             ax.text(0.5, 0.5, "no torque-free phase in this run", ha="center", va="center",
                     transform=ax.transAxes, color="0.4")  # fmt: skip
-        _suptitle(fig, ds, "Hub angular acceleration ω̇ (frame B)")
+        style.suptitle(fig, ds, "Hub angular acceleration ω̇ (frame B)")
         return fig
 
     window = (t >= free_from - 2.0) & (t <= free_from + 8.0)
-    close.plot(t[window], acc[window, 2], color=_AXIS_COLOURS[2], linewidth=1.0)
+    close.plot(t[window], acc[window, 2], color=style.AXIS_COLOURS[2], linewidth=1.0)
     close.axvline(free_from, color="black", linewidth=0.8, linestyle=":")
     close.set_xlim(t[window][0], t[window][-1])
     close.set_title(f"close-up: torque switched off at t = {free_from:.3g} s", fontsize=10)
     ripple = np.abs(acc[free, 2])
-    _line(decay, t[free], _positive(ripple), color=_AXIS_COLOURS[2], linewidth=0.5, alpha=0.35,
-          label="|ω̇_z|")  # fmt: skip
+    style.line(
+        decay,
+        t[free],
+        style.positive(ripple),
+        color=style.AXIS_COLOURS[2],
+        linewidth=0.5,
+        alpha=0.35,
+        label="|ω̇_z|",
+    )
     decay.set_yscale("log")
     decay.set_xlim(t[free][0], t[-1])
     decay_title = "decay of the ripple with no torque applied"
@@ -312,8 +264,14 @@ def plot_angular_acceleration(ds: xr.Dataset, analysis: ModalAnalysis | None = N
         f = dominant_frequency(acc[free, 2], dt, _RIPPLE_MIN_HZ)
         title += f": dominant line {f:.4g} Hz"
         envelope = maximum_filter1d(ripple, size=max(3, round(1.0 / (f * dt))))
-        _line(decay, t[free], _positive(envelope), color=_AXIS_COLOURS[2], linewidth=1.4,
-              label="envelope (max over one period)")  # fmt: skip
+        style.line(
+            decay,
+            t[free],
+            style.positive(envelope),
+            color=style.AXIS_COLOURS[2],
+            linewidth=1.4,
+            label="envelope (max over one period)",
+        )
         rate = _decay_rate(t[free], envelope)
         if rate is not None:
             decay_title = (f"ripple decay, no torque: σ = {rate:.3g} 1/s, "
@@ -325,7 +283,7 @@ def plot_angular_acceleration(ds: xr.Dataset, analysis: ModalAnalysis | None = N
         if lines.size:
             title += f"; modes coupled to yaw: {', '.join(f'{v:.4g}' for v in lines)} Hz"
     lower.suptitle(title, fontsize=10)
-    _suptitle(fig, ds, "Hub angular acceleration ω̇ (frame B)")
+    style.suptitle(fig, ds, "Hub angular acceleration ω̇ (frame B)")
     return fig
 
 
@@ -361,26 +319,43 @@ def plot_torques(ds: xr.Dataset) -> Figure:
     -------
     matplotlib.figure.Figure
     """
-    t = _time(ds)
+    t = style.time_s(ds)
     applied = np.asarray(ds["tau_applied"].values)
     flex = np.asarray(ds["tau_flex"].values)
     net = np.asarray(ds["tau_net"].values)
-    fig, axes = _figure(3, 1, size=(11.0, 9.0), height_ratios=(1, 1, 2))
+    fig, axes = style.figure(3, 1, size=(11.0, 9.0), height_ratios=(1, 1, 2))
     _shade_torque(axes, ds)
     for k in range(3):
         ax = axes[k, 0]
-        _line(ax, t, applied[:, k], color="black", linewidth=1.4, label=f"τ_{_AXES[k]} applied")
-        _line(ax, t, flex[:, k], color="tab:orange", linewidth=0.9,
-              label=f"τ_flex,{_AXES[k]} (joints on hub)")  # fmt: skip
-        _line(ax, t, net[:, k], color="tab:blue", linewidth=0.9, alpha=0.85,
-              label=f"τ_net,{_AXES[k]} = τ + τ_flex")  # fmt: skip
-        ax.set_ylabel(f"torque about {_AXES[k]}_B [N m]")
-        ax.set_title(f"{_AXES[k]} axis  (peak |τ_flex| = {np.abs(flex[:, k]).max():.3g} N m)",
-                     fontsize=10)  # fmt: skip
+        style.line(
+            ax, t, applied[:, k], color="black", linewidth=1.4, label=f"τ_{style.AXES[k]} applied"
+        )
+        style.line(
+            ax,
+            t,
+            flex[:, k],
+            color="tab:orange",
+            linewidth=0.9,
+            label=f"τ_flex,{style.AXES[k]} (joints on hub)",
+        )
+        style.line(
+            ax,
+            t,
+            net[:, k],
+            color="tab:blue",
+            linewidth=0.9,
+            alpha=0.85,
+            label=f"τ_net,{style.AXES[k]} = τ + τ_flex",
+        )
+        ax.set_ylabel(f"torque about {style.AXES[k]}_B [N m]")
+        ax.set_title(
+            f"{style.AXES[k]} axis  (peak |τ_flex| = {np.abs(flex[:, k]).max():.3g} N m)",
+            fontsize=10,
+        )
         handles, _ = ax.get_legend_handles_labels()
         ax.legend(handles=[*handles, *_torque_patches(ds)], loc="upper right", fontsize=8, ncols=2)
-    _finish_time_axis(axes, t)
-    _suptitle(fig, ds, "Torques on the hub: applied, flexible reaction, net (frame B)")
+    style.finish_time_axis(axes, t)
+    style.suptitle(fig, ds, "Torques on the hub: applied, flexible reaction, net (frame B)")
     return fig
 
 
@@ -408,28 +383,28 @@ def plot_root_deformation(ds: xr.Dataset) -> Figure:
     -------
     matplotlib.figure.Figure
     """
-    t = _time(ds)
+    t = style.time_s(ds)
     rho = np.degrees(np.asarray(ds["rho"].values))
     eta = np.asarray(ds["eta"].values)
     eta_units = ds["eta"].attrs.get("units", "m")
     names = _appendage_names(ds)
-    fig, axes = _figure(3, 2, size=(13.0, 9.0))
+    fig, axes = style.figure(3, 2, size=(13.0, 9.0))
     _shade_torque(axes, ds)
     for k in range(3):
         for j, name in enumerate(names):
-            style = {"color": f"C{j % 10}", "linestyle": _APPENDAGE_STYLES[j % 4],
+            look = {"color": f"C{j % 10}", "linestyle": _APPENDAGE_STYLES[j % 4],
                      "linewidth": 1.0, "label": name}  # fmt: skip
-            _line(axes[k, 0], t, rho[:, j, k], **style)
-            _line(axes[k, 1], t, eta[:, j, k], **style)
-        axes[k, 0].set_ylabel(f"ρ_{_AXES[k]} [deg]")
-        axes[k, 0].set_title(f"root rotation ρ_{_AXES[k]} ({_ROOT_ROTATION[k]})", fontsize=10)
-        axes[k, 1].set_ylabel(f"η_{_AXES[k]} [{eta_units}]")
-        axes[k, 1].set_title(f"root translation η_{_AXES[k]}", fontsize=10)
+            style.line(axes[k, 0], t, rho[:, j, k], **look)
+            style.line(axes[k, 1], t, eta[:, j, k], **look)
+        axes[k, 0].set_ylabel(f"ρ_{style.AXES[k]} [deg]")
+        axes[k, 0].set_title(f"root rotation ρ_{style.AXES[k]} ({_ROOT_ROTATION[k]})", fontsize=10)
+        axes[k, 1].set_ylabel(f"η_{style.AXES[k]} [{eta_units}]")
+        axes[k, 1].set_title(f"root translation η_{style.AXES[k]}", fontsize=10)
     handles, _ = axes[0, 0].get_legend_handles_labels()
     fig.legend(handles=[*handles, *_torque_patches(ds)], loc="outside lower center",
                ncols=len(handles) + 1, fontsize=9)  # fmt: skip
-    _finish_time_axis(axes, t)
-    _suptitle(fig, ds, "Appendage root-joint deformations (mount frame)")
+    style.finish_time_axis(axes, t)
+    style.suptitle(fig, ds, "Appendage root-joint deformations (mount frame)")
     return fig
 
 
@@ -447,26 +422,32 @@ def plot_tip_displacement(ds: xr.Dataset) -> Figure:
     -------
     matplotlib.figure.Figure
     """
-    t = _time(ds)
+    t = style.time_s(ds)
     tips = 1e3 * np.asarray(ds["tip_displacement"].values)  # m -> mm
     names = _appendage_names(ds)
     n = len(names)
-    fig, axes = _figure(max(n, 1), 1, size=(11.0, 2.0 + 2.6 * max(n, 1)))
+    fig, axes = style.figure(max(n, 1), 1, size=(11.0, 2.0 + 2.6 * max(n, 1)))
     _shade_torque(axes, ds)
     for j, name in enumerate(names):
         ax = axes[j, 0]
         norm = np.linalg.norm(tips[:, j], axis=-1)
         for k in range(3):
-            _line(ax, t, tips[:, j, k], color=_AXIS_COLOURS[k], linewidth=0.9,
-                  label=f"δ_{_AXES[k]}")  # fmt: skip
-        _line(ax, t, norm, color="black", linewidth=0.8, linestyle=":", label="|δ|")
+            style.line(
+                ax,
+                t,
+                tips[:, j, k],
+                color=style.AXIS_COLOURS[k],
+                linewidth=0.9,
+                label=f"δ_{style.AXES[k]}",
+            )
+        style.line(ax, t, norm, color="black", linewidth=0.8, linestyle=":", label="|δ|")
         ax.set_ylabel("tip displacement [mm]")
         ax.set_title(f"{name}  (peak |δ| = {norm.max():.3g} mm)", fontsize=10)
     handles, _ = axes[0, 0].get_legend_handles_labels()
     fig.legend(handles=[*handles, *_torque_patches(ds)], loc="outside lower center",
                ncols=len(handles) + 1, fontsize=9)  # fmt: skip
-    _finish_time_axis(axes, t)
-    _suptitle(fig, ds, "Panel tip displacement (mount frame)")
+    style.finish_time_axis(axes, t)
+    style.suptitle(fig, ds, "Panel tip displacement (mount frame)")
     return fig
 
 
@@ -491,19 +472,32 @@ def plot_angular_momentum(ds: xr.Dataset) -> Figure:
     -------
     matplotlib.figure.Figure
     """
-    t = _time(ds)
+    t = style.time_s(ds)
     H = np.asarray(ds["angular_momentum"].values)
     rigid = np.asarray(ds["rigid_angular_momentum"].values)
     units = ds["angular_momentum"].attrs.get("units", "N m s")
-    fig, axes = _figure(2, 1, size=(11.0, 8.0), height_ratios=(1.3, 1))
+    fig, axes = style.figure(2, 1, size=(11.0, 8.0), height_ratios=(1.3, 1))
     _shade_torque(axes, ds)
     for k in range(3):
-        c = _AXIS_COLOURS[k]
-        _line(axes[0, 0], t, H[:, k], color=c, linewidth=1.6, label=f"H_{_AXES[k]} total")
-        _line(axes[0, 0], t, rigid[:, k], color=c, linewidth=1.0, linestyle="--",
-              label=f"(J(η)ω)_{_AXES[k]} rigid part")  # fmt: skip
-        _line(axes[1, 0], t, H[:, k] - rigid[:, k], color=c, linewidth=0.9,
-              label=f"H_{_AXES[k]} − (J(η)ω)_{_AXES[k]}")  # fmt: skip
+        c = style.AXIS_COLOURS[k]
+        style.line(axes[0, 0], t, H[:, k], color=c, linewidth=1.6, label=f"H_{style.AXES[k]} total")
+        style.line(
+            axes[0, 0],
+            t,
+            rigid[:, k],
+            color=c,
+            linewidth=1.0,
+            linestyle="--",
+            label=f"(J(η)ω)_{style.AXES[k]} rigid part",
+        )
+        style.line(
+            axes[1, 0],
+            t,
+            H[:, k] - rigid[:, k],
+            color=c,
+            linewidth=0.9,
+            label=f"H_{style.AXES[k]} − (J(η)ω)_{style.AXES[k]}",
+        )
     free_from = _free_from(ds)
     drift = ""
     if free_from is not None and free_from < t[-1]:
@@ -520,8 +514,8 @@ def plot_angular_momentum(ds: xr.Dataset) -> Figure:
                       ncols=2)  # fmt: skip
     handles, _ = axes[1, 0].get_legend_handles_labels()
     axes[1, 0].legend(handles=handles, loc="upper right", fontsize=8)
-    _finish_time_axis(axes, t)
-    _suptitle(fig, ds, "Angular momentum about the system centre of mass (frame N)")
+    style.finish_time_axis(axes, t)
+    style.suptitle(fig, ds, "Angular momentum about the system centre of mass (frame N)")
     return fig
 
 
@@ -545,29 +539,45 @@ def plot_energy(ds: xr.Dataset) -> Figure:
     -------
     matplotlib.figure.Figure
     """
-    t = _time(ds)
+    t = style.time_s(ds)
     kinetic = np.asarray(ds["kinetic_energy"].values)
     elastic = np.asarray(ds["elastic_energy"].values)
     total = np.asarray(ds["total_energy"].values)
     work = np.asarray(ds["work_in"].values)
     dissipated = np.asarray(ds["dissipated_energy"].values)
     error = np.abs(np.asarray(ds["energy_balance_error"].values))
-    fig, axes = _figure(2, 1, size=(11.0, 8.5))
+    fig, axes = style.figure(2, 1, size=(11.0, 8.5))
     _shade_torque(axes, ds)
     macro, micro = axes[0, 0], axes[1, 0]
-    _line(macro, t, work, color="black", linewidth=2.4, alpha=0.35, label="W_in (work of τ)")
-    _line(macro, t, total, color="tab:purple", linewidth=1.2, label="E = T + U")
-    _line(macro, t, kinetic, color="tab:blue", linewidth=1.0, linestyle="--", label="T kinetic")
-    _line(macro, t, elastic, color="tab:orange", linewidth=1.0, label="U elastic")
-    _line(macro, t, dissipated, color="tab:red", linewidth=1.0, label="W_diss (dissipated)")
+    style.line(macro, t, work, color="black", linewidth=2.4, alpha=0.35, label="W_in (work of τ)")
+    style.line(macro, t, total, color="tab:purple", linewidth=1.2, label="E = T + U")
+    style.line(
+        macro, t, kinetic, color="tab:blue", linewidth=1.0, linestyle="--", label="T kinetic"
+    )
+    style.line(macro, t, elastic, color="tab:orange", linewidth=1.0, label="U elastic")
+    style.line(macro, t, dissipated, color="tab:red", linewidth=1.0, label="W_diss (dissipated)")
     macro.set_ylabel("energy [J]")
     macro.set_title("macro: energy flow (linear scale)", fontsize=10)
 
-    _line(micro, t, _positive(elastic), color="tab:orange", linewidth=0.9, label="U elastic")
-    _line(micro, t, _positive(dissipated), color="tab:red", linewidth=0.9,
-          label="W_diss (dissipated)")  # fmt: skip
-    _line(micro, t, _positive(error), color="black", linewidth=0.9,
-          label="|E − E(0) − W_in + W_diss| (integration error)")  # fmt: skip
+    style.line(
+        micro, t, style.positive(elastic), color="tab:orange", linewidth=0.9, label="U elastic"
+    )
+    style.line(
+        micro,
+        t,
+        style.positive(dissipated),
+        color="tab:red",
+        linewidth=0.9,
+        label="W_diss (dissipated)",
+    )
+    style.line(
+        micro,
+        t,
+        style.positive(error),
+        color="black",
+        linewidth=0.9,
+        label="|E − E(0) − W_in + W_diss| (integration error)",
+    )
     micro.set_yscale("log")
     micro.set_ylabel("energy [J] (log)")
     relative = error.max() / max(np.abs(work).max(), np.abs(total).max(), np.finfo(float).tiny)
@@ -577,8 +587,8 @@ def plot_energy(ds: xr.Dataset) -> Figure:
     for ax in (macro, micro):
         handles, _ = ax.get_legend_handles_labels()
         ax.legend(handles=[*handles, *_torque_patches(ds)], loc="center right", fontsize=8)
-    _finish_time_axis(axes, t)
-    _suptitle(fig, ds, "Energy balance")
+    style.finish_time_axis(axes, t)
+    style.suptitle(fig, ds, "Energy balance")
     return fig
 
 
@@ -621,16 +631,16 @@ def plot_spectrogram(
     -------
     matplotlib.figure.Figure
     """
-    if axis not in _AXES:
+    if axis not in style.AXES:
         raise ValueError(f"axis must be one of x, y, z, got {axis!r}")
-    k = _AXES.index(axis)
-    t = _time(ds)
+    k = style.AXES.index(axis)
+    t = style.time_s(ds)
     units = ds["omega_dot"].attrs.get("units", "rad/s^2")
     fig = Figure(figsize=(12.0, 6.5), layout="constrained")
     grid = fig.add_gridspec(1, 2, width_ratios=(4, 1))
     ax = fig.add_subplot(grid[0])
     side = fig.add_subplot(grid[1], sharey=ax)
-    _suptitle(fig, ds, f"Spectrogram of the hub angular acceleration ω̇_{axis} (detrended)")
+    style.suptitle(fig, ds, f"Spectrogram of the hub angular acceleration ω̇_{axis} (detrended)")
     ax.set_ylim(0.0, max_hz)
     ax.set_ylabel("frequency [Hz]")
     ax.set_xlabel("time t [s] (window centre)")
@@ -744,8 +754,6 @@ def write_openloop_figures(
     list of Path
         The files written.
     """
-    out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
     makers = {
         "attitude": lambda: plot_attitude(ds),
         "quaternion": lambda: plot_quaternion(ds),
@@ -757,11 +765,4 @@ def write_openloop_figures(
         "energy": lambda: plot_energy(ds),
         "spectrogram": lambda: plot_spectrogram(ds, analysis, "z"),
     }
-    written = []
-    for name in OPENLOOP_FIGURES:
-        fig = makers[name]()
-        path = out / f"{name}.png"
-        fig.savefig(path, dpi=dpi)
-        fig.clear()
-        written.append(path)
-    return written
+    return style.write_figures(out_dir, OPENLOOP_FIGURES, lambda name: makers[name](), dpi=dpi)

@@ -44,16 +44,8 @@ from pydantic import ValidationError
 
 from flexsat.analysis.requirements import settling_time
 from flexsat.control.quaternion import quaternion_error, target_quaternion
+from flexsat.plots import style
 from flexsat.plots.openloop import (
-    _AXES,
-    _AXIS_COLOURS,
-    _EULER,
-    _figure,
-    _finish_time_axis,
-    _line,
-    _positive,
-    _suptitle,
-    _time,
     plot_energy,
     plot_root_deformation,
     plot_tip_displacement,
@@ -79,7 +71,6 @@ __all__ = [
     "write_slew_figures",
 ]
 
-_BAND = "tab:green"  # requirement bands
 _SURFACE_MIN = "tab:purple"  # sliding surface with Lambda_min (far from the target)
 _SURFACE_MAX = "tab:orange"  # sliding surface with Lambda_max (near the target)
 _SOFT_LIMIT = "tab:orange"  # RF * T_max
@@ -239,28 +230,28 @@ def plot_slew_attitude(ds: xr.Dataset) -> Figure:
     matplotlib.figure.Figure
     """
     scenario = _scenario(ds)
-    t = _time(ds)
+    t = style.time_s(ds)
     euler = np.asarray(ds["euler_deg"].values)
     rate = np.degrees(np.asarray(ds["omega"].values))
     target = scenario.target_euler_deg
-    fig, axes = _figure(2, 1, size=(11.0, 8.0), height_ratios=(1.4, 1))
+    fig, axes = style.figure(2, 1, size=(11.0, 8.0), height_ratios=(1.4, 1))
     angles, rates = axes[0, 0], axes[1, 0]
     for k in range(3):
-        name, symbol = _EULER[k]
-        colour = _AXIS_COLOURS[k]
-        _line(angles, t, euler[:, k], color=colour, linewidth=1.4, label=f"{symbol} ({name})")
+        name, symbol = style.EULER[k]
+        colour = style.AXIS_COLOURS[k]
+        style.line(angles, t, euler[:, k], color=colour, linewidth=1.4, label=f"{symbol} ({name})")
         angles.axhline(target[k], color=colour, linestyle="--", linewidth=1.0,
                        label=f"{symbol} target = {target[k]:.4g} deg")  # fmt: skip
-        _line(rates, t, rate[:, k], color=colour, linewidth=1.0, label=f"ω_{_AXES[k]}")
-    final = ", ".join(f"{_EULER[k][1]} = {euler[-1, k]:.5g}" for k in range(3))
+        style.line(rates, t, rate[:, k], color=colour, linewidth=1.0, label=f"ω_{style.AXES[k]}")
+    final = ", ".join(f"{style.EULER[k][1]} = {euler[-1, k]:.5g}" for k in range(3))
     angles.set_title(f"ZYX Euler angles (final: {final} deg)", fontsize=10)
     angles.set_ylabel("Euler angle [deg]")
     angles.legend(loc="center right", fontsize=8, ncols=2)
     rates.set_title("body rates ω (frame B)", fontsize=10)
     rates.set_ylabel("ω [deg/s]")
     rates.legend(loc="upper right", fontsize=8)
-    _finish_time_axis(axes, t)
-    _suptitle(fig, ds, f"Slew attitude ({_law_name(ds)}): Euler angles and body rates")
+    style.finish_time_axis(axes, t)
+    style.suptitle(fig, ds, f"Slew attitude ({_law_name(ds)}): Euler angles and body rates")
     return fig
 
 
@@ -277,26 +268,26 @@ def plot_slew_quaternion(ds: xr.Dataset) -> Figure:
     matplotlib.figure.Figure
     """
     scenario = _scenario(ds)
-    t = _time(ds)
+    t = style.time_s(ds)
     quat = np.asarray(ds["quaternion"].values)
     q_d = _target_quaternion(ds, scenario)
     finite = np.isfinite(quat).all(axis=1)
     if finite.any() and np.dot(quat[finite][-1], q_d) < 0.0:
         q_d = -q_d  # the same attitude, drawn on the side the trajectory ends on
-    fig, axes = _figure(1, 1, size=(11.0, 5.5))
+    fig, axes = style.figure(1, 1, size=(11.0, 5.5))
     ax = axes[0, 0]
-    colours = ("black", *_AXIS_COLOURS)
+    colours = ("black", *style.AXIS_COLOURS)
     names = ("q0 (scalar)", "q1 (x)", "q2 (y)", "q3 (z)")
     for k in range(4):
-        _line(ax, t, quat[:, k], color=colours[k], linewidth=1.4, label=names[k])
+        style.line(ax, t, quat[:, k], color=colours[k], linewidth=1.4, label=names[k])
         ax.axhline(q_d[k], color=colours[k], linestyle="--", linewidth=1.0,
                    label=f"q_d,{k} = {q_d[k]:.4f}")  # fmt: skip
     ax.set_ylabel("quaternion component [-]")
     ax.set_ylim(-1.1, 1.1)
     ax.set_title("solid: attitude q (frame B to N); dashed: target q_d", fontsize=10)
     ax.legend(loc="lower right", fontsize=8, ncols=4)
-    _finish_time_axis(axes, t)
-    _suptitle(fig, ds, f"Slew attitude quaternion ({_law_name(ds)}), scalar first")
+    style.finish_time_axis(axes, t)
+    style.suptitle(fig, ds, f"Slew attitude quaternion ({_law_name(ds)}), scalar first")
     return fig
 
 
@@ -307,22 +298,28 @@ def _requirement_panel(ax: Axes, t: np.ndarray, values: np.ndarray, bound: float
                        unit: str, label: str, colour: str) -> None:  # fmt: skip
     """``values`` on a log axis with the band below ``bound`` shaded and its settling time."""
     values = np.asarray(values, dtype=float)
-    _line(ax, t, _positive(values), color=colour, linewidth=1.1, label=label)
+    style.line(ax, t, style.positive(values), color=colour, linewidth=1.1, label=label)
     ax.set_yscale("log")
     positive = values[np.isfinite(values) & (values > 0.0)]
     top = max(float(positive.max()) if positive.size else bound, bound)
     bottom = min(float(positive.min()) if positive.size else bound, bound)
     bottom = max(bottom, bound * 1e-4, top * 1e-12)
     lo, hi = bottom / 3.0, top * 3.0
-    ax.axhspan(lo, bound, color=_BAND, alpha=0.15, linewidth=0,
-               label=f"{tag} band: < {bound:.3g} {unit}")  # fmt: skip
-    ax.axhline(bound, color=_BAND, linewidth=1.4, label=f"{tag}: {bound:.3g} {unit}")
+    ax.axhspan(
+        lo,
+        bound,
+        color=style.BAND,
+        alpha=0.15,
+        linewidth=0,
+        label=f"{tag} band: < {bound:.3g} {unit}",
+    )
+    ax.axhline(bound, color=style.BAND, linewidth=1.4, label=f"{tag}: {bound:.3g} {unit}")
     ax.set_ylim(lo, hi)
     settle = settling_time(t, values, bound)
     final = values[np.isfinite(values)][-1] if np.isfinite(values).any() else math.nan
     verdict = "PASS" if final < bound else "FAIL"
     if not math.isnan(settle):
-        ax.axvline(settle, color=_BAND, linestyle=":", linewidth=1.4)
+        ax.axvline(settle, color=style.BAND, linestyle=":", linewidth=1.4)
         ax.annotate(f"in the {tag} band for good\nfrom t = {settle:.4g} s", xy=(settle, bound),
                     xytext=(8, 18), textcoords="offset points", fontsize=9, color="darkgreen",
                     arrowprops={"arrowstyle": "->", "color": "darkgreen"})  # fmt: skip
@@ -351,16 +348,16 @@ def plot_pointing(ds: xr.Dataset) -> Figure:
     matplotlib.figure.Figure
     """
     req = _scenario(ds).requirements
-    t = _time(ds)
-    fig, axes = _figure(2, 1, size=(11.0, 8.5))
+    t = style.time_s(ds)
+    fig, axes = style.figure(2, 1, size=(11.0, 8.5))
     _requirement_panel(axes[0, 0], t, ds["pointing_error_deg"].values, req.pointing_deg, "R1",
                        "deg", "pointing error 2 asin|q_v,e|", "black")  # fmt: skip
     axes[0, 0].set_ylabel("pointing error [deg] (log)")
     _requirement_panel(axes[1, 0], t, ds["rate_error_deg_s"].values, req.jitter_deg_s, "R2",
                        "deg/s", "residual rate |ω − ω_d|", "tab:blue")  # fmt: skip
     axes[1, 0].set_ylabel("residual rate |ω| [deg/s] (log)")
-    _finish_time_axis(axes, t)
-    _suptitle(fig, ds, f"Pointing requirements ({_law_name(ds)}): R1 pointing, R2 jitter")
+    style.finish_time_axis(axes, t)
+    style.suptitle(fig, ds, f"Pointing requirements ({_law_name(ds)}): R1 pointing, R2 jitter")
     return fig
 
 
@@ -449,7 +446,7 @@ def plot_phase_plane(ds: xr.Dataset) -> Figure:
     """
     scenario = _scenario(ds)
     surface = _surface(ds, scenario)
-    t = _time(ds)
+    t = style.time_s(ds)
     qv = attitude_error_vector(ds)
     omega = np.asarray(ds["omega"].values, dtype=float)
     step = max(1, math.ceil(t.size / _PHASE_POINTS))
@@ -465,10 +462,10 @@ def plot_phase_plane(ds: xr.Dataset) -> Figure:
     t_near = float(t[near[0]]) if near.size else float(t[-1])
     zoom = t_s >= t_near
 
-    fig, axes = _figure(2, 3, size=(15.0, 9.5), sharex=False)
+    fig, axes = style.figure(2, 3, size=(15.0, 9.5), sharex=False)
     lines = None
     for k in range(3):
-        a = _AXES[k]
+        a = style.AXES[k]
         lines = _phase_panel(axes[0, k], qv_s[:, k], omega_s[:, k], t_s, norm, surface,
                              f"start (t = {t[0]:.3g} s)")  # fmt: skip
         axes[0, k].set_title(f"axis {a}: whole slew", fontsize=10)
@@ -487,7 +484,7 @@ def plot_phase_plane(ds: xr.Dataset) -> Figure:
         label = "time t [s]" + (" (later: end colour)" if extend == "max" else "")
         fig.colorbar(lines, ax=axes.ravel().tolist(), shrink=0.85, extend=extend, label=label)
     what = "sliding surfaces s = ω_e + Λ q_v,e = 0" if surface else "no sliding surface"
-    _suptitle(fig, ds, f"Phase plane q_v,e – ω_e per axis ({_law_name(ds)}, {what})")
+    style.suptitle(fig, ds, f"Phase plane q_v,e – ω_e per axis ({_law_name(ds)}, {what})")
     return fig
 
 
@@ -509,12 +506,12 @@ def plot_sliding_variables(ds: xr.Dataset) -> Figure:
     matplotlib.figure.Figure
     """
     surface = _surface(ds, _scenario(ds))
-    t = _time(ds)
+    t = style.time_s(ds)
     s = np.asarray(ds["sliding_variable"].values, dtype=float)
-    fig, axes = _figure(3, 1, size=(11.0, 9.0))
+    fig, axes = style.figure(3, 1, size=(11.0, 9.0))
     for k in range(3):
         ax = axes[k, 0]
-        ax.set_ylabel(f"s_{_AXES[k]} [rad/s]")
+        ax.set_ylabel(f"s_{style.AXES[k]} [rad/s]")
         if surface is None or not _recorded(s[:, k]):
             _no_data(ax, _no_surface(ds, "sliding variable"))
             continue
@@ -524,19 +521,21 @@ def plot_sliding_variables(ds: xr.Dataset) -> Figure:
         for sign in (1.0, -1.0):
             ax.axhline(sign * phi, color=_SURFACE_MAX, linestyle="--", linewidth=1.2,
                        label="±Φ" if sign > 0 else None)  # fmt: skip
-        _line(ax, t, s[:, k], color=_AXIS_COLOURS[k], linewidth=1.0, label=f"s_{_AXES[k]}")
+        style.line(
+            ax, t, s[:, k], color=style.AXIS_COLOURS[k], linewidth=1.0, label=f"s_{style.AXES[k]}"
+        )
         ax.set_yscale("symlog", linthresh=phi * 1e-3, linscale=1.0)
         top = max(float(np.nanmax(np.abs(s[:, k]))), phi) * 3.0
         ax.set_ylim(-top, top)
         inside = settling_time(t, np.abs(s[:, k]), phi)
         if not math.isnan(inside):
             ax.axvline(inside, color="0.3", linestyle=":", linewidth=1.2)
-        ax.set_title(f"s_{_AXES[k]}: {_settled('inside the boundary layer for good', inside)}; "
-                     f"final {s[-1, k]:.3g} rad/s", fontsize=10)  # fmt: skip
+        settled = _settled("inside the boundary layer for good", inside)
+        ax.set_title(f"s_{style.AXES[k]}: {settled}; final {s[-1, k]:.3g} rad/s", fontsize=10)
     _figure_legend(fig, axes)
-    _finish_time_axis(axes, t)
+    style.finish_time_axis(axes, t)
     scale = "symlog, linear within ±Φ/1000"
-    _suptitle(fig, ds, f"Sliding variables s = ω_e + Λ q_v,e ({_law_name(ds)}; {scale})")
+    style.suptitle(fig, ds, f"Sliding variables s = ω_e + Λ q_v,e ({_law_name(ds)}; {scale})")
     return fig
 
 
@@ -561,21 +560,21 @@ def plot_adaptation(ds: xr.Dataset) -> Figure:
     surface = _surface(ds, scenario)
     act = scenario.actuator
     ceiling = act.reduction_factor * act.t_max_nm
-    t = _time(ds)
+    t = style.time_s(ds)
     lam = np.asarray(ds["lambda_act"].values, dtype=float)
     jk = np.asarray(ds["jk"].values, dtype=float)
-    fig, axes = _figure(2, 1, size=(11.0, 8.0))
+    fig, axes = style.figure(2, 1, size=(11.0, 8.0))
     top, bottom = axes[0, 0], axes[1, 0]
     top.set_ylabel("Λ_act [rad/s]")
     bottom.set_ylabel("JK [N m]")
     if surface is None or not _recorded(lam):
         for ax in (top, bottom):
             _no_data(ax, _no_surface(ds, "slope or robust gain"))
-        _finish_time_axis(axes, t)
-        _suptitle(fig, ds, f"Adaptation of Λ and JK ({_law_name(ds)})")
+        style.finish_time_axis(axes, t)
+        style.suptitle(fig, ds, f"Adaptation of Λ and JK ({_law_name(ds)})")
         return fig
 
-    _line(top, t, lam, color="black", linewidth=1.4, label="Λ_act")
+    style.line(top, t, lam, color="black", linewidth=1.4, label="Λ_act")
     top.axhline(surface.lambda_min, color=_SURFACE_MIN, linestyle="--", linewidth=1.2,
                 label=f"Λ_min = {surface.lambda_min:.3g} rad/s")  # fmt: skip
     if surface.lambda_max != surface.lambda_min:
@@ -603,7 +602,14 @@ def plot_adaptation(ds: xr.Dataset) -> Figure:
     top.legend(loc="center right", fontsize=8)
 
     for k in range(3):
-        _line(bottom, t, jk[:, k], color=_AXIS_COLOURS[k], linewidth=1.0, label=f"JK_{_AXES[k]}")
+        style.line(
+            bottom,
+            t,
+            jk[:, k],
+            color=style.AXIS_COLOURS[k],
+            linewidth=1.0,
+            label=f"JK_{style.AXES[k]}",
+        )
     bottom.axhline(surface.jk_min, color="black", linestyle="--", linewidth=1.2,
                    label=f"floor JK_min = {surface.jk_min:.4g} N m")  # fmt: skip
     bottom.axhline(ceiling, color=_SOFT_LIMIT, linestyle="--", linewidth=1.2,
@@ -615,8 +621,8 @@ def plot_adaptation(ds: xr.Dataset) -> Figure:
     bottom.set_title("robust torque gain per axis: the torque budget left to the robust term",
                      fontsize=10)  # fmt: skip
     bottom.legend(loc="upper right", fontsize=8)
-    _finish_time_axis(axes, t)
-    _suptitle(fig, ds, f"Adaptation of the slope Λ and the robust gain JK ({_law_name(ds)})")
+    style.finish_time_axis(axes, t)
+    style.suptitle(fig, ds, f"Adaptation of the slope Λ and the robust gain JK ({_law_name(ds)})")
     return fig
 
 
@@ -646,24 +652,37 @@ def plot_disturbances(ds: xr.Dataset) -> Figure:
     scenario = _scenario(ds)
     surface = _surface(ds, scenario)
     dist, act = scenario.disturbances, scenario.actuator
-    t = _time(ds)
+    t = style.time_s(ds)
     cmd = np.asarray(ds["tau_cmd"].values, dtype=float)
     total = np.asarray(ds["tau_applied"].values, dtype=float) - cmd
     slosh = dist.sloshing_ratio * cmd * np.sin(2.0 * np.pi * dist.sloshing_hz * t)[:, None]
     shortfall = (np.asarray(act.gain) - 1.0) * cmd
     constant = np.asarray(dist.environment_nm) + np.asarray(dist.residual_nm)
     slosh_label = f"sloshing {dist.sloshing_ratio:.3g}·τ_cmd·sin(2π·{dist.sloshing_hz:.3g} Hz·t)"
-    fig, axes = _figure(3, 1, size=(11.0, 9.0))
+    fig, axes = style.figure(3, 1, size=(11.0, 9.0))
     for k in range(3):
         ax = axes[k, 0]
-        a = _AXES[k]
+        a = style.AXES[k]
         ax.axhline(constant[k], color="tab:green", linestyle="--", linewidth=1.3,
                    label="environment + residual (constant)")  # fmt: skip
-        _line(ax, t, slosh[:, k], color="tab:blue", linewidth=0.9, label=slosh_label)
-        _line(ax, t, shortfall[:, k], color="tab:orange", linewidth=1.0,
-              label="actuator-gain shortfall −(1 − G)·τ_cmd")  # fmt: skip
-        _line(ax, t, total[:, k], color="black", linewidth=0.9, alpha=0.8,
-              label="total τ_applied − τ_cmd")  # fmt: skip
+        style.line(ax, t, slosh[:, k], color="tab:blue", linewidth=0.9, label=slosh_label)
+        style.line(
+            ax,
+            t,
+            shortfall[:, k],
+            color="tab:orange",
+            linewidth=1.0,
+            label="actuator-gain shortfall −(1 − G)·τ_cmd",
+        )
+        style.line(
+            ax,
+            t,
+            total[:, k],
+            color="black",
+            linewidth=0.9,
+            alpha=0.8,
+            label="total τ_applied − τ_cmd",
+        )
         ax.set_ylabel(f"d_{a} [N m]")
         peak = float(np.nanmax(np.abs(total[:, k]))) if _recorded(total[:, k]) else math.nan
         title = (f"axis {a}: constant {constant[k]:.3g} N m, G_{a} = {act.gain[k]:.3g}; "
@@ -672,8 +691,8 @@ def plot_disturbances(ds: xr.Dataset) -> Figure:
             title += f" (robust-gain floor JK_min = {surface.jk_min:.4g} N m)"
         ax.set_title(title, fontsize=10)
     _figure_legend(fig, axes, ncols=4)
-    _finish_time_axis(axes, t)
-    _suptitle(fig, ds, "Disturbance torques of the actuator model (frame B)")
+    style.finish_time_axis(axes, t)
+    style.suptitle(fig, ds, "Disturbance torques of the actuator model (frame B)")
     return fig
 
 
@@ -694,31 +713,39 @@ def plot_torque_limits(ds: xr.Dataset) -> Figure:
     """
     act = _scenario(ds).actuator
     soft = act.reduction_factor * act.t_max_nm
-    t = _time(ds)
+    t = style.time_s(ds)
     cmd = np.asarray(ds["tau_cmd"].values, dtype=float)
     applied = np.asarray(ds["tau_applied"].values, dtype=float)
-    fig, axes = _figure(3, 1, size=(11.0, 9.0))
+    fig, axes = style.figure(3, 1, size=(11.0, 9.0))
     r3 = bool(np.all(np.abs(applied[np.isfinite(applied)]) <= act.t_max_nm * (1 + 1e-12)))
     for k in range(3):
         ax = axes[k, 0]
-        a = _AXES[k]
+        a = style.AXES[k]
         for sign in (1.0, -1.0):
             ax.axhline(sign * act.t_max_nm, color=_HARD_LIMIT, linewidth=1.4,
                        label=f"±T_max = {act.t_max_nm:.3g} N m" if sign > 0 else None)  # fmt: skip
             ax.axhline(sign * soft, color=_SOFT_LIMIT, linestyle="--", linewidth=1.2,
                        label=f"±RF·T_max = {soft:.3g} N m" if sign > 0 else None)  # fmt: skip
-        _line(ax, t, cmd[:, k], color="black", linewidth=1.6, label="τ_cmd (commanded)")
-        _line(ax, t, applied[:, k], color="tab:cyan", linewidth=1.0,
-              label="τ_applied (delivered to the hub)")  # fmt: skip
+        style.line(ax, t, cmd[:, k], color="black", linewidth=1.6, label="τ_cmd (commanded)")
+        style.line(
+            ax,
+            t,
+            applied[:, k],
+            color="tab:cyan",
+            linewidth=1.0,
+            label="τ_applied (delivered to the hub)",
+        )
         ax.set_ylim(-1.15 * act.t_max_nm, 1.15 * act.t_max_nm)
         ax.set_ylabel(f"τ_{a} [N m]")
         ax.set_title(f"axis {a}: peak |τ_cmd| = {np.nanmax(np.abs(cmd[:, k])):.4g} N m, "
                      f"|τ_applied| = {np.nanmax(np.abs(applied[:, k])):.4g} N m",
                      fontsize=10)  # fmt: skip
     _figure_legend(fig, axes, ncols=4)
-    _finish_time_axis(axes, t)
+    style.finish_time_axis(axes, t)
     verdict = "PASS" if r3 else "FAIL"
-    _suptitle(fig, ds, f"Control torque against its limits (R3 {verdict}: |τ_applied| ≤ T_max)")
+    style.suptitle(
+        fig, ds, f"Control torque against its limits (R3 {verdict}: |τ_applied| ≤ T_max)"
+    )
     return fig
 
 
@@ -740,33 +767,40 @@ def plot_torque_breakdown(ds: xr.Dataset) -> Figure:
     """
     act = _scenario(ds).actuator
     soft = act.reduction_factor * act.t_max_nm
-    t = _time(ds)
+    t = style.time_s(ds)
     parts = (
         ("tau_gyro", "tab:green", "τ_gyro = ω × Jω"),
         ("tau_guide", "tab:blue", "τ_guide = −JΛ q̇_v,e (equivalent)"),
         ("tau_rob", "tab:red", "τ_rob = −JK sat(s/Φ)"),
     )
-    fig, axes = _figure(3, 1, size=(11.0, 9.0))
+    fig, axes = style.figure(3, 1, size=(11.0, 9.0))
     cmd = np.asarray(ds["tau_cmd"].values, dtype=float)
     for k in range(3):
         ax = axes[k, 0]
-        a = _AXES[k]
+        a = style.AXES[k]
         for sign in (1.0, -1.0):
             ax.axhline(sign * soft, color=_SOFT_LIMIT, linestyle=":", linewidth=1.0,
                        label=f"±RF·T_max = {soft:.3g} N m" if sign > 0 else None)  # fmt: skip
         recorded = [name for name, _, _ in parts if _recorded(ds[name].values[:, k])]
         for name, colour, label in parts:
             if name in recorded:
-                _line(ax, t, ds[name].values[:, k], color=colour, linewidth=1.0, label=label)
+                style.line(ax, t, ds[name].values[:, k], color=colour, linewidth=1.0, label=label)
         if not recorded:
             _no_data(ax, "breakdown not recorded for a plain-Python controller")
-        _line(ax, t, cmd[:, k], color="black", linewidth=0.9, linestyle="--",
-              label="τ_cmd (sum, clipped)")  # fmt: skip
+        style.line(
+            ax,
+            t,
+            cmd[:, k],
+            color="black",
+            linewidth=0.9,
+            linestyle="--",
+            label="τ_cmd (sum, clipped)",
+        )
         ax.set_ylabel(f"τ_{a} [N m]")
         ax.set_title(f"axis {a}", fontsize=10)
     _figure_legend(fig, axes, ncols=5)
-    _finish_time_axis(axes, t)
-    _suptitle(fig, ds, f"Breakdown of the commanded torque ({_law_name(ds)})")
+    style.finish_time_axis(axes, t)
+    style.suptitle(fig, ds, f"Breakdown of the commanded torque ({_law_name(ds)})")
     return fig
 
 
@@ -785,26 +819,33 @@ def plot_flex_torque(ds: xr.Dataset) -> Figure:
     -------
     matplotlib.figure.Figure
     """
-    t = _time(ds)
+    t = style.time_s(ds)
     applied = np.asarray(ds["tau_applied"].values, dtype=float)
     flex = np.asarray(ds["tau_flex"].values, dtype=float)
     net = np.asarray(ds["tau_net"].values, dtype=float)
-    fig, axes = _figure(3, 1, size=(11.0, 9.0))
+    fig, axes = style.figure(3, 1, size=(11.0, 9.0))
     for k in range(3):
         ax = axes[k, 0]
-        a = _AXES[k]
-        _line(ax, t, applied[:, k], color="0.6", linewidth=1.0, label="τ_applied (actuators)")
-        _line(ax, t, net[:, k], color="tab:blue", linewidth=1.1,
-              label="τ_net = τ_applied + τ_flex")  # fmt: skip
-        _line(ax, t, flex[:, k], color="tab:orange", linewidth=1.0,
-              label="τ_flex (appendage joints on the hub)")  # fmt: skip
+        a = style.AXES[k]
+        style.line(ax, t, applied[:, k], color="0.6", linewidth=1.0, label="τ_applied (actuators)")
+        style.line(
+            ax, t, net[:, k], color="tab:blue", linewidth=1.1, label="τ_net = τ_applied + τ_flex"
+        )
+        style.line(
+            ax,
+            t,
+            flex[:, k],
+            color="tab:orange",
+            linewidth=1.0,
+            label="τ_flex (appendage joints on the hub)",
+        )
         ax.set_ylabel(f"τ_{a} [N m]")
         ax.set_title(f"axis {a}: peak |τ_flex| = {np.nanmax(np.abs(flex[:, k])):.3g} N m, "
                      f"peak |τ_net| = {np.nanmax(np.abs(net[:, k])):.3g} N m",
                      fontsize=10)  # fmt: skip
     _figure_legend(fig, axes)
-    _finish_time_axis(axes, t)
-    _suptitle(fig, ds, "Flexible torque against net torque on the hub (frame B)")
+    style.finish_time_axis(axes, t)
+    style.suptitle(fig, ds, "Flexible torque against net torque on the hub (frame B)")
     return fig
 
 
@@ -872,13 +913,4 @@ def write_slew_figures(ds: xr.Dataset, out_dir: str | Path, *, dpi: int = 120) -
         The files written.
     """
     _scenario(ds)  # fail early on a dataset that is not a slew
-    out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
-    written = []
-    for name in SLEW_FIGURES:
-        fig = _MAKERS[name](ds)
-        path = out / f"{name}.png"
-        fig.savefig(path, dpi=dpi)
-        fig.clear()
-        written.append(path)
-    return written
+    return style.write_figures(out_dir, SLEW_FIGURES, lambda name: _MAKERS[name](ds), dpi=dpi)

@@ -1,0 +1,159 @@
+"""The one plot style of flexsat: colours, figure layout, time axes, and writing figures.
+
+Every figure module draws with these helpers, so the figure sets of an open-loop
+run, a slew, a campaign and a comparison look alike. Figures are created directly
+(:class:`matplotlib.figure.Figure`, no pyplot), so nothing here needs a display or
+changes the global backend.
+
+- :func:`figure`: a constrained-layout figure and its 2-D array of axes.
+- :func:`time_s`: the time coordinate of a result dataset [s].
+- :func:`suptitle`: the figure title, the run's title below it and a failure notice.
+- :func:`line`, :func:`envelope`: a time series, thinned to a min/max envelope when long.
+- :func:`finish_time_axis`: grid, time limits and the time label of the bottom row.
+- :func:`positive`: values masked to the positive ones, for a log axis.
+- :func:`save_figure`, :func:`write_figures`: PNG files, one helper for every writer.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Iterable
+from pathlib import Path
+
+import numpy as np
+import xarray as xr
+from matplotlib.axes import Axes
+from matplotlib.figure import Figure
+
+__all__ = [
+    "AXES",
+    "AXIS_COLOURS",
+    "BAND",
+    "EULER",
+    "MAX_LINE_POINTS",
+    "envelope",
+    "figure",
+    "finish_time_axis",
+    "line",
+    "positive",
+    "save_figure",
+    "suptitle",
+    "time_s",
+    "write_figures",
+]
+
+AXES = ("x", "y", "z")
+"""Body-axis names, in component order."""
+AXIS_COLOURS = ("tab:red", "tab:green", "tab:blue")
+"""One colour per body axis x, y, z."""
+EULER = (("roll", "φ"), ("pitch", "θ"), ("yaw", "ψ"))
+"""Name and thesis symbol of each ZYX Euler angle, in component order."""
+BAND = "tab:green"
+"""Colour of requirement bands and settling markers."""
+MAX_LINE_POINTS = 8000
+"""Longer records are drawn as a min/max envelope of about this many points."""
+
+
+def figure(nrows: int, ncols: int = 1, *, size=(11.0, 7.5), sharex=True, **grid) -> tuple:
+    """A constrained-layout figure of ``size`` inches and its axes, shape (nrows, ncols).
+
+    Extra keywords go to the grid (``height_ratios=...``).
+    """
+    fig = Figure(figsize=size, layout="constrained")
+    axes = fig.subplots(nrows, ncols, sharex=sharex, squeeze=False, gridspec_kw=grid or None)
+    return fig, axes
+
+
+def time_s(ds: xr.Dataset) -> np.ndarray:
+    """The time coordinate of a result dataset as float64 [s]."""
+    return np.asarray(ds["time"].values, dtype=float)
+
+
+def suptitle(fig: Figure, ds: xr.Dataset, what: str) -> None:
+    """Title ``what``, the run's title below it, and the failure message of a failed run."""
+    scenario = ds.attrs.get("title", "flexsat open-loop run")
+    text = f"{what}\n{scenario}"
+    if ds.attrs.get("status", "ok") != "ok":
+        text += f"  —  FAILED: {ds.attrs.get('message', '')}"
+    fig.suptitle(text, fontsize=11)
+
+
+def envelope(t: np.ndarray, y: np.ndarray, max_points: int = MAX_LINE_POINTS) -> tuple:
+    """(t, y) thinned to about ``max_points`` keeping each bucket's min and max.
+
+    Unlike plain striding this keeps the peaks of an oscillation faster than the
+    thinned sampling, so the drawn envelope is the true one.
+    """
+    n = t.size
+    if n <= max_points:
+        return t, y
+    size = int(np.ceil(2 * n / max_points))
+    m = n // size
+    head = y[: m * size].reshape(m, size)
+    base = np.arange(m) * size
+    lo = base + np.argmin(head, axis=1)
+    hi = base + np.argmax(head, axis=1)
+    keep = np.concatenate([np.sort(np.stack([lo, hi], axis=1), axis=1).ravel(),
+                           np.arange(m * size, n)])  # fmt: skip
+    return t[keep], y[keep]
+
+
+def line(ax: Axes, t: np.ndarray, y: np.ndarray, **kw):
+    """Plot ``y`` against ``t`` on ``ax`` (through :func:`envelope`); returns the line."""
+    return ax.plot(*envelope(t, np.asarray(y, dtype=float)), **kw)[0]
+
+
+def finish_time_axis(axes, t: np.ndarray) -> None:
+    """Grid and time limits on every axis, the time label on the bottom row."""
+    for ax in np.ravel(axes):
+        ax.grid(True, color="0.85", linewidth=0.6)
+        ax.set_xlim(t[0], t[-1])
+    for ax in np.atleast_2d(axes)[-1]:
+        ax.set_xlabel("time t [s]")
+
+
+def positive(values: np.ndarray) -> np.ndarray:
+    """Values with non-positive entries masked (NaN), for a log axis."""
+    values = np.asarray(values, dtype=float)
+    return np.where(values > 0.0, values, np.nan)
+
+
+def save_figure(fig: Figure, path: str | Path, *, dpi: int) -> Path:
+    """Write ``fig`` to ``path`` (format from the suffix) and release its drawing.
+
+    Parameters
+    ----------
+    fig : Figure
+        The figure; it is cleared afterwards to free its memory.
+    path : str or Path
+        Target file; its folder is created if missing, an existing file replaced.
+    dpi : int
+        Resolution [dots per inch].
+
+    Returns
+    -------
+    Path
+        The file written.
+    """
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(path, dpi=dpi)
+    fig.clear()
+    return path
+
+
+def write_figures(
+    out_dir: str | Path, names: Iterable[str], draw: Callable[[str], Figure], *, dpi: int
+) -> list[Path]:
+    """Draw and write one PNG per name, ``<out_dir>/<name>.png``, in the order given.
+
+    Figures are drawn one at a time (``draw(name)``) and released once written, so
+    a long set never holds more than one figure in memory.
+
+    Returns
+    -------
+    list of Path
+        The files written.
+    """
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    return [save_figure(draw(name), out / f"{name}.png", dpi=dpi) for name in names]
