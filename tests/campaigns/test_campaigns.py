@@ -41,8 +41,8 @@ def _short(name: str, duration: float) -> CampaignDefinition:
     [("sensitivity", 12), ("montecarlo-critical", 25), ("deployment-shock", 32)],
 )
 def test_presets_expand_to_the_thesis_case_counts(name, count):
-    # DESIGN.md: 11 one-at-a-time cases + nominal; 24 crossed corners + nominal;
-    # 8 rate vectors x 4 deformations.
+    # docs/campaigns.md: 11 one-at-a-time cases + nominal; 24 crossed corners + nominal
+    # ('The critical-case set'); 8 rate vectors x 4 deformations ('The deployment-shock set').
     assert len(resolve_cases(load_campaign(name), nominal())) == count
 
 

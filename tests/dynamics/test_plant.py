@@ -136,7 +136,7 @@ def test_angular_momentum_rate_equals_external_torque(any_plant):
 
 def test_flex_torque_two_ways(any_plant):
     # tau_flex from the joint wrench equals J_hub w_dot + w x J_hub w - tau_applied
-    # (the hub's own Euler equation, DESIGN.md); both exact -> round-off.
+    # (the hub's own Euler equation; docs/model.md, 'Conventions'); both exact -> round-off.
     rng = np.random.default_rng(7)
     for _ in range(N_STATES):
         q, qd = random_state(any_plant, rng)

@@ -52,7 +52,7 @@ def test_torque_never_exceeds_the_limits(thesis_slew):
 def test_adaptation_timeline(thesis_metrics):
     # Section 5.1.3: Lambda leaves its minimum "around 30 s" (the error crosses
     # theta_th = 5 deg) and the pointing error stays inside R1 "from t ~ 45 s".
-    # Our run: 27.3 s and 37 s. The law as written is the spec (DESIGN.md); the
+    # Our run: 27.3 s and 37 s. The law as written is the spec (docs/control.md); the
     # thesis's plot timing is read off a figure, so the bounds are generous and the
     # gap on R1 is reported in docs/control.md.
     assert 20.0 < thesis_metrics["lambda_switch_time_s"] < 35.0
@@ -134,8 +134,9 @@ def test_random_disturbance_draws_are_seeded_and_bounded(nominal_plant):
 
 
 def test_residual_disturbance_switch_still_meets_r1(nominal_plant):
-    # DESIGN.md: injecting the 0.005 N m residual roughly doubles the steady-state
-    # error, still inside R1 (measured 4.6e-3 deg against 2.3e-3 deg).
+    # docs/control.md, 'Disturbances forced to maximum': injecting the 0.005 N m
+    # residual roughly doubles the steady-state error, still inside R1 (measured
+    # 4.6e-3 deg against 2.3e-3 deg).
     scenario = SlewScenario.model_validate({"disturbances": {"residual_nm": [0.005] * 3}})
     metrics = _metrics(run_slew(nominal_plant, scenario), scenario)
     assert metrics["r1_pass"] and metrics["r3_pass"]

@@ -82,8 +82,8 @@ def test_rk4_agrees_with_tight_dop853(nominal_plant, thesis_run):
     # to ~1e-8 (attitude, deformations, energy: measured 7e-9 deg, 2e-10 rad,
     # 8e-11 J). Rates, accelerations and tau_flex also carry the ~100 Hz joint
     # modes, which RK4 at 1 ms (omega dt ~ 0.6) integrates with a small phase and
-    # amplitude error (DESIGN.md): measured 2e-7 rad/s, 4e-5 rad/s^2 and 1.2e-3 N m
-    # (0.07 % of the 1.58 N m peak); bounds at about 5x those.
+    # amplitude error (docs/model.md, 'Integration'): measured 2e-7 rad/s,
+    # 4e-5 rad/s^2 and 1.2e-3 N m (0.07 % of the 1.58 N m peak); bounds at about 5x those.
     reference = run_openloop(nominal_plant, OpenLoopScenario(solver="dop853"))
     a, b = thesis_run.dataset, reference.dataset
     np.testing.assert_allclose(a["euler_deg"], b["euler_deg"], rtol=0, atol=5e-8)
@@ -241,8 +241,9 @@ def test_other_topologies_simulate(any_plant):
 
 
 def test_recorded_flex_torque_two_ways(nominal_plant, thesis_run):
-    # DESIGN.md: tau_flex from the joint wrench equals J_hub w_dot + w x J_hub w -
-    # tau_applied (the hub's Euler equation), on every record; round-off only.
+    # docs/model.md, 'Conventions': tau_flex from the joint wrench equals
+    # J_hub w_dot + w x J_hub w - tau_applied (the hub's Euler equation), on every
+    # record; round-off only.
     ds = thesis_run.dataset
     J = nominal_plant.hub_J
     w, w_dot = ds["omega"].values, ds["omega_dot"].values

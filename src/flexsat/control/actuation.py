@@ -1,9 +1,9 @@
 """Actuator and disturbance model between the command and the plant (compiled).
 
-Order (DESIGN.md): tau_cmd is already clipped to the software limit RF * T_max by
-the law; the applied torque is clip_Tmax(G_act tau_cmd + environment + sloshing +
-residual), with sloshing_i = ratio * tau_cmd,i * sin(2 pi f t) (proportional to the
-effort, so it vanishes at rest).
+Order (docs/control.md, 'Torque budget, Λ and saturation order'): tau_cmd is already
+clipped to the software limit RF * T_max by the law; the applied torque is
+clip_Tmax(G_act tau_cmd + environment + sloshing + residual), with sloshing_i =
+ratio * tau_cmd,i * sin(2 pi f t) (proportional to the effort, so it vanishes at rest).
 
 Packed parameters ``dist`` (DIST_SIZE,): actuator gain (3), environment torque (3)
 [N m], sloshing ratio [-], sloshing frequency [Hz], residual torque (3) [N m], T_max

@@ -104,8 +104,8 @@ class ActuatorConfig(_Frozen):
 
 
 class DisturbanceConfig(_Frozen):
-    """Disturbance torques: "forced to maximum" (the nominal validation, DESIGN.md) or
-    one random draw within the same bounds.
+    """Disturbance torques: "forced to maximum" (the nominal validation; docs/control.md,
+    'Disturbances forced to maximum') or one random draw within the same bounds.
 
     In ``mode = "random"`` each run draws, from ``seed``: the actuator gain per axis
     uniformly within 1 +- |1 - G_act|, the environment and residual torques per axis

@@ -24,7 +24,7 @@ Kinematics are exact: the panel rotation relative to its mount is
 R_MP = Rz(rho_z) Ry(rho_y) Rx(rho_x) with relative body rate S(rho) rho_dot (the
 thesis writes rho_dot, the small-angle form of eq. 2.31; see docs/model.md).
 
-Structure (DESIGN.md, "Exploit the structure"): M(q) is block-arrow, and since each
+Structure (docs/model.md, 'Exploit the structure'): M(q) is block-arrow, and since each
 appendage hangs on a full 6-DOF joint the Schur complement of the appendage
 blocks equals the bare hub's mass matrix. :func:`accelerations` therefore needs
 no factorization: each panel's absolute accelerations follow from its own
