@@ -1,8 +1,10 @@
 """The reference thesis's published numbers, transcribed once with their sources.
 
-The study report prints them beside flexsat's results; the test suite checks the
-model against them. Each value cites the equation, table, figure or section it was
-read from, and says how it was printed (its precision sets the tests' tolerances).
+The thesis is *Multi-Body Dynamic Modeling and Robust Sliding Mode Control of Flexible
+Satellites*. The study report prints its numbers beside flexsat's results; the test
+suite checks the model against them. Each value cites the equation, table, figure or
+section it was read from, and says how it was printed (its precision sets the tests'
+tolerances).
 """
 
 from __future__ import annotations
