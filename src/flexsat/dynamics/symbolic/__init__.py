@@ -67,11 +67,14 @@ from pathlib import Path
 from flexsat.dynamics.symbolic.cache import (
     _cache_path,
     _cache_subdir,
-    _fingerprint,
-    _write_atomic,
     cache_dir,
     read_model,
+    read_source,
     write_model,
+    write_source,
+)
+from flexsat.dynamics.symbolic.cache import (
+    _write_atomic as _write_atomic,  # re-exported: the cache tests write through it
 )
 from flexsat.dynamics.symbolic.codegen import _generate_source
 from flexsat.dynamics.symbolic.derivation import SymbolicModel, _derive
@@ -210,18 +213,13 @@ def _load_reference(
 ) -> ReferenceModel:
     """The model from the source in ``directory`` if valid, else generated and stored."""
     path = _cache_path(directory, "reference", n_appendages, panel_rates, ".py")
-    if path is not None:
+    source = read_source(path) if path is not None else None
+    if source is not None:
         try:
-            source = path.read_text(encoding="utf-8")
-        except (OSError, UnicodeDecodeError):
+            return ReferenceModel(n_appendages, panel_rates, source, path)
+        except Exception:  # a damaged file: generate again and overwrite it
             pass
-        else:
-            if f"# key: {_fingerprint()}\n" in source:
-                try:
-                    return ReferenceModel(n_appendages, panel_rates, source, path)
-                except Exception:  # a damaged file: generate again and overwrite it
-                    pass
     source = _generate_source(derive(n_appendages, panel_rates))
     if path is not None:
-        _write_atomic(path, source.encode("utf-8"))
+        write_source(path, source)
     return ReferenceModel(n_appendages, panel_rates, source, path)

@@ -110,3 +110,17 @@ def read_model(path: Path) -> SymbolicModel | None:
 def write_model(path: Path, model: SymbolicModel) -> None:
     """Store a derived model at ``path`` (atomically, see :func:`_write_atomic`)."""
     _write_atomic(path, pickle.dumps(model, protocol=pickle.HIGHEST_PROTOCOL))
+
+
+def read_source(path: Path) -> str | None:
+    """The generated source stored at ``path`` if written under the current key, else ``None``."""
+    try:
+        source = path.read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError):  # missing or damaged: the caller generates again
+        return None
+    return source if f"# key: {_fingerprint()}\n" in source else None
+
+
+def write_source(path: Path, source: str) -> None:
+    """Store a generated source at ``path`` (atomically, see :func:`_write_atomic`)."""
+    _write_atomic(path, source.encode("utf-8"))

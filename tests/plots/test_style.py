@@ -1,0 +1,64 @@
+"""The shared plot style (flexsat.plots.style): layout, envelopes, writing files."""
+
+from __future__ import annotations
+
+import numpy as np
+import xarray as xr
+
+from flexsat.plots import style
+
+PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
+
+
+def test_envelope_keeps_every_peak_of_a_fast_oscillation():
+    t = np.linspace(0.0, 10.0, 200_001)
+    y = np.sin(2.0 * np.pi * 37.0 * t) * np.exp(-0.1 * t)
+    tt, yy = style.envelope(t, y, max_points=2000)
+    assert tt.size <= 2200  # about max_points (pairs of min/max plus the tail)
+    assert np.all(np.diff(tt) >= 0.0)  # still a time series
+    # Striding to 2000 points would miss the extremes; min/max buckets keep them exactly.
+    assert yy.max() == y.max() and yy.min() == y.min()
+    short_t, short_y = style.envelope(t[:100], y[:100])
+    assert np.array_equal(short_t, t[:100]) and np.array_equal(short_y, y[:100])  # untouched
+
+
+def test_positive_masks_what_a_log_axis_cannot_show():
+    out = style.positive([1.0, 0.0, -2.0, 3.0])
+    assert np.array_equal(np.isnan(out), [False, True, True, False])
+
+
+def test_time_axis_and_title():
+    ds = xr.Dataset(coords={"time": [0.0, 0.5, 1.0]}, attrs={"title": "run A"})
+    t = style.time_s(ds)
+    fig, axes = style.figure(2, 3)
+    assert axes.shape == (2, 3)
+    style.finish_time_axis(axes, t)
+    assert axes[0, 0].get_xlim() == (0.0, 1.0)
+    assert axes[1, 2].get_xlabel() == "time t [s]" and axes[0, 2].get_xlabel() == ""
+    style.suptitle(fig, ds.assign_attrs(status="failed", message="diverged"), "What")
+    assert fig._suptitle.get_text() == "What\nrun A  —  FAILED: diverged"
+
+
+def test_write_figures_writes_in_order_and_creates_the_folder(tmp_path):
+    drawn = []
+
+    def draw(name):
+        drawn.append(name)
+        fig, axes = style.figure(1, 1, size=(2.0, 2.0))
+        style.line(axes[0, 0], np.arange(3.0), np.arange(3.0))
+        return fig
+
+    out = tmp_path / "a" / "b"
+    written = style.write_figures(out, ("second", "first"), draw, dpi=20)
+    assert drawn == ["second", "first"]
+    assert written == [out / "second.png", out / "first.png"]
+    assert all(p.read_bytes().startswith(PNG_MAGIC) for p in written)
+    assert style.write_figures(tmp_path / "empty", (), draw, dpi=20) == []
+    assert (tmp_path / "empty").is_dir()  # the folder exists even with nothing to draw
+
+
+def test_save_figure_releases_the_figure(tmp_path):
+    fig, axes = style.figure(1, 1, size=(2.0, 2.0))
+    path = style.save_figure(fig, tmp_path / "sub" / "one.png", dpi=20)
+    assert path.read_bytes().startswith(PNG_MAGIC)
+    assert not fig.axes  # cleared once written
