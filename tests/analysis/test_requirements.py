@@ -57,7 +57,7 @@ def synthetic_slew(pointing_deg, rate_deg_s, duration_s=120.0, **requirements) -
             "target_quaternion": TARGET.tolist(),
             "controller": "asmc",
             "wall_time_s": 0.0,
-            "steps": int(round(duration_s / 1e-3)),
+            "steps": round(duration_s / 1e-3),
             "status": "ok",
             "message": "",
         },
