@@ -36,9 +36,7 @@ def synthetic_slew(pointing_deg, rate_deg_s, duration_s=120.0, **requirements) -
     t = np.round(np.arange(0.0, duration_s + 0.5 * RECORD_DT, RECORD_DT), 10)
     pointing, rate = pointing_deg(t), rate_deg_s(t)
     zeros3 = np.zeros((t.size, 3))
-    scenario = SlewScenario.model_validate(
-        {"duration_s": duration_s, "requirements": requirements}
-    )
+    scenario = SlewScenario.model_validate({"duration_s": duration_s, "requirements": requirements})
     return xr.Dataset(
         {
             "pointing_error_deg": ("time", pointing),
