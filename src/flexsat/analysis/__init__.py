@@ -1,8 +1,6 @@
 """Analysis of plants and results: modes, open-loop metrics, spectra, requirement verdicts."""
 
 from flexsat.analysis.modal import (
-    HUB_DOFS,
-    JOINT_DOFS,
     ModalAnalysis,
     Mode,
     dof_names,
@@ -30,9 +28,7 @@ from flexsat.analysis.spectrogram import (
 __all__ = [
     "DEFAULT_OVERLAP",
     "DEFAULT_WINDOW_S",
-    "HUB_DOFS",
     "HUB_ROTATION_DOF",
-    "JOINT_DOFS",
     "ModalAnalysis",
     "Mode",
     "Requirements",
