@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import json
-import time
 from pathlib import Path
 
 import numpy as np
@@ -87,16 +86,13 @@ def _hlines(ax) -> list[float]:
 
 def test_write_all_figures(slew_ds, tmp_path: Path) -> None:
     out = tmp_path / "figures" / "slew"  # created, parents too
-    start = time.perf_counter()
     written = write_slew_figures(slew_ds, out, dpi=60)
-    elapsed = time.perf_counter() - start
     assert len(written) == len(SLEW_FIGURES) == 13
     assert [p.name for p in written] == [f"{name}.png" for name in SLEW_FIGURES]
     assert sorted(out.iterdir()) == sorted(written)
     for path in written:
         assert path.read_bytes()[:8] == PNG_MAGIC, path
         assert path.stat().st_size > 5_000, path
-    assert elapsed < 60.0  # generous: a few seconds on a quiet machine
 
 
 @pytest.mark.parametrize("plot", TIME_FIGURES)
