@@ -125,6 +125,19 @@ def test_pointing_bands_at_the_requirements(slew_ds) -> None:
     assert 0.05 not in _hlines(looser.axes[0])
 
 
+def test_pointing_verdicts_over_the_observation_window(slew_ds) -> None:
+    # The 30 s run ends before the default 90 s deadline: no window observed, FAIL.
+    r1 = plot_pointing(slew_ds).axes[0]
+    assert r1.get_title().startswith("R1 FAIL: the run ends at 30 s, before the 90 s deadline")
+    # A 20 s deadline: the window 20-30 s is shaded, and R1 fails over it (the
+    # error is still above 0.05 deg at 20 s).
+    r1 = plot_pointing(_with_scenario(slew_ds, requirements={"settling_deadline_s": 20.0})).axes[0]
+    assert r1.get_title().startswith("R1 FAIL over 20–30 s: max ")
+    window = [p for p in r1.patches if p.get_label().startswith("observation window")]
+    assert len(window) == 1
+    assert (window[0].get_bbox().x0, window[0].get_bbox().x1) == pytest.approx((20.0, 30.0))
+
+
 def test_torque_limits_from_the_scenario(slew_ds) -> None:
     fig = plot_torque_limits(slew_ds)
     assert {2.0, -2.0, 1.9, -1.9} <= set(_hlines(fig.axes[0]))
