@@ -15,7 +15,8 @@ from flexsat.analysis import (
     slew_metrics,
 )
 from flexsat.control.quaternion import quaternion_error, target_quaternion
-from flexsat.simulate import SlewScenario, run_slew
+from flexsat.errors import ConfigError
+from flexsat.simulate import SlewScenario, load_slew, run_slew
 
 RECORD_DT = 0.01  # [s] the slew's default record interval
 TARGET = target_quaternion((45.0, 45.0, 45.0))
@@ -187,3 +188,13 @@ def test_the_thesis_slew_meets_r1_and_r2_over_the_window(nominal_plant):
     assert metrics["final_pointing_error_deg"] <= metrics["ape_deg"] < 0.01
     assert 0.0 < metrics["rpe_deg"] <= 2.0 * metrics["ape_deg"]
     assert metrics["max_rate_error_deg_s"] < 1e-3
+
+
+def test_the_window_is_set_in_the_slew_toml(tmp_path):
+    path = tmp_path / "slew.toml"
+    path.write_text("[requirements]\nsettling_deadline_s = 70.0\nrpe_window_s = 2.0\n")
+    requirements = load_slew(path).requirements
+    assert (requirements.settling_deadline_s, requirements.rpe_window_s) == (70.0, 2.0)
+    path.write_text("[requirements]\nsettling_deadline_s = 100.0\nwindow_end_s = 80.0\n")
+    with pytest.raises(ConfigError, match=r"requirements.*window_end_s must be > settling"):
+        load_slew(path)
