@@ -208,7 +208,9 @@ def slew_metrics(
     stored = _stored_scenario(ds)
     req = requirements or Requirements.model_validate(stored.get("requirements", {}))
     bands = {"pointing_deg": pointing_deg, "jitter_deg_s": jitter_deg_s}
-    req = req.model_copy(update={k: v for k, v in bands.items() if v is not None})
+    req = Requirements.model_validate(
+        {**req.model_dump(), **{k: v for k, v in bands.items() if v is not None}}
+    )
     if t_max_nm is None:
         t_max_nm = float(stored.get("actuator", {}).get("t_max_nm", 2.0))
     t = ds["time"].values
