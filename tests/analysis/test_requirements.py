@@ -198,3 +198,8 @@ def test_the_window_is_set_in_the_slew_toml(tmp_path):
     path.write_text("[requirements]\nsettling_deadline_s = 100.0\nwindow_end_s = 80.0\n")
     with pytest.raises(ConfigError, match=r"requirements.*window_end_s must be > settling"):
         load_slew(path)
+
+
+def test_a_law_without_lambda_has_no_switch_time():
+    metrics = slew_metrics(synthetic_slew(settles, quiet).drop_vars("lambda_act"))
+    assert np.isnan(metrics["lambda_switch_time_s"]) and metrics["r1_pass"]

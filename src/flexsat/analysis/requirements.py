@@ -203,7 +203,8 @@ def slew_metrics(
         ``rpe_window_s``), ``max_rate_error_deg_s`` the largest residual rate there.
         Settling times are when each quantity enters its band for good (NaN if not
         by the end): ``settling_time_s`` is R1's, ``r2_settling_time_s`` R2's.
-        ``lambda_switch_time_s`` is when Lambda first leaves its initial value.
+        ``lambda_switch_time_s`` is when Lambda first leaves its initial value (NaN
+        if it never does, or the law has no Lambda).
     """
     stored = _stored_scenario(ds)
     req = requirements or Requirements.model_validate(stored.get("requirements", {}))
@@ -226,7 +227,7 @@ def slew_metrics(
     )
     ape = absolute_performance_error(pointing[inside])
     max_rate = absolute_performance_error(jitter[inside])
-    lam = ds["lambda_act"].values
+    lam = ds["lambda_act"].values if "lambda_act" in ds else np.zeros(1)  # laws without Lambda
     applied = np.abs(ds["tau_applied"].values)
     commanded = np.abs(ds["tau_cmd"].values)
     leaves = np.nonzero(lam > lam[0] * (1 + 1e-9))[0]
