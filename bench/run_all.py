@@ -2,7 +2,7 @@
 
 ``python bench/run_all.py`` (what ``make bench`` runs) prints, in this order, the
 tables of bench_dynamics, bench_openloop, bench_slew, bench_scaling, bench_startup,
-bench_campaigns and bench_basilisk (skipped with a line when Basilisk or the script
+bench_campaigns, bench_figures and bench_basilisk (skipped with a line when Basilisk or the script
 is missing), then one table of the performance targets: each target, the measured
 value, and met / not met. A benchmark that fails is reported and the others still
 run; the exit status is then 1.
@@ -38,6 +38,7 @@ BENCHMARKS = (
     "bench_scaling",
     "bench_startup",
     "bench_campaigns",
+    "bench_figures",
     "bench_basilisk",
 )
 OPTIONAL = {"bench_basilisk"}  # skipped, not failed, when it or its dependency is missing

@@ -51,7 +51,7 @@ def run(duration_s: float = 120.0) -> dict:
     scenario = SlewScenario(duration_s=duration_s, control_dt_s=0.01)
     law = QuaternionPID(scenario.target_euler_deg)
     result = run_slew(Plant.from_config(nominal()), scenario, controller=law)
-    return slew_metrics(result.dataset, 0.05, 1e-3, scenario.actuator.t_max_nm)
+    return slew_metrics(result.dataset)  # the requirements of the stored scenario
 
 
 if __name__ == "__main__":

@@ -5,6 +5,10 @@ A rigid hub carries flexible appendages; flexsat models the coupled dynamics
 produces the figures and tables of a design review.
 """
 
+from flexsat._version import package_version
+
+__version__ = package_version()
+
 from flexsat._compiled_cache import drop_stale_caches
 
 drop_stale_caches()  # before any compiled module loads its cache
@@ -12,8 +16,6 @@ drop_stale_caches()  # before any compiled module loads its cache
 from flexsat.config import SatelliteConfig, load_config, nominal  # noqa: E402
 from flexsat.dynamics.plant import Plant  # noqa: E402
 from flexsat.errors import ConfigError, FlexsatError, SimulationError  # noqa: E402
-
-__version__ = "0.1.0"
 
 __all__ = [
     "ConfigError",

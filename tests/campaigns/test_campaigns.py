@@ -14,6 +14,7 @@ import pytest
 from flexsat.campaigns import (
     CAMPAIGN_PRESETS,
     CampaignDefinition,
+    CampaignStore,
     load_campaign,
     resolve_cases,
     run_campaign,
@@ -81,13 +82,28 @@ def test_parametric_uncertainty_cases_meet_r1_and_r2(thesis_campaigns, name):
 
 def test_deployment_shock_stays_stable_and_meets_r1(thesis_campaigns):
     # Thesis section 5.3: no case goes unstable and R1 is met; R2 "is not satisfied
-    # during the first 120 seconds" there. We report the R2 rate rather than
-    # assert it (the number is in the closing note).
+    # during the first 120 seconds" there. Judged over the 90-120 s window, 13 of
+    # the 32 cases meet R2 (24 did when only the last sample counted); we report
+    # the rate rather than assert it (docs/control.md).
     summary = summarize(thesis_campaigns["deployment-shock"])
     assert summary["failed"] == 0
     assert summary["r1_pass_rate"] == 1.0
     assert summary["r3_pass_rate"] == 1.0
     assert 0.0 <= summary["r2_pass_rate"] <= 1.0
+
+
+def test_rows_carry_the_verdicts_over_the_window(thesis_campaigns):
+    # Each row states its observation window and its APE/RPE, and its R2 verdict
+    # is the residual rate's maximum over that window, not its last sample.
+    rows = CampaignStore(thesis_campaigns["deployment-shock"]).rows()
+    rates = summarize(thesis_campaigns["deployment-shock"])["r2_pass_rate"]
+    assert rates == sum(r["metrics"]["max_rate_error_deg_s"] < 1e-3 for r in rows) / len(rows)
+    for row in rows:
+        metrics = row["metrics"]
+        assert metrics["observation_window_s"] == [90.0, 120.0]
+        assert metrics["ape_deg"] >= metrics["final_pointing_error_deg"]
+        assert metrics["rpe_deg"] >= 0.0
+        assert metrics["r1_pass"] == (metrics["ape_deg"] < 0.05)
 
 
 def test_local_and_dask_give_identical_rows(tmp_path):

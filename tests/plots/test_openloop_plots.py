@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import io
-import time
 from pathlib import Path
 
 import numpy as np
@@ -53,16 +52,13 @@ def openloop_analysis(openloop_plant: Plant) -> ModalAnalysis:
 
 def test_write_all_figures(openloop_ds, openloop_analysis, tmp_path: Path) -> None:
     out = tmp_path / "figures" / "openloop"  # created, parents too
-    start = time.perf_counter()
     written = write_openloop_figures(openloop_ds, openloop_analysis, out)
-    elapsed = time.perf_counter() - start
     assert len(written) == len(OPENLOOP_FIGURES) == 9
     assert [p.name for p in written] == [f"{name}.png" for name in OPENLOOP_FIGURES]
     assert sorted(out.iterdir()) == sorted(written)
     for path in written:
         assert path.read_bytes()[:8] == PNG_MAGIC, path
         assert path.stat().st_size > 10_000, path
-    assert elapsed < 60.0  # generous: a few seconds on a quiet machine
 
 
 def test_figures_without_analysis(openloop_ds) -> None:

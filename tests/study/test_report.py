@@ -101,3 +101,12 @@ def test_the_report_is_self_contained(report, quick_study):
                for src in parser.images)  # fmt: skip
     assert not re.search(r"""(src|href)=["']?(https?:|//|file:)""", text)
     assert "flexsat " + manifest["flexsat_version"] in text
+
+
+def test_the_slew_states_how_r1_and_r2_are_judged(report):
+    # The verdicts are over a stated window; its bounds are a cell of the slew's JSON.
+    _, text, parser = report
+    assert "R1 and R2 are judged over an observation window" in text
+    shown = {(c["data-source"], c["data-path"]) for c in parser.cells}
+    for key in ("observation_window_s", "ape_deg", "rpe_deg", "rpe_window_s"):
+        assert ("slew/asmc/metrics.json", key) in shown, key

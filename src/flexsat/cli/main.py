@@ -7,6 +7,7 @@ exit code 2, never a traceback.
 from __future__ import annotations
 
 import json
+import math
 import shutil
 import sys
 from pathlib import Path
@@ -34,8 +35,11 @@ app = typer.Typer(
     no_args_is_help=True,
     add_completion=False,
     pretty_exceptions_enable=False,
+    rich_markup_mode=None,  # help texts are plain: "[s]" is a unit, not Rich markup
 )
-config_app = typer.Typer(help="Inspect and copy satellite configurations.", no_args_is_help=True)
+config_app = typer.Typer(
+    help="Inspect and copy satellite configurations.", no_args_is_help=True, rich_markup_mode=None
+)
 app.add_typer(config_app, name="config")
 
 _console = Console()
@@ -158,16 +162,19 @@ def openloop(
     _announce_compilation()
     plant = Plant.from_config(load_config(config))
     chosen = load_scenario(scenario)
-    overrides = {
-        key: value
-        for key, value in (("duration_s", duration), ("dt_s", dt), ("solver", solver))
-        if value is not None
-    }
-    if dt is not None and chosen.record_dt_s % dt > 1e-12 * chosen.record_dt_s:
-        overrides["record_dt_s"] = max(dt, round(chosen.record_dt_s / dt) * dt)
+    given = {"--duration": duration, "--dt": dt, "--solver": solver}
+    fields = {"--duration": "duration_s", "--dt": "dt_s", "--solver": "solver"}
+    overrides = {fields[option]: value for option, value in given.items() if value is not None}
+    # A valid step that does not divide the record interval moves the record interval
+    # to a multiple of it; an invalid step is left to the model to refuse.
+    record = chosen.record_dt_s
+    if dt is not None and 0.0 < dt < math.inf and record % dt > 1e-12 * record:
+        overrides["record_dt_s"] = max(dt, round(record / dt) * dt)
     if overrides:
         chosen = validate_config(
-            {**chosen.model_dump(), **overrides}, source="options", model=OpenLoopScenario
+            {**chosen.model_dump(), **overrides},
+            source=_options(given),
+            model=OpenLoopScenario,
         )
     result, metrics = fly_openloop(plant, chosen, out, progress=None if not json_output else False)
     if json_output:
@@ -220,8 +227,12 @@ def slew(
     if controller is not None and controller != "all":
         overrides["controller"] = {"kind": controller}
     if overrides:
+        given = {"--duration": duration, "--target-euler-deg": target_euler_deg,
+                 "--controller": controller}  # fmt: skip
         chosen = validate_config(
-            {**chosen.model_dump(by_alias=True), **overrides}, source="options", model=SlewScenario
+            {**chosen.model_dump(by_alias=True), **overrides},
+            source=_options(given),
+            model=SlewScenario,
         )
     if controller == "all":
         kinds = ("asmc", "smc", "pd")
@@ -425,6 +436,11 @@ def study(
     if failed:
         _errors.print(f"[bold red]error:[/] failed parts: {', '.join(failed)}", highlight=False)
         raise typer.Exit(1)
+
+
+def _options(given: dict) -> str:
+    """The options the user gave, to name them in a validation message."""
+    return ", ".join(option for option, value in given.items() if value is not None)
 
 
 def _parse_triple(text: str, option: str) -> list[float]:

@@ -8,7 +8,7 @@ from importlib import resources
 from pathlib import Path
 from typing import Any
 
-from pydantic import BaseModel, ValidationError
+from pydantic import BaseModel, Tag, ValidationError
 
 from flexsat.config.models import SatelliteConfig
 from flexsat.errors import ConfigError
@@ -107,24 +107,31 @@ def _location(loc: tuple[Any, ...]) -> str:
 
 
 def _known_keys(model: type[BaseModel], loc: tuple[Any, ...]) -> list[str]:
-    """Field names of the (sub)model at ``loc``, for unknown-key suggestions."""
-    current: Any = model
+    """Field names of the (sub)model at ``loc``, for unknown-key suggestions.
+
+    A discriminated union (the controller's ``kind``) puts the member's tag in the
+    error path (``controller.asmc.gain``): that segment selects the member.
+    """
+    candidates: list[tuple[str | None, type[BaseModel]]] = [(None, model)]
     for part in loc:
         if isinstance(part, int):
             continue
-        field = current.model_fields.get(part) if hasattr(current, "model_fields") else None
-        if field is None:
+        models = [m for _, m in candidates]
+        if any(part in m.model_fields for m in models):
+            candidates = [member for m in models if part in m.model_fields
+                          for member in _members(m.model_fields[part].annotation)]  # fmt: skip
+        else:
+            candidates = [(tag, m) for tag, m in candidates if tag == part]
+        if not candidates:
             return []
-        current = _model_of(field.annotation)
-    return sorted(current.model_fields) if hasattr(current, "model_fields") else []
+    return sorted({name for _, m in candidates for name in m.model_fields})
 
 
-def _model_of(annotation: Any) -> Any:
-    """The BaseModel inside an annotation such as ``list[Model]`` or ``Model | None``."""
+def _members(annotation: Any) -> list[tuple[str | None, type[BaseModel]]]:
+    """(tag, model) of every BaseModel inside an annotation such as ``list[Model]``,
+    ``Model | None`` or a tagged union; the tag is the member's pydantic ``Tag``, if any."""
     if isinstance(annotation, type) and issubclass(annotation, BaseModel):
-        return annotation
-    for arg in getattr(annotation, "__args__", ()):
-        found = _model_of(arg)
-        if found is not None:
-            return found
-    return None
+        return [(None, annotation)]
+    tag = next((m.tag for m in getattr(annotation, "__metadata__", ()) if isinstance(m, Tag)), None)
+    return [(tag or inner, m) for arg in getattr(annotation, "__args__", ())
+            for inner, m in _members(arg)]  # fmt: skip

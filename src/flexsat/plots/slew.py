@@ -42,7 +42,7 @@ from matplotlib.figure import Figure
 from matplotlib.ticker import MaxNLocator
 from pydantic import ValidationError
 
-from flexsat.analysis.requirements import settling_time
+from flexsat.analysis.requirements import settling_time, slew_metrics
 from flexsat.control.quaternion import quaternion_error, target_quaternion
 from flexsat.plots import style
 from flexsat.plots.openloop import (
@@ -295,8 +295,11 @@ def plot_slew_quaternion(ds: xr.Dataset) -> Figure:
 
 
 def _requirement_panel(ax: Axes, t: np.ndarray, values: np.ndarray, bound: float, tag: str,
-                       unit: str, label: str, colour: str) -> None:  # fmt: skip
-    """``values`` on a log axis with the band below ``bound`` shaded and its settling time."""
+                       unit: str, label: str, colour: str,
+                       verdict: tuple[tuple[float, float], bool, float]) -> None:  # fmt: skip
+    """``values`` on a log axis with the band below ``bound`` shaded, its settling time and
+    the observation window with the verdict over it: ``verdict`` = (window, passed, the
+    largest value in the window)."""
     values = np.asarray(values, dtype=float)
     style.line(ax, t, style.positive(values), color=colour, linewidth=1.1, label=label)
     ax.set_yscale("log")
@@ -316,15 +319,23 @@ def _requirement_panel(ax: Axes, t: np.ndarray, values: np.ndarray, bound: float
     ax.axhline(bound, color=style.BAND, linewidth=1.4, label=f"{tag}: {bound:.3g} {unit}")
     ax.set_ylim(lo, hi)
     settle = settling_time(t, values, bound)
-    final = values[np.isfinite(values)][-1] if np.isfinite(values).any() else math.nan
-    verdict = "PASS" if final < bound else "FAIL"
+    (start, end), passed, worst = verdict
+    if start < t[-1]:  # a run that ends before the deadline has no window to shade
+        ax.axvspan(start, min(end, t[-1]), color="0.85", alpha=0.5, linewidth=0,
+                   label=f"observation window {start:.4g}–{end:.4g} s")  # fmt: skip
     if not math.isnan(settle):
         ax.axvline(settle, color=style.BAND, linestyle=":", linewidth=1.4)
         ax.annotate(f"in the {tag} band for good\nfrom t = {settle:.4g} s", xy=(settle, bound),
                     xytext=(8, 18), textcoords="offset points", fontsize=9, color="darkgreen",
                     arrowprops={"arrowstyle": "->", "color": "darkgreen"})  # fmt: skip
-    ax.set_title(f"{tag} {verdict}: final {final:.3g} {unit} (limit {bound:.3g} {unit}), "
-                 f"{_settled('in the band for good', settle)}", fontsize=10)  # fmt: skip
+    if t[-1] < start:
+        judged = f"{tag} FAIL: the run ends at {t[-1]:.4g} s, before the {start:.4g} s deadline"
+    elif t[-1] < end - 1e-6:
+        judged = f"{tag} FAIL: the run stops at {t[-1]:.4g} s, before its window ends ({end:.4g} s)"
+    else:
+        judged = (f"{tag} {'PASS' if passed else 'FAIL'} over {start:.4g}–{end:.4g} s: "
+                  f"max {worst:.3g} {unit} (limit {bound:.3g} {unit})")  # fmt: skip
+    ax.set_title(f"{judged}, {_settled('in the band for good', settle)}", fontsize=10)
     ax.legend(loc="upper right", fontsize=8)
 
 
@@ -335,8 +346,8 @@ def plot_pointing(ds: xr.Dataset) -> Figure:
     scenario's ``requirements.pointing_deg``) shaded green; bottom: the residual
     rate (jitter) |omega - omega_d| with the R2 band (``requirements.jitter_deg_s``).
     Each panel marks the time its quantity enters its band for good
-    (:func:`flexsat.analysis.requirements.settling_time`) and gives the verdict on
-    the final value.
+    (:func:`flexsat.analysis.requirements.settling_time`), shades the observation
+    window and gives the verdict over it (:func:`flexsat.analysis.slew_metrics`).
 
     Parameters
     ----------
@@ -348,13 +359,17 @@ def plot_pointing(ds: xr.Dataset) -> Figure:
     matplotlib.figure.Figure
     """
     req = _scenario(ds).requirements
+    metrics = slew_metrics(ds)
+    window = tuple(metrics["observation_window_s"])
     t = style.time_s(ds)
     fig, axes = style.figure(2, 1, size=(11.0, 8.5))
     _requirement_panel(axes[0, 0], t, ds["pointing_error_deg"].values, req.pointing_deg, "R1",
-                       "deg", "pointing error 2 asin|q_v,e|", "black")  # fmt: skip
+                       "deg", "pointing error 2 asin|q_v,e|", "black",
+                       (window, metrics["r1_pass"], metrics["ape_deg"]))  # fmt: skip
     axes[0, 0].set_ylabel("pointing error [deg] (log)")
     _requirement_panel(axes[1, 0], t, ds["rate_error_deg_s"].values, req.jitter_deg_s, "R2",
-                       "deg/s", "residual rate |ω − ω_d|", "tab:blue")  # fmt: skip
+                       "deg/s", "residual rate |ω − ω_d|", "tab:blue",
+                       (window, metrics["r2_pass"], metrics["max_rate_error_deg_s"]))  # fmt: skip
     axes[1, 0].set_ylabel("residual rate |ω| [deg/s] (log)")
     style.finish_time_axis(axes, t)
     style.suptitle(fig, ds, f"Pointing requirements ({_law_name(ds)}): R1 pointing, R2 jitter")

@@ -11,6 +11,7 @@ from typing import Annotated, ClassVar, Literal
 
 from pydantic import Field, model_validator
 
+from flexsat.analysis.requirements import Requirements
 from flexsat.config.load import read_toml, validate_config
 from flexsat.config.models import Positive, Real, Vector3, _Frozen
 from flexsat.control.config import ActuatorConfig, ASMCConfig, ControllerConfig, DisturbanceConfig
@@ -135,13 +136,6 @@ class OpenLoopScenario(_TimedRun):
         default_factory=lambda: [TorqueSegment(start_s=0.0, end_s=10.0, torque_nm=(0, 0, 1.0))]
     )
     disturbance_torque_nm: Vector3 = Field(_ZERO3, description="constant body torque [N m]")
-
-
-class Requirements(_Frozen):
-    """Pointing requirements checked on every slew (thesis sec. 5.1.1)."""
-
-    pointing_deg: Positive = Field(0.05, description="R1: absolute pointing error [deg]")
-    jitter_deg_s: Positive = Field(1e-3, description="R2: residual rate [deg/s]")
 
 
 class SlewScenario(_TimedRun):

@@ -147,10 +147,7 @@ def fly_slew(plant: Plant, scenario=None, out: Path | None = None, progress=None
 
     scenario = scenario or SlewScenario()
     result = run_slew(plant, scenario, progress=progress)
-    req = scenario.requirements
-    metrics = slew_metrics(
-        result.dataset, req.pointing_deg, req.jitter_deg_s, scenario.actuator.t_max_nm
-    )
+    metrics = slew_metrics(result.dataset)  # the stored scenario's requirements
     if out is not None:
         _write_run(result, metrics, Path(out), figures)
     return result, metrics

@@ -287,18 +287,38 @@ def _openloop(root: Path, outputs: dict, context: dict) -> str:
 def _slew(root: Path, outputs: dict, context: dict) -> str:
     src = _Source(root, outputs["json"])
     verdicts = [
-        ["R1 pointing", src.cell("r1_pass"), src.cell("final_pointing_error_deg"), "< 0.05 deg"],
-        ["R2 jitter", src.cell("r2_pass"), src.cell("final_rate_error_deg_s"), "< 1e-3 deg/s"],
-        ["R3 torque", src.cell("r3_pass"), src.cell("max_abs_torque_nm"), "≤ 2 N m per axis"],
+        ["R1 pointing", src.cell("r1_pass"), src.cell("ape_deg"),
+         "APE < 0.05 deg over the window"],
+        ["R2 jitter", src.cell("r2_pass"), src.cell("max_rate_error_deg_s"),
+         "< 1e-3 deg/s at every record of the window"],
+        ["R3 torque", src.cell("r3_pass"), src.cell("max_abs_torque_nm"),
+         "≤ 2 N m per axis at every record of the run"],
+    ]  # fmt: skip
+    window = [
+        ["observation window (start, end) [s]", src.cell("observation_window_s")],
+        ["RPE over the window [deg]", src.cell("rpe_deg")],
+        ["RPE averaging window [s]", src.cell("rpe_window_s")],
+        ["pointing error at the end [deg]", src.cell("final_pointing_error_deg")],
+        ["residual rate at the end [deg/s]", src.cell("final_rate_error_deg_s")],
     ]
     parts = [
         "<p>The nominal 45/45/45 deg slew with the adaptive sliding-mode law "
         "(thesis section 5.1), 120 s, disturbances at their maximum.</p>",
+        "<p>R1 and R2 are judged over an observation window, from the scenario's "
+        "settling deadline (90 s unless the scenario says otherwise) to the end of the "
+        "run: the pointing error must stay below its band at every record of the window "
+        "(its largest value there is the absolute performance error, APE, of "
+        "ECSS-E-ST-60-10C), and so must the residual rate. A run that ends before the "
+        "window closes fails both. The relative performance error (RPE) is the largest "
+        "distance of the error vector from its mean over consecutive windows of the "
+        "stated duration: the pointing stability, bias removed. R3 holds at every "
+        "record.</p>",
         _table(
-            ["requirement", "verdict", "value at the end / peak", "bound"],
+            ["requirement", "verdict", "value over the window / peak", "bound"],
             verdicts,
             "Requirements (bounds of the thesis scenario)",
         ),
+        _table(["quantity", "flexsat"], window, "Observation window and pointing errors"),
         _table(
             ["metric", "flexsat", "thesis", "thesis source"],
             _compare_rows(src, thesis.CLOSED_LOOP),
