@@ -15,10 +15,11 @@ from typing import Annotated
 import numpy as np
 import typer
 from rich.console import Console
+from rich.markup import escape
 from rich.table import Table
 
 from flexsat import __version__
-from flexsat.errors import FlexsatError
+from flexsat.errors import MAX_MESSAGE_CHARS, FlexsatError, shorten
 from flexsat.jsonable import jsonable
 
 __all__ = ["app", "main"]
@@ -38,7 +39,7 @@ app = typer.Typer(
 config_app = typer.Typer(help="Inspect and copy satellite configurations.", no_args_is_help=True)
 app.add_typer(config_app, name="config")
 
-_console = Console()
+_console = Console(markup=False)  # names and paths are printed as written, never as markup
 _errors = Console(stderr=True, soft_wrap=True)
 
 ConfigOption = Annotated[
@@ -175,7 +176,7 @@ def openloop(
     else:
         _print_metrics(metrics)
     if not result.ok:
-        _errors.print(f"[bold red]error:[/] {result.message}", highlight=False)
+        _print_error(result.message)
         raise typer.Exit(1)
 
 
@@ -253,7 +254,7 @@ def slew(
         _print_metrics(metrics, title=f"Slew with {kind.upper()}")
     if failed:
         for message in failed:
-            _errors.print(f"[bold red]error:[/] {message}", highlight=False)
+            _print_error(message)
         raise typer.Exit(1)
 
 
@@ -423,7 +424,7 @@ def study(
     failed = [part["title"] for part in manifest["parts"] if part["status"] == "failed"]
     _console.print(f"report: {manifest['report']}")
     if failed:
-        _errors.print(f"[bold red]error:[/] failed parts: {', '.join(failed)}", highlight=False)
+        _print_error(f"failed parts: {', '.join(failed)}")
         raise typer.Exit(1)
 
 
@@ -535,5 +536,11 @@ def main() -> None:
     try:
         app()
     except FlexsatError as exc:
-        _errors.print(f"[bold red]error:[/] {exc}", highlight=False)
-        sys.exit(2)
+        _print_error(str(exc))
+        sys.exit(exc.exit_code)
+
+
+def _print_error(message: str) -> None:
+    """One error line on stderr; the message is plain text (never read as markup)."""
+    _errors.print(f"[bold red]error:[/] {escape(shorten(message, MAX_MESSAGE_CHARS))}",
+                  highlight=False)  # fmt: skip

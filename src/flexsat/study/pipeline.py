@@ -20,6 +20,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from rich.console import Console
+from rich.markup import escape
 
 from flexsat import __version__
 from flexsat.config.models import SatelliteConfig
@@ -264,5 +265,5 @@ def _announce(console: Console, part: Part, entry: dict) -> None:
     style = {"ok": "green", "failed": "bold red", "skipped": "yellow"}[entry["status"]]
     line = f"[{style}]{entry['status']:>7}[/] {part.title} ({entry['wall_time_s']:.1f} s)"
     if entry["status"] != "ok":
-        line += f": {entry['error']}"
+        line += f": {escape(entry['error'])}"
     console.print(line, highlight=False)
