@@ -18,9 +18,13 @@ Workers are started with the ``spawn`` method: they share nothing with the paren
 
 from __future__ import annotations
 
+import contextlib
+import ctypes
+import ctypes.util
 import multiprocessing
 import os
 import signal
+import sys
 import threading
 import time
 from collections import deque
@@ -32,6 +36,7 @@ __all__ = ["LocalPool"]
 _PARENT_POLL_S = 0.2  # how often a worker checks that its parent is alive
 _GRACE_S = 1.0  # time given to a worker to exit on SIGTERM before SIGKILL
 _ATTEMPTS = 2  # runs of an item whose worker died before it is given up
+_PR_SET_PDEATHSIG = 1  # prctl(2) option: signal sent to this process when its parent dies
 
 
 class LocalPool:
@@ -133,6 +138,7 @@ class _Worker:
 def _serve(conn, function: Callable, parent_pid: int) -> None:
     """Worker loop: run each received item, send the result back; exit with the parent."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # the parent decides what Ctrl-C stops
+    _die_with_parent()
     threading.Thread(target=_exit_with_parent, args=(parent_pid,), daemon=True).start()
     while True:
         try:
@@ -140,6 +146,19 @@ def _serve(conn, function: Callable, parent_pid: int) -> None:
         except (EOFError, OSError):  # the parent closed the pipe
             return
         conn.send(function(item))
+
+
+def _die_with_parent() -> None:
+    """On Linux, have the kernel send SIGKILL to this worker when its parent dies.
+
+    Immediate even while the worker holds the GIL (compiling, in a compiled loop);
+    elsewhere :func:`_exit_with_parent` alone watches the parent.
+    """
+    if not sys.platform.startswith("linux"):
+        return
+    with contextlib.suppress(OSError, AttributeError):
+        libc = ctypes.CDLL(ctypes.util.find_library("c") or "libc.so.6", use_errno=True)
+        libc.prctl(_PR_SET_PDEATHSIG, signal.SIGKILL)
 
 
 def _exit_with_parent(parent_pid: int) -> None:

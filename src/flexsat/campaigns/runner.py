@@ -239,22 +239,26 @@ def run_campaign(
         todo = [case for case in cases if case.case_id not in done]
         columns = (TextColumn(f"campaign {definition.name}"), BarColumn(), MofNCompleteColumn(),
                    TextColumn("failed {task.fields[failed]}"), TimeRemainingColumn())  # fmt: skip
-        with Progress(*columns, disable=not progress, transient=True) as bar, _interruptible():
+        interrupts = _Interrupts()
+        with Progress(*columns, disable=not progress, transient=True) as bar, interrupts:
             task = bar.add_task("cases", total=len(cases), completed=len(done), failed=0)
             try:
                 for row in execute(todo):
                     history = row.pop(HISTORY_KEY, None)
-                    if history is not None:  # before the case: a stored case has its history
-                        store.write_history(row["case_id"], history, status=row["status"])
-                    store.write_case(row)
+                    with interrupts.deferred():  # a signal never cuts a write in half
+                        if history is not None:  # before the case: a stored case has its history
+                            store.write_history(row["case_id"], history, status=row["status"])
+                        store.write_case(row)
                     failed += row["status"] != "ok"
                     bar.update(task, advance=1, failed=failed)
             except _Interrupted as stop:
-                raise CampaignInterrupted(
+                interrupted = CampaignInterrupted(
                     f"campaign {definition.name} interrupted ({stop.name}): "
                     f"{_stored(store, cases)} of {len(cases)} cases are stored in {store.root}; "
                     "run the same command with --resume to finish it",
-                ) from None
+                )
+                interrupted.exit_code = 128 + stop.signum  # the shell's convention
+                raise interrupted from None
             except OSError as exc:
                 raise FlexsatError(
                     f"cannot write to the campaign store {store.root}: {exc.strerror or exc}; "
@@ -285,23 +289,45 @@ class _Interrupted(BaseException):
         self.signum, self.name = signum, signal.Signals(signum).name
 
 
-@contextlib.contextmanager
-def _interruptible() -> Iterator[None]:
-    """Turn SIGINT and SIGTERM into :class:`_Interrupted` while the block runs."""
-    def handler(signum, frame):
+class _Interrupts:
+    """While active, SIGINT and SIGTERM raise :class:`_Interrupted` in the main thread.
+
+    Inside :meth:`deferred` (the store's writes, whose libraries hold locks) a signal
+    is kept and raised at the end of the block instead.
+    """
+
+    def __init__(self) -> None:
+        self.pending: int | None = None
+        self.deferring = False
+        self.previous: dict = {}
+
+    def _handler(self, signum, frame) -> None:
+        if self.deferring:
+            self.pending = signum
+            return
         raise _Interrupted(signum)
 
-    signums = (signal.SIGINT, signal.SIGTERM)
-    try:
-        previous = {signum: signal.signal(signum, handler) for signum in signums}
-    except ValueError:  # not the main thread: leave the signals alone
-        yield
-        return
-    try:
-        yield
-    finally:
-        for signum, old in previous.items():
+    def __enter__(self) -> _Interrupts:
+        try:
+            for signum in (signal.SIGINT, signal.SIGTERM):
+                self.previous[signum] = signal.signal(signum, self._handler)
+        except ValueError:  # not the main thread: leave the signals alone
+            pass
+        return self
+
+    def __exit__(self, *exc) -> None:
+        for signum, old in self.previous.items():
             signal.signal(signum, old)
+
+    @contextlib.contextmanager
+    def deferred(self) -> Iterator[None]:
+        self.deferring = True
+        try:
+            yield
+        finally:
+            self.deferring = False
+            if self.pending is not None:
+                raise _Interrupted(self.pending)
 
 
 def _lost_case(case: ResolvedCase, exitcode: int | None) -> dict:
