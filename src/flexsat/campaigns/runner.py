@@ -227,6 +227,7 @@ def run_campaign(
         When the store cannot be written (full disk...), after stopping the workers.
     """
     cases = resolve_cases(definition, satellite, n_random)
+    _check_sizes(definition, satellite, cases)
     store = CampaignStore(out)
     if store.root.exists() and not store.root.is_dir():
         raise ConfigError(f"--out {store.root} is a file, not a folder")
@@ -275,6 +276,26 @@ def run_campaign(
         "parquet": str(parquet),
         "csv": str(csv),
     }
+
+
+def _check_sizes(definition, satellite: SatelliteConfig, cases: list[ResolvedCase]) -> None:
+    """Refuse, before any case runs, a case whose records would not fit in a worker."""
+    from flexsat.dynamics.plant import Plant
+    from flexsat.simulate import SlewScenario
+    from flexsat.simulate.common import check_run_size
+
+    n_dof = Plant.from_config(satellite).n_dof  # modifiers change values, not coordinates
+    timing = ("duration_s", "dt_s", "record_dt_s")
+    seen = set()
+    for case in cases:
+        key = tuple(case.scenario.get(name) for name in timing)
+        if key in seen:
+            continue
+        seen.add(key)
+        try:
+            check_run_size(n_dof, SlewScenario.model_validate(case.scenario))
+        except ConfigError as exc:
+            raise ConfigError(f"campaign {definition.name}, case {case.case_id!r}: {exc}") from None
 
 
 def _stored(store: CampaignStore, cases: list[ResolvedCase]) -> int:

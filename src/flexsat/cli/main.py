@@ -9,6 +9,7 @@ from __future__ import annotations
 import json
 import shutil
 import sys
+import warnings
 from pathlib import Path
 from typing import Annotated
 
@@ -533,11 +534,18 @@ def equations(
 
 def main() -> None:
     """Entry point: run the app, turning flexsat errors into a message and exit code 2."""
+    warnings.showwarning = _print_warning
     try:
         app()
     except FlexsatError as exc:
         _print_error(str(exc))
         sys.exit(exc.exit_code)
+
+
+def _print_warning(message, category, filename, lineno, file=None, line=None) -> None:
+    """Warnings (a long run's estimate...) as one plain line on stderr."""
+    _errors.print(f"[yellow]warning:[/] {escape(shorten(str(message), MAX_MESSAGE_CHARS))}",
+                  highlight=False)  # fmt: skip
 
 
 def _print_error(message: str) -> None:

@@ -20,6 +20,7 @@ from flexsat.dynamics.plant import Plant
 from flexsat.errors import ConfigError
 from flexsat.simulate.common import (
     PROGRESS_MIN_STEPS,
+    check_run_size,
     chunk_steps,
     progress_bar,
     run_attributes,
@@ -88,8 +89,15 @@ def run_openloop(
         Recorded every ``record_dt_s``. A diverging run stops at the failing step and
         returns its history up to there with ``status = "failed"`` and a message
         that names the time; it does not raise.
+
+    Raises
+    ------
+    ConfigError
+        Before it starts, if its records would not fit in memory
+        (:func:`flexsat.simulate.common.check_run_size`).
     """
     scenario = scenario or thesis_openloop()
+    check_run_size(plant.n_dof, scenario)
     q0, qd0 = initial_state(plant, scenario)
     profile = _profile(scenario)
     start = time.perf_counter()

@@ -16,6 +16,7 @@ from flexsat.config.models import Positive, Real, Vector3, _Frozen
 from flexsat.control.config import ActuatorConfig, ASMCConfig, ControllerConfig, DisturbanceConfig
 
 __all__ = [
+    "MAX_STEPS",
     "AppendageInitialState",
     "InitialState",
     "OpenLoopScenario",
@@ -90,6 +91,11 @@ class InitialState(_Frozen):
         return self
 
 
+MAX_STEPS = 1e9
+"""Most integration steps of one run: the longest documented run (1e6 s) at the
+default 1 ms step; about an hour of wall time on one core."""
+
+
 class _TimedRun(_Frozen):
     """Duration, RK4 step and recording rate shared by every kind of run."""
 
@@ -111,6 +117,13 @@ class _TimedRun(_Frozen):
                 )
         if self.duration_s < self.record_dt_s:
             raise ValueError(f"duration_s must be at least record_dt_s ({self.record_dt_s})")
+        steps = self.duration_s / self.dt_s
+        if steps > MAX_STEPS:
+            raise ValueError(
+                f"duration_s / dt_s = {steps:.3g} steps is more than the {MAX_STEPS:.0e} "
+                f"allowed (duration_s {self.duration_s:g} s at dt_s {self.dt_s:g} s); "
+                "use a larger dt_s or a shorter run"
+            )
         return self
 
     @property

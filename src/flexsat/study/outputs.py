@@ -139,6 +139,7 @@ def fly_slew(plant: Plant, scenario=None, out: Path | None = None, progress=None
     """
     from flexsat.analysis.requirements import slew_metrics
     from flexsat.simulate import SlewScenario, run_slew
+    from flexsat.simulate.common import check_run_size
 
     def figures() -> list[Path]:
         from flexsat.plots.slew import write_slew_figures
@@ -146,6 +147,7 @@ def fly_slew(plant: Plant, scenario=None, out: Path | None = None, progress=None
         return write_slew_figures(result.dataset, Path(out))
 
     scenario = scenario or SlewScenario()
+    check_run_size(plant.n_dof, scenario)
     result = run_slew(plant, scenario, progress=progress)
     req = scenario.requirements
     metrics = slew_metrics(
