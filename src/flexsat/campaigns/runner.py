@@ -230,7 +230,7 @@ def run_campaign(
     _check_sizes(definition, satellite, cases)
     store = CampaignStore(out)
     if store.root.exists() and not store.root.is_dir():
-        raise ConfigError(f"--out {store.root} is a file, not a folder")
+        raise ConfigError(f"--out {store.root}: exists and is not a folder")
     start = time.perf_counter()
     failed = 0
     with _backend(workers, scheduler, dask_local) as execute, store.session(

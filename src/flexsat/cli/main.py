@@ -509,7 +509,12 @@ def config_preset(
         return
     if output.exists():
         raise FlexsatError(f"{output} exists; choose another file name")
-    shutil.copyfile(source, output)
+    if not output.parent.is_dir():
+        raise FlexsatError(f"-o {output}: the folder {output.parent} does not exist")
+    try:
+        shutil.copyfile(source, output)
+    except OSError as exc:
+        raise FlexsatError(f"-o {output}: cannot write it ({exc.strerror or exc})") from None
     _console.print(f"wrote {output}")
 
 

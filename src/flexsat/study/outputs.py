@@ -9,10 +9,12 @@ the one source of the numbers that the CLI prints and the study report shows.
 from __future__ import annotations
 
 import json
+import tempfile
 from collections.abc import Callable
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from flexsat.errors import ConfigError
 from flexsat.jsonable import jsonable
 
 if TYPE_CHECKING:  # the CLI imports this module at start-up: keep numba out of it
@@ -23,9 +25,30 @@ __all__ = [
     "fly_campaign",
     "fly_openloop",
     "fly_slew",
+    "prepare_output_dir",
     "write_json",
     "write_modal",
 ]
+
+
+def prepare_output_dir(path: str | Path, option: str = "--out") -> Path:
+    """Create an output folder now and check it can be written, before any work.
+
+    Raises
+    ------
+    ConfigError
+        If ``path`` is a file, or the folder cannot be created or written.
+    """
+    path = Path(path)
+    if path.exists() and not path.is_dir():
+        raise ConfigError(f"{option} {path}: exists and is not a folder")
+    try:
+        path.mkdir(parents=True, exist_ok=True)
+        with tempfile.TemporaryFile(dir=path):
+            pass
+    except OSError as exc:
+        raise ConfigError(f"{option} {path}: cannot write there ({exc.strerror or exc})") from None
+    return path
 
 
 def write_json(path: str | Path, payload: dict) -> Path:
@@ -76,6 +99,8 @@ def write_modal(plant: Plant, out: Path | None = None, animate: list[int] | None
     from flexsat.analysis.modal import modal_analysis
     from flexsat.plots.modal import write_modal_figures
 
+    if out is not None:
+        prepare_output_dir(out)
     analysis = modal_analysis(plant)
     summary = analysis.to_dict()
     if out is not None:
@@ -112,6 +137,8 @@ def fly_openloop(plant: Plant, scenario=None, out: Path | None = None, progress=
 
         return write_openloop_figures(result.dataset, modal_analysis(plant), Path(out))
 
+    if out is not None:
+        prepare_output_dir(out)
     result = run_openloop(plant, scenario or OpenLoopScenario(), progress=progress)
     metrics = openloop_metrics(result.dataset)
     if out is not None:
@@ -148,6 +175,8 @@ def fly_slew(plant: Plant, scenario=None, out: Path | None = None, progress=None
 
     scenario = scenario or SlewScenario()
     check_run_size(plant.n_dof, scenario)
+    if out is not None:
+        prepare_output_dir(out)
     result = run_slew(plant, scenario, progress=progress)
     req = scenario.requirements
     metrics = slew_metrics(

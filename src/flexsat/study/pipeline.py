@@ -29,6 +29,7 @@ from flexsat.study.outputs import (
     fly_campaign,
     fly_openloop,
     fly_slew,
+    prepare_output_dir,
     write_json,
     write_modal,
 )
@@ -207,8 +208,7 @@ def run_study(
     """
     from flexsat.study.report import write_report
 
-    out = Path(out)
-    out.mkdir(parents=True, exist_ok=True)
+    out = prepare_output_dir(out)
     console = console or Console(stderr=True)
     ctx = StudyContext(config, out, quick, progress, workers)
     manifest = {
