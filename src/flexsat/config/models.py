@@ -220,4 +220,14 @@ class SatelliteConfig(_Frozen):
         duplicated = sorted({n for n in names if names.count(n) > 1})
         if duplicated:
             raise ValueError(f"appendage names must be unique, repeated: {duplicated}")
+        hub = self.hub
+        if hub.radius_m is not None:  # a cylinder: its surface is known
+            for k, app in enumerate(self.appendages):
+                x, y, z = app.mount_point_m
+                if np.hypot(x, y) < hub.radius_m and abs(z) < 0.5 * hub.height_m:
+                    raise ValueError(
+                        f"appendages[{k}].mount_point_m {list(app.mount_point_m)} is inside the "
+                        f"hub (radius {hub.radius_m:g} m, height {hub.height_m:g} m); mount "
+                        "appendages on or outside its surface"
+                    )
         return self
