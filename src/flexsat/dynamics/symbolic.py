@@ -46,7 +46,11 @@ subexpressions eliminated) for numeric evaluation. A fresh derivation takes abou
 derived model (pickle) and the generated source are cached on disk, keyed by the
 topology, this file's source and the SymPy and Python versions: under
 ``$FLEXSAT_CACHE_DIR`` or, by default, ``~/.cache/flexsat`` (see :func:`cache_dir`).
-Within one process, results are memoized per topology.
+Loading a pickle or generated source runs code, so every cache file is signed
+(HMAC-SHA256) with a per-user secret key kept apart from the cache
+(``~/.config/flexsat/cache-key``, mode 0600): a file planted in the cache folder is
+never unpickled or executed, only regenerated. Within one process, results are
+memoized per topology.
 """
 
 from __future__ import annotations
@@ -54,9 +58,11 @@ from __future__ import annotations
 import contextlib
 import functools
 import hashlib
+import hmac
 import math
 import os
 import pickle
+import secrets
 import sys
 import tempfile
 import textwrap
@@ -428,9 +434,10 @@ def _load_model(
     """The model from ``directory`` if stored there and valid, else derived and stored."""
     path = _cache_path(directory, "model", n_appendages, panel_rates, ".pickle")
     if path is not None:
+        data = _read_signed(path)  # unpickling runs code: only what this user wrote
         try:
-            model = pickle.loads(path.read_bytes())
-        except Exception:  # missing, stale or damaged: derive again and overwrite it
+            model = pickle.loads(data) if data is not None else None
+        except Exception:  # stale or damaged: derive again and overwrite it
             model = None
         if (
             isinstance(model, SymbolicModel)
@@ -802,18 +809,72 @@ def _cache_path(
     return directory / f"{kind}-n{n_appendages}-{panel_rates}-{key}{suffix}"
 
 
+_SIGNATURE = b"flexsat-hmac-sha256:"
+
+
+def _key_path() -> Path:
+    """This user's secret cache key: kept apart from the cache, in the config folder."""
+    config = os.environ.get("XDG_CONFIG_HOME") or Path.home() / ".config"
+    return Path(config) / "flexsat" / "cache-key"
+
+
+def _cache_key() -> bytes | None:
+    """The cache key (created on first use, mode 0600); None if it cannot be trusted.
+
+    Cache files are signed with it (HMAC-SHA256), so a file planted in the cache
+    folder by anyone who cannot read this key is never unpickled or executed.
+    """
+    path = _key_path()
+    try:
+        if not path.exists():
+            path.parent.mkdir(parents=True, exist_ok=True)
+            fd = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o600)
+            with os.fdopen(fd, "wb") as f:
+                f.write(secrets.token_bytes(32))
+        info = path.stat()
+        if info.st_uid != os.getuid() or info.st_mode & 0o077:
+            return None  # not this user's, or readable by others
+        key = path.read_bytes()
+    except OSError:
+        return None
+    return key if len(key) >= 32 else None
+
+
+def _read_signed(path: Path) -> bytes | None:
+    """The payload of a cache file whose signature checks with this user's key, else None."""
+    key = _cache_key()
+    try:
+        data = path.read_bytes()
+    except OSError:
+        return None
+    header, _, payload = data.partition(b"\n")
+    if key is None or not header.startswith(_SIGNATURE):
+        return None
+    expected = hmac.new(key, payload, hashlib.sha256).hexdigest().encode()
+    return payload if hmac.compare_digest(header[len(_SIGNATURE) :], expected) else None
+
+
 def _write_atomic(path: Path, data: bytes) -> None:
-    """Write ``data`` to ``path`` via a temporary file and ``os.replace``.
+    """Write ``data``, signed, to ``path`` via a temporary file and ``os.replace``.
 
     Readers in other processes see either no file or a complete one. Failure to
-    write (read-only or full disk) only costs the cache, with a warning.
+    write (read-only or full disk, no usable key) only costs the cache, with a warning.
     """
+    key = _cache_key()
+    if key is None:
+        warnings.warn(
+            f"flexsat: no usable cache key ({_key_path()}); the symbolic cache is off",
+            RuntimeWarning,
+            stacklevel=3,
+        )
+        return
+    signature = hmac.new(key, data, hashlib.sha256).hexdigest().encode()
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
         fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
         try:
             with os.fdopen(fd, "wb") as f:
-                f.write(data)
+                f.write(_SIGNATURE + signature + b"\n" + data)
             os.replace(tmp, path)
         except BaseException:
             with contextlib.suppress(OSError):
@@ -1203,9 +1264,10 @@ def _load_reference(
     """The model from the source in ``directory`` if valid, else generated and stored."""
     path = _cache_path(directory, "reference", n_appendages, panel_rates, ".py")
     if path is not None:
+        data = _read_signed(path)  # the source is executed: only what this user wrote
         try:
-            source = path.read_text(encoding="utf-8")
-        except (OSError, UnicodeDecodeError):
+            source = data.decode("utf-8") if data is not None else ""
+        except UnicodeDecodeError:
             pass
         else:
             if f"# key: {_fingerprint()}\n" in source:
