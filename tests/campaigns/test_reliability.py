@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import json
 import os
+import resource
 import signal
 import subprocess
 import sys
@@ -208,3 +209,20 @@ def test_a_killed_worker_is_replaced_and_the_campaign_completes(tmp_path):
     assert process.returncode == 0, stderr
     summary = json.loads(stdout)
     assert (summary["cases"], summary["failed"]) == (12, 0)
+
+
+def test_a_write_error_stops_the_run_at_once_with_one_message(tmp_path):
+    """Files above 8 kB cannot be written (as on a full disk): the first history fails."""
+
+    def small_files() -> None:
+        resource.setrlimit(resource.RLIMIT_FSIZE, (8192, 8192))
+
+    store = tmp_path / "store"
+    command = [*FLEXSAT, "campaign", "sensitivity", "--duration", "2", "--workers", "2",
+               "--out", str(store), "--json"]  # fmt: skip
+    result = subprocess.run(command, capture_output=True, text=True, timeout=300,
+                            preexec_fn=small_files)  # fmt: skip
+    assert result.returncode == 2
+    assert "cannot write to the campaign store" in result.stderr
+    assert "0 of 12 cases are stored" in result.stderr and "--resume" in result.stderr
+    assert "Traceback" not in result.stderr

@@ -261,12 +261,11 @@ def run_campaign(
                 interrupted.exit_code = 128 + stop.signum  # the shell's convention
                 raise interrupted from None
             except OSError as exc:
-                raise FlexsatError(
-                    f"cannot write to the campaign store {store.root}: {exc.strerror or exc}; "
-                    f"{_stored(store, cases)} of {len(cases)} cases are stored; fix it and "
-                    "run the same command with --resume to finish"
-                ) from None
-        parquet, csv = store.write_tables()
+                raise _write_error(store, cases, exc) from None
+        try:
+            parquet, csv = store.write_tables()
+        except OSError as exc:
+            raise _write_error(store, cases, exc) from None
     return {
         "campaign": definition.name,
         "cases": len(cases),
@@ -296,6 +295,14 @@ def _check_sizes(definition, satellite: SatelliteConfig, cases: list[ResolvedCas
             check_run_size(n_dof, SlewScenario.model_validate(case.scenario))
         except ConfigError as exc:
             raise ConfigError(f"campaign {definition.name}, case {case.case_id!r}: {exc}") from None
+
+
+def _write_error(store: CampaignStore, cases: list[ResolvedCase], exc: OSError) -> FlexsatError:
+    return FlexsatError(
+        f"cannot write to the campaign store {store.root}: {exc.strerror or exc}; "
+        f"{_stored(store, cases)} of {len(cases)} cases are stored; fix it and "
+        "run the same command with --resume to finish"
+    )
 
 
 def _stored(store: CampaignStore, cases: list[ResolvedCase]) -> int:

@@ -107,10 +107,15 @@ class CampaignStore:
             _acquire(lock, self.root)
             self._check(fingerprint, resume)
             self._remove_partials()
-            _write_atomic(
-                self.root / "campaign.json",
-                json.dumps({"name": name, "fingerprint": fingerprint}, indent=2),
-            )
+            try:
+                _write_atomic(
+                    self.root / "campaign.json",
+                    json.dumps({"name": name, "fingerprint": fingerprint}, indent=2),
+                )
+            except OSError as exc:
+                raise ConfigError(
+                    f"cannot write the campaign store {self.root}: {exc.strerror or exc}"
+                ) from None
             yield
         finally:
             lock.close()  # releases the flock
@@ -197,6 +202,8 @@ class CampaignStore:
         try:
             ds.to_netcdf(tmp)
             os.replace(tmp, path)
+        except RuntimeError as exc:  # the HDF5 library's way of saying the write failed
+            raise OSError(f"writing {path.name} failed ({exc})") from None
         finally:
             if os.path.exists(tmp):
                 os.remove(tmp)
