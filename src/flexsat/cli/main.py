@@ -538,13 +538,24 @@ def equations(
 
 
 def main() -> None:
-    """Entry point: run the app, turning flexsat errors into a message and exit code 2."""
+    """Entry point: run the app, turning flexsat errors into a message and exit code 2.
+
+    Errors of the file system (full disk, permissions) also end with one message and
+    code 2, Ctrl-C with "interrupted" and code 130 (a campaign says what it stored).
+    """
     warnings.showwarning = _print_warning
     try:
         app()
     except FlexsatError as exc:
         _print_error(str(exc))
         sys.exit(exc.exit_code)
+    except OSError as exc:  # a full disk or a permission, met while writing results
+        where = f"{exc.filename}: " if exc.filename else ""
+        _print_error(f"{where}{exc.strerror or exc}")
+        sys.exit(2)
+    except KeyboardInterrupt:
+        _print_error("interrupted")
+        sys.exit(130)
 
 
 def _print_warning(message, category, filename, lineno, file=None, line=None) -> None:
