@@ -68,7 +68,9 @@ def test_damaged_cases_are_named_then_recomputed_alone(tmp_path, small_store):
     with pytest.raises(ConfigError, match=r"damaged case file .*random-00000\.json"):
         summarize(store)
     untouched = (cases / "nominal.json").stat().st_mtime_ns
-    run = run_campaign(definition, nominal(), store, resume=True, n_random=2, progress=False)
+    run = run_campaign(
+        definition, nominal(), store, workers=1, resume=True, n_random=2, progress=False
+    )
     assert run["ran"] == 2  # only the two damaged cases
     assert (cases / "nominal.json").stat().st_mtime_ns == untouched
     assert summarize(store)["cases"] == 3
@@ -117,9 +119,10 @@ def test_replay_needs_a_campaign_store(tmp_path):
 # -- signals and processes ---------------------------------------------------------
 
 
-def _start(store, *extra: str, duration: str = "10") -> subprocess.Popen:
-    command = [*FLEXSAT, "campaign", "sensitivity", "--duration", duration, "--workers", "2",
-               "--out", str(store), "--json", *extra]  # fmt: skip
+def _start(store, *extra: str, duration: str = "5") -> subprocess.Popen:
+    """The 12 sensitivity cases on 2 workers (``extra`` options may change the campaign)."""
+    command = [*FLEXSAT, "campaign", *(extra or ("sensitivity",)), "--duration", duration,
+               "--workers", "2", "--out", str(store), "--json"]  # fmt: skip
     return subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
 
 
@@ -202,13 +205,13 @@ def test_killing_the_parent_leaves_no_worker_behind(tmp_path):
 
 def test_a_killed_worker_is_replaced_and_the_campaign_completes(tmp_path):
     store = tmp_path / "store"
-    process = _start(store, duration="5")
+    process = _start(store, "montecarlo-random", "--cases", "4", duration="2")
     workers = _workers_of(process)
     workers[0].kill()
     stdout, stderr = process.communicate(timeout=300)
     assert process.returncode == 0, stderr
     summary = json.loads(stdout)
-    assert (summary["cases"], summary["failed"]) == (12, 0)
+    assert (summary["cases"], summary["failed"]) == (5, 0)
 
 
 def test_a_write_error_stops_the_run_at_once_with_one_message(tmp_path):
@@ -218,7 +221,7 @@ def test_a_write_error_stops_the_run_at_once_with_one_message(tmp_path):
         resource.setrlimit(resource.RLIMIT_FSIZE, (8192, 8192))
 
     store = tmp_path / "store"
-    command = [*FLEXSAT, "campaign", "sensitivity", "--duration", "2", "--workers", "2",
+    command = [*FLEXSAT, "campaign", "sensitivity", "--duration", "1", "--workers", "1",
                "--out", str(store), "--json"]  # fmt: skip
     result = subprocess.run(command, capture_output=True, text=True, timeout=300,
                             preexec_fn=small_files)  # fmt: skip

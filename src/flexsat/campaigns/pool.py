@@ -81,9 +81,14 @@ class LocalPool:
         pending = deque(items)
         attempts: dict[int, int] = {}
         while pending or any(w.item is not None for w in self._workers):
-            for worker in self._workers:
+            for k, worker in enumerate(self._workers):
                 if worker.item is None and pending:
-                    worker.give(pending.popleft())
+                    item = pending.popleft()
+                    try:
+                        worker.give(item)
+                    except OSError:  # it died while idle: a new worker takes the item
+                        self._replace(worker)
+                        self._workers[k].give(item)
             busy = [w for w in self._workers if w.item is not None]
             ready = wait([w.conn for w in busy] + [w.process.sentinel for w in busy])
             for worker in busy:
