@@ -192,10 +192,12 @@ def _write_run(result, metrics: dict, out: Path, figures: Callable[[], list[Path
     metrics.json into ``out``; the written paths are added to ``metrics["files"]``."""
     out.mkdir(parents=True, exist_ok=True)
     files = [result.to_netcdf(out / "result.nc")]
+    metrics["files"] = [str(p) for p in [*files, out / "metrics.json"]]
+    write_json(out / "metrics.json", metrics)  # first: a figure that fails loses no number
     if result.ok:
         files += figures()
-    metrics["files"] = [str(p) for p in [*files, out / "metrics.json"]]
-    write_json(out / "metrics.json", metrics)
+        metrics["files"] = [str(p) for p in [*files, out / "metrics.json"]]
+        write_json(out / "metrics.json", metrics)
 
 
 def fly_campaign(definition, config, store: Path, *, progress: bool = True, **backend) -> dict:
