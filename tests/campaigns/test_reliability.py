@@ -56,6 +56,19 @@ def test_resume_refuses_another_case_count_naming_both(small_store):
         run_campaign(definition, nominal(), store, resume=True, n_random=4, progress=False)
 
 
+def test_the_study_resumes_only_an_identical_campaign(tmp_path):
+    """The study resumes its campaigns (``fly_campaign(..., resume=True)``): another
+    satellite in the same folder is refused, naming it; the same one runs nothing."""
+    from flexsat.study.outputs import fly_campaign
+
+    definition = _short("montecarlo-random", 1.0)
+    options = {"workers": 1, "resume": True, "n_random": 1, "progress": False}
+    assert fly_campaign(definition, nominal(), tmp_path, **options)["ran"] == 2
+    with pytest.raises(ConfigError, match="the satellite config"):
+        fly_campaign(definition, _heavy(), tmp_path, **options)
+    assert fly_campaign(definition, nominal(), tmp_path, **options)["ran"] == 0
+
+
 def test_damaged_cases_are_named_then_recomputed_alone(tmp_path, small_store):
     source, definition = small_store
     store = tmp_path / "store"
