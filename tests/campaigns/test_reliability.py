@@ -94,7 +94,7 @@ def test_a_live_store_is_locked_and_the_holder_named(tmp_path):
     definition = _short("montecarlo-random", 1.0)
     cases = resolve_cases(definition, nominal(), n_random=1)
     store = CampaignStore(tmp_path)
-    with store.session(campaign_fingerprint(definition, nominal(), cases), "x", False):
+    with store.opened(campaign_fingerprint(definition, nominal(), cases), "x", False):
         with pytest.raises(ConfigError, match=f"in use by process {os.getpid()} on "):
             run_campaign(definition, nominal(), tmp_path, resume=True, n_random=1, progress=False)
 
@@ -153,7 +153,7 @@ def _workers_of(process: subprocess.Popen) -> list[psutil.Process]:
 
 
 def _children(process: subprocess.Popen) -> list[psutil.Process]:
-    """The pool's worker processes (spawned Pythons), not helper processes."""
+    """The pool's worker processes (spawned Pythons), not the other children (resource tracker)."""
     try:
         children = psutil.Process(process.pid).children()
     except psutil.NoSuchProcess:

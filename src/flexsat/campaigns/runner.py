@@ -233,7 +233,7 @@ def run_campaign(
         raise ConfigError(f"--out {store.root}: exists and is not a folder")
     start = time.perf_counter()
     failed = 0
-    with _backend(workers, scheduler, dask_local) as execute, store.session(
+    with _backend(workers, scheduler, dask_local) as execute, store.opened(
         campaign_fingerprint(definition, satellite, cases), definition.name, resume
     ):
         done = store.finished({case.case_id: case.digest for case in cases})

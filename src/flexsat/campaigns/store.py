@@ -78,7 +78,7 @@ class CampaignStore:
         self.histories_dir = self.root / "histories"
 
     @contextlib.contextmanager
-    def session(self, fingerprint: dict, name: str, resume: bool) -> Iterator[None]:
+    def opened(self, fingerprint: dict, name: str, resume: bool) -> Iterator[None]:
         """Create (or check, when resuming) and lock the store for one run.
 
         Parameters
