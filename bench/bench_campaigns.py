@@ -5,8 +5,8 @@ the local process pool (1 worker runs the cases in this process) and a Dask
 LocalCluster (single-threaded worker processes). Wall times are those of
 ``run_campaign``: they include starting the pool or the cluster and writing the
 store. This process first runs one short slew, as any earlier work would have, so
-that its compiled code is loaded; the local pool's forked workers inherit it, Dask's
-spawned workers load it themselves (within the timed wall time).
+that its compiled code is loaded; the workers of both backends are spawned and load
+it themselves from the on-disk cache (within the timed wall time).
 
 Prints wall time and cases per second per campaign and backend, the 1 -> 2 worker
 scaling (speed-up and its efficiency, speed-up / 2) of each backend over the 68

@@ -3,13 +3,29 @@
 from __future__ import annotations
 
 import copy
+import os
 import tomllib
 
 import numpy as np
 import pytest
+from hypothesis import settings
 
 from flexsat.config import SatelliteConfig, preset_path, validate_config
 from flexsat.dynamics.plant import Plant
+
+# Hypothesis runs derandomized by default (profile "ci"): the same examples on every
+# run and machine, so the suite cannot fail at random. HYPOTHESIS_PROFILE=explore
+# draws fresh examples (seeded from the clock) to look for new failures.
+settings.register_profile("ci", derandomize=True, print_blob=True)
+settings.register_profile("explore", derandomize=False, print_blob=True)
+HYPOTHESIS_PROFILE = os.environ.get("HYPOTHESIS_PROFILE", "ci")
+settings.load_profile(HYPOTHESIS_PROFILE)
+
+
+def pytest_report_header(config) -> str:
+    chosen = settings.get_profile(HYPOTHESIS_PROFILE)
+    seed = "fixed, from each test's name" if chosen.derandomize else "random"
+    return f"hypothesis profile: {HYPOTHESIS_PROFILE!r} (seed: {seed})"
 
 
 def nominal_dict() -> dict:

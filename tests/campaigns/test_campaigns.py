@@ -163,7 +163,7 @@ def test_failed_case_is_recorded_and_the_campaign_finishes(tmp_path):
 
 def test_resuming_into_another_campaign_is_refused(tmp_path):
     run_campaign(_short("sensitivity", 1.0), nominal(), tmp_path, workers=1, progress=False)
-    with pytest.raises(ConfigError, match="another definition"):
+    with pytest.raises(ConfigError, match="the campaign definition"):
         run_campaign(_short("sensitivity", 2.0), nominal(), tmp_path, resume=True, progress=False)
     with pytest.raises(ConfigError, match="use --resume"):
         run_campaign(_short("sensitivity", 1.0), nominal(), tmp_path, progress=False)
@@ -173,7 +173,7 @@ BAD_CAMPAIGNS = [
     ('[[cases]]\nid = "a"\nplant = [{ path = "hub.colour", value = 1.0 }]\n', "no 'colour'"),
     ('[[cases]]\nid = "a"\nplant = [{ path = "hub.mass_kg", uniform = [2.0, 2.0] }]\n', "low < high"),
     ('[[cases]]\nid = "a"\nplant = [{ path = "hub.mass_kg", truncnormal = [1.0, 0.1, 2.0, 1.0] }]\n', "low < high"),
-    ('[[cases]]\nid = "a"\nplant = [{ path = "hub.mass_kg", value = -5.0 }]\n', "hub.mass_kg: Input should be greater than 0"),
+    ('[[cases]]\nid = "a"\nplant = [{ path = "hub.mass_kg", value = -5.0 }]\n', "hub.mass_kg: Input should be greater than or equal to 0.0001"),
     ('[random]\nn = -3\n', "random.n"),
     ('[base]\ndt_s = -1.0\n', "dt_s"),
 ]

@@ -7,7 +7,7 @@ import xarray as xr
 
 from flexsat.analysis.spectral import dominant_frequency
 
-__all__ = ["openloop_metrics"]
+__all__ = ["finite_part", "openloop_metrics"]
 
 _RIPPLE_MIN_HZ = 0.05  # below this a "line" is drift, not a structural ripple
 
@@ -22,7 +22,11 @@ def openloop_metrics(ds: xr.Dataset) -> dict:
     (of the yaw-acceleration ripple after the commanded torque ends; NaN if the
     torque never ends or too little time is left), ``energy_balance_error_j``
     (max |E - E0 - W_in + W_diss|), ``wall_time_s``, ``steps``, ``status``, ``message``.
+
+    A diverged run's metrics are those of its finite part (:func:`finite_part`);
+    ``finite_until_s`` says where that ends.
     """
+    ds = finite_part(ds)
     t = ds["time"].values
     commanded = np.abs(ds["tau_cmd"].values).max(axis=1) > 0.0
     free_from = 0.0
@@ -46,8 +50,25 @@ def openloop_metrics(ds: xr.Dataset) -> dict:
         "peak_root_rotation_deg": float(np.degrees(np.abs(ds["rho"].values).max())),
         "dominant_frequency_hz": dominant,
         "energy_balance_error_j": float(np.abs(ds["energy_balance_error"].values).max()),
+        "finite_until_s": float(t[-1]),
         "wall_time_s": float(ds.attrs["wall_time_s"]),
         "steps": int(ds.attrs["steps"]),
         "status": str(ds.attrs["status"]),
         "message": str(ds.attrs["message"]),
     }
+
+
+def finite_part(ds: xr.Dataset) -> xr.Dataset:
+    """The records before the first one where any time-dependent variable is not finite.
+
+    A diverging run's last records can overflow (energies, momenta of a state that
+    blew up); metrics are computed on what came before. The first record is always
+    kept.
+    """
+    bad = np.zeros(ds.sizes["time"], dtype=bool)
+    for var in ds.data_vars.values():
+        if "time" in var.dims and np.issubdtype(var.dtype, np.floating):
+            values = var.transpose("time", ...).values.reshape(ds.sizes["time"], -1)
+            bad |= ~np.isfinite(values).all(axis=1)
+    first_bad = int(np.argmax(bad)) if bad.any() else ds.sizes["time"]
+    return ds.isel(time=slice(0, max(first_bad, 1)))

@@ -36,6 +36,7 @@ __all__ = [
     "CAMPAIGN_PRESETS",
     "CampaignDefinition",
     "ResolvedCase",
+    "campaign_fingerprint",
     "load_campaign",
     "resolve_cases",
 ]
@@ -76,7 +77,9 @@ class RandomCases(_Frozen):
 class CampaignDefinition(_Frozen):
     """A campaign: the satellite, the base slew, and how the cases vary them."""
 
-    name: str
+    name: Annotated[
+        str, Field(min_length=1, max_length=80, pattern=r"^[A-Za-z0-9_][A-Za-z0-9_.+\-]*$")
+    ] = Field(description="campaign name, also its store folder's (no path separators)")
     description: str = ""
     include_nominal: bool = Field(True, description="add the unmodified case 'nominal'")
     base: dict = Field(default_factory=dict, description="SlewScenario fields for every case")
@@ -107,6 +110,34 @@ class ResolvedCase:
     plant: dict
     scenario: dict
     parameters: dict
+
+    @property
+    def digest(self) -> str:
+        """Hash of everything that defines this case's result (plant and scenario)."""
+        return _digest({"plant": self.plant, "scenario": self.scenario})
+
+
+def _digest(data) -> str:
+    return hashlib.sha256(json.dumps(data, sort_keys=True).encode()).hexdigest()[:16]
+
+
+def campaign_fingerprint(
+    definition: CampaignDefinition, satellite: SatelliteConfig, cases: list[ResolvedCase]
+) -> dict:
+    """What a store's results depend on, part by part, to refuse a mixed resume.
+
+    Returns
+    -------
+    dict
+        ``definition`` and ``satellite`` (digests), ``cases`` (count) and
+        ``case_inputs`` (a digest over every case's id and inputs).
+    """
+    return {
+        "definition": definition.fingerprint(),
+        "satellite": _digest(satellite.model_dump(mode="json")),
+        "cases": len(cases),
+        "case_inputs": _digest([[case.case_id, case.digest] for case in cases]),
+    }
 
 
 def load_campaign(name_or_path: str | Path) -> CampaignDefinition:

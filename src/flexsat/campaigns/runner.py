@@ -3,29 +3,39 @@
 Cases are resolved in the parent (:func:`resolve_cases`), so every backend and
 worker count runs the same inputs and the stored rows are identical bit for bit.
 A case that raises or diverges is stored as failed with its message; the campaign
-goes on.
+goes on. Ctrl-C or SIGTERM stops the run at once (pending cases cancelled, workers
+stopped) and says how many cases are stored and how to resume.
 """
 
 from __future__ import annotations
 
-import json
+import contextlib
 import os
+import re
+import signal
 import time
 import traceback
 from collections.abc import Iterator
-from concurrent.futures import ProcessPoolExecutor, as_completed
 from pathlib import Path
 
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
 
-from flexsat.campaigns.definition import CampaignDefinition, ResolvedCase, resolve_cases
+from flexsat.campaigns.definition import (
+    CampaignDefinition,
+    ResolvedCase,
+    campaign_fingerprint,
+    resolve_cases,
+)
+from flexsat.campaigns.pool import LocalPool
 from flexsat.campaigns.store import HISTORY_UNITS, CampaignStore
 from flexsat.config.models import SatelliteConfig
+from flexsat.errors import ConfigError, FlexsatError, shorten
 
 __all__ = [
     "HISTORY_DT_S",
     "HISTORY_KEY",
     "HISTORY_UNITS",
+    "CampaignInterrupted",
     "case_history",
     "replay_case",
     "run_campaign",
@@ -34,19 +44,40 @@ __all__ = [
 ]
 
 
+_CASE_ID = re.compile(r"^[A-Za-z0-9_+\-][A-Za-z0-9_.+\-]*$")
+
+
 def replay_case(store: str | Path, case_id: str):
-    """Re-run one stored case alone from its stored inputs; returns its ``Result``."""
-    from flexsat.config.models import SatelliteConfig
+    """Re-run one stored case alone from its stored inputs; returns its ``Result``.
+
+    Raises
+    ------
+    ConfigError
+        ``store`` holds no campaign, ``case_id`` is not a case id (no path
+        separators) or not in the store, or its stored inputs are refused.
+    """
+    from flexsat.config.load import validate_config
     from flexsat.dynamics.plant import Plant
-    from flexsat.errors import ConfigError
     from flexsat.simulate import SlewScenario, run_slew
 
-    path = CampaignStore(store).cases_dir / f"{case_id}.json"
+    store = CampaignStore(store)
+    if not (store.root / "campaign.json").is_file():
+        raise ConfigError(f"{store.root} is not a campaign store (no campaign.json)")
+    if not _CASE_ID.match(case_id):
+        raise ConfigError(
+            f"{shorten(repr(case_id))} is not a case id (letters, digits and _ . + -)"
+        )
+    path = store.cases_dir / f"{case_id}.json"
     if not path.exists():
-        raise ConfigError(f"no case {case_id!r} in {store}")
-    inputs = json.loads(path.read_text())["inputs"]
-    plant = Plant.from_config(SatelliteConfig.model_validate(inputs["plant"]))
-    return run_slew(plant, SlewScenario.model_validate(inputs["scenario"]))
+        raise ConfigError(f"no case {case_id!r} in {store.root}")
+    row = store.row(case_id)
+    inputs = row.get("inputs") or {}
+    source = f"case {case_id!r}"
+    plant = Plant.from_config(validate_config(inputs.get("plant"), source=f"{source} (plant)"))
+    scenario = validate_config(
+        inputs.get("scenario"), source=f"{source} (scenario)", model=SlewScenario
+    )
+    return run_slew(plant, scenario)
 
 
 def summarize(store: str | Path) -> dict:
@@ -123,6 +154,7 @@ def run_case(case: ResolvedCase) -> dict:
 
     row = {
         "case_id": case.case_id,
+        "inputs_digest": case.digest,
         "root_seed": case.root_seed,
         "stream_index": case.stream_index,
         "parameters": case.parameters,
@@ -145,6 +177,10 @@ def run_case(case: ResolvedCase) -> dict:
     return row
 
 
+class CampaignInterrupted(FlexsatError):
+    """A campaign stopped by Ctrl-C or SIGTERM; the finished cases are stored."""
+
+
 def run_campaign(
     definition: CampaignDefinition,
     satellite: SatelliteConfig,
@@ -163,10 +199,11 @@ def run_campaign(
     workers : int, optional
         Local worker processes; default all cores. 1 runs in this process.
     resume : bool
-        Skip the cases already in the store (refused if the store was made by a
-        different definition).
+        Skip the cases already in the store (refused if the store was made with
+        other inputs: definition, satellite config, number of cases).
     scheduler : str, optional
-        Address of a running Dask scheduler (``tcp://host:port``).
+        Address of a running Dask scheduler (``tcp://host:port``). Connecting to
+        it means trusting it: it runs the code it is sent.
     dask_local : int, optional
         Start a Dask LocalCluster with this many single-threaded worker processes.
 
@@ -174,26 +211,58 @@ def run_campaign(
     -------
     dict
         ``cases``, ``ran`` (this call), ``failed``, ``wall_time_s``, the store paths.
+
+    Raises
+    ------
+    ConfigError
+        Before any case runs: bad cases, a store that is not writable, in use or
+        made with other inputs, an unreachable scheduler.
+    CampaignInterrupted
+        On Ctrl-C or SIGTERM, after stopping the workers; it says how many cases
+        are stored and how to resume (exit code 130 or 143).
+    FlexsatError
+        When the store cannot be written (full disk...), after stopping the workers.
     """
     cases = resolve_cases(definition, satellite, n_random)
+    _check_sizes(definition, satellite, cases)
     store = CampaignStore(out)
-    store.open(definition.fingerprint(), definition.name, resume)
-    done = store.finished()
-    todo = [case for case in cases if case.case_id not in done]
+    if store.root.exists() and not store.root.is_dir():
+        raise ConfigError(f"--out {store.root}: exists and is not a folder")
     start = time.perf_counter()
     failed = 0
-    columns = (TextColumn(f"campaign {definition.name}"), BarColumn(), MofNCompleteColumn(),
-               TextColumn("failed {task.fields[failed]}"), TimeRemainingColumn())  # fmt: skip
-    with Progress(*columns, disable=not progress, transient=True) as bar:
-        task = bar.add_task("cases", total=len(cases), completed=len(cases) - len(todo), failed=0)
-        for row in _execute(todo, workers, scheduler, dask_local):
-            history = row.pop(HISTORY_KEY, None)
-            if history is not None:  # before the case: a stored case has its history
-                store.write_history(row["case_id"], history, status=row["status"])
-            store.write_case(row)
-            failed += row["status"] != "ok"
-            bar.update(task, advance=1, failed=failed)
-    parquet, csv = store.write_tables()
+    with _backend(workers, scheduler, dask_local) as execute, store.opened(
+        campaign_fingerprint(definition, satellite, cases), definition.name, resume
+    ):
+        done = store.finished({case.case_id: case.digest for case in cases})
+        todo = [case for case in cases if case.case_id not in done]
+        columns = (TextColumn(f"campaign {definition.name}"), BarColumn(), MofNCompleteColumn(),
+                   TextColumn("failed {task.fields[failed]}"), TimeRemainingColumn())  # fmt: skip
+        interrupts = _Interrupts()
+        with Progress(*columns, disable=not progress, transient=True) as bar, interrupts:
+            task = bar.add_task("cases", total=len(cases), completed=len(done), failed=0)
+            try:
+                for row in execute(todo):
+                    history = row.pop(HISTORY_KEY, None)
+                    with interrupts.deferred():  # a signal never cuts a write in half
+                        if history is not None:  # before the case: a stored case has its history
+                            store.write_history(row["case_id"], history, status=row["status"])
+                        store.write_case(row)
+                    failed += row["status"] != "ok"
+                    bar.update(task, advance=1, failed=failed)
+            except _Interrupted as stop:
+                interrupted = CampaignInterrupted(
+                    f"campaign {definition.name} interrupted ({stop.name}): "
+                    f"{_stored(store, cases)} of {len(cases)} cases are stored in {store.root}; "
+                    "run the same command with --resume to finish it",
+                )
+                interrupted.exit_code = 128 + stop.signum  # the shell's convention
+                raise interrupted from None
+            except OSError as exc:
+                raise _write_error(store, cases, exc) from None
+        try:
+            parquet, csv = store.write_tables()
+        except OSError as exc:
+            raise _write_error(store, cases, exc) from None
     return {
         "campaign": definition.name,
         "cases": len(cases),
@@ -205,24 +274,126 @@ def run_campaign(
     }
 
 
-def _execute(todo, workers, scheduler, dask_local) -> Iterator[dict]:
+def _check_sizes(definition, satellite: SatelliteConfig, cases: list[ResolvedCase]) -> None:
+    """Refuse, before any case runs, a case whose records would not fit in a worker."""
+    from flexsat.dynamics.plant import Plant
+    from flexsat.simulate import SlewScenario
+    from flexsat.simulate.common import check_run_size
+
+    n_dof = Plant.from_config(satellite).n_dof  # modifiers change values, not coordinates
+    timing = ("duration_s", "dt_s", "record_dt_s")
+    seen = set()
+    for case in cases:
+        key = tuple(case.scenario.get(name) for name in timing)
+        if key in seen:
+            continue
+        seen.add(key)
+        try:
+            check_run_size(n_dof, SlewScenario.model_validate(case.scenario))
+        except ConfigError as exc:
+            raise ConfigError(f"campaign {definition.name}, case {case.case_id!r}: {exc}") from None
+
+
+def _write_error(store: CampaignStore, cases: list[ResolvedCase], exc: OSError) -> FlexsatError:
+    return FlexsatError(
+        f"cannot write to the campaign store {store.root}: {exc.strerror or exc}; "
+        f"{_stored(store, cases)} of {len(cases)} cases are stored; fix it and "
+        "run the same command with --resume to finish"
+    )
+
+
+def _stored(store: CampaignStore, cases: list[ResolvedCase]) -> int:
+    return len(store.finished({case.case_id: case.digest for case in cases}))
+
+
+class _Interrupted(BaseException):
+    """Ctrl-C or SIGTERM, raised where the main process is (never caught as an Exception)."""
+
+    def __init__(self, signum: int) -> None:
+        super().__init__(signum)
+        self.signum, self.name = signum, signal.Signals(signum).name
+
+
+class _Interrupts:
+    """While active, SIGINT and SIGTERM raise :class:`_Interrupted` in the main thread.
+
+    Inside :meth:`deferred` (the store's writes, whose libraries hold locks) a signal
+    is kept and raised at the end of the block instead.
+    """
+
+    def __init__(self) -> None:
+        self.pending: int | None = None
+        self.deferring = False
+        self.previous: dict = {}
+
+    def _handler(self, signum, frame) -> None:
+        if self.deferring:
+            self.pending = signum
+            return
+        raise _Interrupted(signum)
+
+    def __enter__(self) -> _Interrupts:
+        try:
+            for signum in (signal.SIGINT, signal.SIGTERM):
+                self.previous[signum] = signal.signal(signum, self._handler)
+        except ValueError:  # not the main thread: leave the signals alone
+            pass
+        return self
+
+    def __exit__(self, *exc) -> None:
+        for signum, old in self.previous.items():
+            signal.signal(signum, old)
+
+    @contextlib.contextmanager
+    def deferred(self) -> Iterator[None]:
+        self.deferring = True
+        try:
+            yield
+        finally:
+            self.deferring = False
+            if self.pending is not None:
+                raise _Interrupted(self.pending)
+
+
+def _lost_case(case: ResolvedCase, exitcode: int | None) -> dict:
+    """The failed row of a case whose worker process died running it (twice)."""
+    return {
+        "case_id": case.case_id,
+        "inputs_digest": case.digest,
+        "root_seed": case.root_seed,
+        "stream_index": case.stream_index,
+        "parameters": case.parameters,
+        "inputs": {"plant": case.plant, "scenario": case.scenario},
+        "status": "failed",
+        "error": f"its worker process died running it (exit code {exitcode}), twice",
+        "metrics": {},
+        "case_wall_time_s": float("nan"),
+    }
+
+
+@contextlib.contextmanager
+def _backend(workers, scheduler, dask_local):
+    """Connect to (or start) the backend, then yield ``execute(todo) -> rows``."""
     if scheduler or dask_local:
-        yield from _dask(todo, scheduler, dask_local)
+        with _dask_client(scheduler, dask_local) as client:
+            yield lambda todo: _dask(client, todo)
         return
     workers = workers or os.cpu_count() or 1
-    if workers == 1:
-        for case in todo:
-            yield run_case(case)
-        return
-    with ProcessPoolExecutor(max_workers=workers) as pool:
-        futures = [pool.submit(run_case, case) for case in todo]
-        for future in as_completed(futures):
-            yield future.result()
+
+    def execute(todo) -> Iterator[dict]:
+        if workers == 1 or len(todo) <= 1:
+            for case in todo:
+                yield run_case(case)
+            return
+        with LocalPool(run_case, min(workers, len(todo)), _lost_case) as pool:
+            yield from pool.map_unordered(todo)
+
+    yield execute
 
 
-def _dask(todo, scheduler, dask_local) -> Iterator[dict]:
+@contextlib.contextmanager
+def _dask_client(scheduler, dask_local):
     from dask.distributed import Client, LocalCluster
-    from dask.distributed import as_completed as dask_completed
 
     cluster = None
     if scheduler is None:
@@ -230,12 +401,26 @@ def _dask(todo, scheduler, dask_local) -> Iterator[dict]:
             n_workers=dask_local, threads_per_worker=1, processes=True,
             host="127.0.0.1", dashboard_address=None,
         )  # fmt: skip
-    client = Client(cluster if cluster is not None else scheduler)
     try:
-        futures = client.map(run_case, todo, pure=False)
-        for future in dask_completed(futures):
-            yield future.result()
+        client = Client(cluster if cluster is not None else scheduler, timeout="10s")
+    except (OSError, TimeoutError, ValueError) as exc:
+        if cluster is not None:
+            cluster.close()
+        raise ConfigError(f"cannot connect to the Dask scheduler {scheduler}: {exc}") from None
+    try:
+        yield client
     finally:
         client.close()
         if cluster is not None:
             cluster.close()
+
+
+def _dask(client, todo) -> Iterator[dict]:
+    from dask.distributed import as_completed as dask_completed
+
+    futures = client.map(run_case, todo, pure=False)
+    try:
+        for future in dask_completed(futures):
+            yield future.result()
+    finally:
+        client.cancel(futures)

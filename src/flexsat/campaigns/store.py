@@ -6,13 +6,25 @@ flight and never leaves a half-written row. ``results.parquet`` (and
 ``results.csv`` beside it, for people) are rebuilt from the case files. The
 decimated time history of each case is kept apart, in ``histories/<id>.nc``
 (NetCDF, also written through a temporary name and an atomic rename).
+
+``campaign.json`` holds the store's fingerprint: a digest of the campaign
+definition, of the satellite config, the number of cases and a digest of every
+case's inputs. Resuming is refused when any of them differs, naming which. While a
+campaign runs into the store, ``campaign.lock`` is locked (``flock``) and names
+the process holding it, so a second run into the same store is refused instead of
+recomputing the same cases.
 """
 
 from __future__ import annotations
 
+import contextlib
+import datetime as dt
+import fcntl
 import json
 import os
+import socket
 import tempfile
+from collections.abc import Iterator
 from pathlib import Path
 
 import numpy as np
@@ -23,6 +35,16 @@ from flexsat.errors import ConfigError
 from flexsat.jsonable import jsonable
 
 __all__ = ["HISTORY_UNITS", "CampaignStore"]
+
+_UMASK = os.umask(0o022)
+os.umask(_UMASK)  # read once: every stored file gets the mode a plain open() would give
+_ROW_KEYS = ("case_id", "status", "metrics", "inputs_digest")
+_FINGERPRINT_PARTS = {
+    "definition": "the campaign definition",
+    "satellite": "the satellite config",
+    "cases": "the number of cases",
+    "case_inputs": "the cases' inputs",
+}
 
 HISTORY_UNITS = {
     "time": "s",
@@ -55,28 +77,98 @@ class CampaignStore:
         self.cases_dir = self.root / "cases"
         self.histories_dir = self.root / "histories"
 
-    def open(self, fingerprint: str, name: str, resume: bool) -> None:
-        """Create the store, or check it belongs to the same campaign when resuming."""
-        marker = self.root / "campaign.json"
-        if marker.exists():
-            stored = json.loads(marker.read_text())
-            if not resume:
-                raise ConfigError(
-                    f"{self.root} already holds a campaign; use --resume or another --out"
-                )
-            if stored["fingerprint"] != fingerprint:
-                raise ConfigError(
-                    f"{self.root} holds campaign {stored['name']!r} with another definition; "
-                    "refusing to resume into it"
-                )
-        self.cases_dir.mkdir(parents=True, exist_ok=True)
-        _write_atomic(marker, json.dumps({"name": name, "fingerprint": fingerprint}))
+    @contextlib.contextmanager
+    def opened(self, fingerprint: dict, name: str, resume: bool) -> Iterator[None]:
+        """Create (or check, when resuming) and lock the store for one run.
 
-    def finished(self) -> set[str]:
-        """Ids of the cases already stored."""
+        Parameters
+        ----------
+        fingerprint : dict
+            What defines the cases' results (keys of ``_FINGERPRINT_PARTS``).
+        name : str
+            The campaign's name.
+        resume : bool
+            Accept a store that already holds this very campaign.
+
+        Raises
+        ------
+        ConfigError
+            The folder cannot be created or written, holds another campaign (or
+            this one without ``resume``), or another process is running into it.
+        """
+        try:
+            self.cases_dir.mkdir(parents=True, exist_ok=True)
+            lock = open(self.root / "campaign.lock", "a+")
+        except OSError as exc:
+            raise ConfigError(
+                f"cannot create the campaign store {self.root}: {exc.strerror or exc}"
+            ) from None
+        try:
+            _acquire(lock, self.root)
+            self._check(fingerprint, resume)
+            self._remove_partials()
+            try:
+                _write_atomic(
+                    self.root / "campaign.json",
+                    json.dumps({"name": name, "fingerprint": fingerprint}, indent=2),
+                )
+            except OSError as exc:
+                raise ConfigError(
+                    f"cannot write the campaign store {self.root}: {exc.strerror or exc}"
+                ) from None
+            yield
+        finally:
+            lock.close()  # releases the flock
+
+    def _check(self, fingerprint: dict, resume: bool) -> None:
+        marker = self.root / "campaign.json"
+        if not marker.exists():
+            return
+        if not resume:
+            raise ConfigError(
+                f"{self.root} already holds a campaign; use --resume or another --out"
+            )
+        try:
+            stored = json.loads(marker.read_text())
+            old = stored["fingerprint"]
+        except (OSError, ValueError, KeyError, TypeError):
+            raise ConfigError(f"{marker} is damaged; refusing to resume into {self.root}") from None
+        if not isinstance(old, dict):
+            old = {"definition": old}  # a store written by an older flexsat
+        differs = [
+            f"{what} (stored {old.get(key)!r}, given {fingerprint[key]!r})"
+            for key, what in _FINGERPRINT_PARTS.items()
+            if old.get(key) != fingerprint[key]
+        ]
+        if differs:
+            raise ConfigError(
+                f"{self.root} holds campaign {stored.get('name')!r} made with other inputs; "
+                f"refusing to resume into it: {'; '.join(differs)}. Use another --out"
+            )
+
+    def _remove_partials(self) -> None:
+        """Temporary files left by a killed run (never a finished case)."""
+        for folder in (self.root, self.cases_dir, self.histories_dir):
+            for path in folder.glob("*.partial"):
+                with contextlib.suppress(OSError):
+                    path.unlink()
+
+    def finished(self, digests: dict[str, str] | None = None) -> set[str]:
+        """Ids of the cases stored intact (and, given ``digests``, with those inputs).
+
+        A damaged case file (truncated, not a row) is not finished: it is run again
+        and overwritten.
+        """
         if not self.cases_dir.exists():
             return set()
-        return {p.stem for p in self.cases_dir.glob("*.json")}
+        done = set()
+        for path in self.cases_dir.glob("*.json"):
+            row = _read_row(path)
+            if row is None:
+                continue
+            if digests is None or digests.get(path.stem) == row["inputs_digest"]:
+                done.add(path.stem)
+        return done
 
     def write_case(self, row: dict) -> None:
         _write_atomic(self.cases_dir / f"{row['case_id']}.json", json.dumps(jsonable(row)))
@@ -106,9 +198,12 @@ class CampaignStore:
         path = self.histories_dir / f"{case_id}.nc"
         fd, tmp = tempfile.mkstemp(dir=self.histories_dir, suffix=".partial")
         os.close(fd)
+        os.chmod(tmp, 0o666 & ~_UMASK)
         try:
             ds.to_netcdf(tmp)
             os.replace(tmp, path)
+        except RuntimeError as exc:  # the HDF5 library's way of saying the write failed
+            raise OSError(f"writing {path.name} failed ({exc})") from None
         finally:
             if os.path.exists(tmp):
                 os.remove(tmp)
@@ -125,7 +220,25 @@ class CampaignStore:
         return loaded
 
     def rows(self) -> list[dict]:
-        return [json.loads(p.read_text()) for p in sorted(self.cases_dir.glob("*.json"))]
+        """Every stored case row, sorted by case id (see :meth:`row`)."""
+        return [self.row(path.stem) for path in sorted(self.cases_dir.glob("*.json"))]
+
+    def row(self, case_id: str) -> dict:
+        """The stored row of one case.
+
+        Raises
+        ------
+        ConfigError
+            Naming the case file when it is damaged (resuming recomputes it).
+        """
+        path = self.cases_dir / f"{case_id}.json"
+        row = _read_row(path)
+        if row is None:
+            raise ConfigError(
+                f"damaged case file {path} (not a complete case row); run the campaign "
+                "again with --resume to recompute it"
+            )
+        return row
 
     def table(self) -> pd.DataFrame:
         """One row per stored case, sorted by case id; list values become columns."""
@@ -145,13 +258,47 @@ class CampaignStore:
         for path, writer in ((parquet, frame.to_parquet), (csv, frame.to_csv)):
             fd, tmp = tempfile.mkstemp(dir=self.root, suffix=".partial")
             os.close(fd)
+            os.chmod(tmp, 0o666 & ~_UMASK)
             writer(tmp, index=False)
             os.replace(tmp, path)
         return parquet, csv
 
 
+def _read_row(path: Path) -> dict | None:
+    """A stored case row, or None when the file is damaged (not JSON, not a row)."""
+    try:
+        row = json.loads(path.read_text())
+    except (OSError, ValueError):
+        return None
+    if not isinstance(row, dict) or any(key not in row for key in _ROW_KEYS):
+        return None
+    if row["case_id"] != path.stem or not isinstance(row["metrics"], dict):
+        return None
+    return row
+
+
+def _acquire(lock, root: Path) -> None:
+    """Lock the store for this process, or say which process holds it."""
+    try:
+        fcntl.flock(lock.fileno(), fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except OSError:
+        lock.seek(0)
+        holder = lock.read().strip() or "another process"
+        lock.close()
+        raise ConfigError(
+            f"{root} is in use by {holder}; wait for it to finish (or stop it) "
+            "before running into this store"
+        ) from None
+    lock.seek(0)
+    lock.truncate()
+    started = dt.datetime.now(dt.UTC).strftime("%Y-%m-%d %H:%M:%S UTC")
+    lock.write(f"process {os.getpid()} on {socket.gethostname()} (since {started})")
+    lock.flush()
+
+
 def _write_atomic(path: Path, text: str) -> None:
     fd, tmp = tempfile.mkstemp(dir=path.parent, suffix=".partial")
+    os.chmod(tmp, 0o666 & ~_UMASK)
     with os.fdopen(fd, "w") as handle:
         handle.write(text)
         handle.flush()

@@ -10,16 +10,18 @@ import json
 import math
 import shutil
 import sys
+import warnings
 from pathlib import Path
 from typing import Annotated
 
 import numpy as np
 import typer
 from rich.console import Console
+from rich.markup import escape
 from rich.table import Table
 
 from flexsat import __version__
-from flexsat.errors import FlexsatError
+from flexsat.errors import MAX_MESSAGE_CHARS, FlexsatError, shorten
 from flexsat.jsonable import jsonable
 
 __all__ = ["app", "main"]
@@ -42,7 +44,7 @@ config_app = typer.Typer(
 )
 app.add_typer(config_app, name="config")
 
-_console = Console()
+_console = Console(markup=False)  # names and paths are printed as written, never as markup
 _errors = Console(stderr=True, soft_wrap=True)
 
 ConfigOption = Annotated[
@@ -182,7 +184,7 @@ def openloop(
     else:
         _print_metrics(metrics)
     if not result.ok:
-        _errors.print(f"[bold red]error:[/] {result.message}", highlight=False)
+        _print_error(result.message)
         raise typer.Exit(1)
 
 
@@ -264,7 +266,7 @@ def slew(
         _print_metrics(metrics, title=f"Slew with {kind.upper()}")
     if failed:
         for message in failed:
-            _errors.print(f"[bold red]error:[/] {message}", highlight=False)
+            _print_error(message)
         raise typer.Exit(1)
 
 
@@ -434,7 +436,7 @@ def study(
     failed = [part["title"] for part in manifest["parts"] if part["status"] == "failed"]
     _console.print(f"report: {manifest['report']}")
     if failed:
-        _errors.print(f"[bold red]error:[/] failed parts: {', '.join(failed)}", highlight=False)
+        _print_error(f"failed parts: {', '.join(failed)}")
         raise typer.Exit(1)
 
 
@@ -523,7 +525,12 @@ def config_preset(
         return
     if output.exists():
         raise FlexsatError(f"{output} exists; choose another file name")
-    shutil.copyfile(source, output)
+    if not output.parent.is_dir():
+        raise FlexsatError(f"-o {output}: the folder {output.parent} does not exist")
+    try:
+        shutil.copyfile(source, output)
+    except OSError as exc:
+        raise FlexsatError(f"-o {output}: cannot write it ({exc.strerror or exc})") from None
     _console.print(f"wrote {output}")
 
 
@@ -547,9 +554,33 @@ def equations(
 
 
 def main() -> None:
-    """Entry point: run the app, turning flexsat errors into a message and exit code 2."""
+    """Entry point: run the app, turning flexsat errors into a message and exit code 2.
+
+    Errors of the file system (full disk, permissions) also end with one message and
+    code 2, Ctrl-C with "interrupted" and code 130 (a campaign says what it stored).
+    """
+    warnings.showwarning = _print_warning
     try:
         app()
     except FlexsatError as exc:
-        _errors.print(f"[bold red]error:[/] {exc}", highlight=False)
+        _print_error(str(exc))
+        sys.exit(exc.exit_code)
+    except OSError as exc:  # a full disk or a permission, met while writing results
+        where = f"{exc.filename}: " if exc.filename else ""
+        _print_error(f"{where}{exc.strerror or exc}")
         sys.exit(2)
+    except KeyboardInterrupt:
+        _print_error("interrupted")
+        sys.exit(130)
+
+
+def _print_warning(message, category, filename, lineno, file=None, line=None) -> None:
+    """Warnings (a long run's estimate...) as one plain line on stderr."""
+    _errors.print(f"[yellow]warning:[/] {escape(shorten(str(message), MAX_MESSAGE_CHARS))}",
+                  highlight=False)  # fmt: skip
+
+
+def _print_error(message: str) -> None:
+    """One error line on stderr; the message is plain text (never read as markup)."""
+    _errors.print(f"[bold red]error:[/] {escape(shorten(message, MAX_MESSAGE_CHARS))}",
+                  highlight=False)  # fmt: skip

@@ -11,7 +11,7 @@ from typing import Any
 from pydantic import BaseModel, Tag, ValidationError
 
 from flexsat.config.models import SatelliteConfig
-from flexsat.errors import ConfigError
+from flexsat.errors import ConfigError, shorten
 
 __all__ = ["PRESETS", "load_config", "nominal", "preset_path", "read_toml", "validate_config"]
 
@@ -61,6 +61,8 @@ def read_toml(path: str | Path, what: str = "config") -> dict[str, Any]:
         raise ConfigError(f"cannot read {what} file {path}: {exc}") from None
     except tomllib.TOMLDecodeError as exc:
         raise ConfigError(f"{path}: not valid TOML: {exc}") from None
+    except RecursionError:
+        raise ConfigError(f"{path}: not valid TOML: arrays or tables nested too deep") from None
 
 
 def validate_config(
@@ -77,7 +79,7 @@ def validate_config(
 
 
 def _describe(error: dict[str, Any], model: type[BaseModel]) -> str:
-    location = _location(error["loc"])
+    location = shorten(_location(error["loc"]))
     kind = error["type"]
     if kind == "extra_forbidden":
         known = _known_keys(model, error["loc"][:-1])
@@ -89,12 +91,15 @@ def _describe(error: dict[str, Any], model: type[BaseModel]) -> str:
     if kind == "union_tag_invalid":
         ctx = error.get("ctx", {})
         allowed, got = ctx.get("expected_tags"), ctx.get("tag")
-        return f"{location}.kind: must be one of {allowed} (got {got!r})"
+        return f"{location}.kind: must be one of {allowed} (got {shorten(repr(got))})"
     if kind in ("model_type", "dict_type"):
-        return f"{location}: expected a TOML table (section), got {error.get('input')!r}"
-    message = error["msg"].removeprefix("Value error, ")
+        got = shorten(repr(error.get("input")))
+        return f"{location}: expected a TOML table (section), got {got}"
+    message = shorten(error["msg"].removeprefix("Value error, "), 400)
+    if kind == "string_pattern_mismatch":
+        message = f"contains characters that are not allowed (allowed: {error['ctx']['pattern']})"
     if "input" in error and error["loc"] and not isinstance(error["input"], dict):
-        return f"{location}: {message} (got {error['input']!r})"
+        return f"{location}: {message} (got {shorten(repr(error['input']))})"
     return f"{location}: {message}"
 
 

@@ -32,6 +32,22 @@ Angle = Annotated[float, Strict(), AllowInfNan(False), Field(ge=-360.0, le=360.0
 Vector3 = tuple[Real, Real, Real]
 Matrix3 = tuple[Vector3, Vector3, Vector3]
 
+# Physical magnitudes are bounded at the boundary, so that nothing downstream
+# overflows (a 1e154 m hub radius squared) or loses every digit (a 5e-324 kg hub):
+# each range spans far beyond any spacecraft, from a chip-sat to a space station.
+Mass = Annotated[float, Strict(), AllowInfNan(False), Field(ge=1e-4, le=1e7)]  # [kg]
+Size = Annotated[float, Strict(), AllowInfNan(False), Field(ge=1e-3, le=1e3)]  # [m]
+Thickness = Annotated[float, Strict(), AllowInfNan(False), Field(ge=1e-6, le=1e3)]  # [m]
+Coordinate = Annotated[float, Strict(), AllowInfNan(False), Field(ge=-1e3, le=1e3)]  # [m]
+Point3 = tuple[Coordinate, Coordinate, Coordinate]
+Density = Annotated[float, Strict(), AllowInfNan(False), Field(ge=1e-4, le=1e5)]  # [kg/m^2]
+Frequency = Annotated[float, Strict(), AllowInfNan(False), Field(ge=1e-3, le=1e4)]  # [Hz]
+InertiaEntry = Annotated[float, Strict(), AllowInfNan(False), Field(ge=-1e12, le=1e12)]
+# Names are printed in tables, figure titles and messages: plain characters only.
+Name = Annotated[
+    str, Field(min_length=1, max_length=64, pattern=r"^[A-Za-z0-9_][A-Za-z0-9_ .+\-()#,:]*$")
+]
+
 
 class _Frozen(BaseModel):
     model_config = ConfigDict(frozen=True, extra="forbid", validate_default=True)
@@ -45,10 +61,14 @@ class HubConfig(_Frozen):
     mass in hub frame B.
     """
 
-    mass_kg: Positive = Field(description="hub mass [kg]")
-    radius_m: Positive | None = Field(None, description="cylinder radius [m]")
-    height_m: Positive | None = Field(None, description="cylinder height along hub Z [m]")
-    inertia_kg_m2: Matrix3 | None = Field(
+    mass_kg: Mass = Field(description="hub mass [kg]")
+    radius_m: Size | None = Field(None, description="cylinder radius [m]")
+    height_m: Size | None = Field(None, description="cylinder height along hub Z [m]")
+    inertia_kg_m2: tuple[
+        tuple[InertiaEntry, InertiaEntry, InertiaEntry],
+        tuple[InertiaEntry, InertiaEntry, InertiaEntry],
+        tuple[InertiaEntry, InertiaEntry, InertiaEntry],
+    ] | None = Field(
         None, description="inertia about the hub centre of mass, hub frame B [kg m^2]"
     )
 
@@ -79,7 +99,9 @@ class HubConfig(_Frozen):
 
 def _check_inertia(j: np.ndarray) -> None:
     scale = float(np.max(np.abs(j)))
-    if scale == 0.0 or np.max(np.abs(j - j.T)) > 1e-9 * scale:
+    if scale == 0.0:
+        raise ValueError("inertia_kg_m2 must be positive definite, got all zeros")
+    if np.max(np.abs(j - j.T)) > 1e-9 * scale:
         raise ValueError("inertia_kg_m2 must be symmetric (J == J^T)")
     principal = np.linalg.eigvalsh(j)
     if principal[0] <= 0.0:
@@ -102,12 +124,12 @@ class TargetFrequencies(_Frozen):
     bending), torsion about Y_M (the span axis), in-plane bending about Z_M.
     """
 
-    flapping: Positive = Field(description="out-of-plane bending, rotation about X_M [Hz]")
-    in_plane: Positive = Field(description="in-plane bending, rotation about Z_M [Hz]")
-    torsion: Positive = Field(description="torsion, rotation about Y_M [Hz]")
-    translation_x: Positive = Field(description="root translation along X_M [Hz]")
-    translation_y: Positive = Field(description="root translation along Y_M [Hz]")
-    translation_z: Positive = Field(description="root translation along Z_M [Hz]")
+    flapping: Frequency = Field(description="out-of-plane bending, rotation about X_M [Hz]")
+    in_plane: Frequency = Field(description="in-plane bending, rotation about Z_M [Hz]")
+    torsion: Frequency = Field(description="torsion, rotation about Y_M [Hz]")
+    translation_x: Frequency = Field(description="root translation along X_M [Hz]")
+    translation_y: Frequency = Field(description="root translation along Y_M [Hz]")
+    translation_z: Frequency = Field(description="root translation along Z_M [Hz]")
 
     def per_dof(self) -> np.ndarray:
         """Frequencies in joint-DOF order, shape (6,) [Hz].
@@ -136,16 +158,16 @@ class AppendageConfig(_Frozen):
     Give the mass either as ``surface_density_kg_m2`` (eq. 2.6) or as ``mass_kg``.
     """
 
-    name: Annotated[str, Field(min_length=1, max_length=64)]
-    mount_point_m: Vector3 = Field(description="root position from hub centre of mass, frame B [m]")
+    name: Name
+    mount_point_m: Point3 = Field(description="root position from hub centre of mass, frame B [m]")
     mount_yaw_deg: Angle = Field(0.0, description="mount frame rotation about Z_B [deg]")
     sadm_angle_deg: Angle = Field(0.0, description="SADM angle about Y_M [deg]")
     span_direction: Literal["+y", "-y"] = Field("+y", description="span along +Y_M or -Y_M")
-    length_m: Positive = Field(description="span L_p [m]")
-    width_m: Positive = Field(description="chord W_p [m]")
-    thickness_m: Positive = Field(description="thickness t_p [m]")
-    surface_density_kg_m2: Positive | None = Field(None, description="rho_sup [kg/m^2]")
-    mass_kg: Positive | None = Field(None, description="panel mass M_p [kg]")
+    length_m: Size = Field(description="span L_p [m]")
+    width_m: Size = Field(description="chord W_p [m]")
+    thickness_m: Thickness = Field(description="thickness t_p [m]")
+    surface_density_kg_m2: Density | None = Field(None, description="rho_sup [kg/m^2]")
+    mass_kg: Mass | None = Field(None, description="panel mass M_p [kg]")
     target_frequencies_hz: TargetFrequencies
     damping_ratio: Annotated[float, Strict(), AllowInfNan(False), Field(ge=0.0, lt=1.0)] = Field(
         description="viscous damping ratio zeta of every joint DOF [-]"
@@ -188,7 +210,7 @@ class AppendageConfig(_Frozen):
 class SatelliteConfig(_Frozen):
     """A hub and its list of flexible appendages."""
 
-    name: Annotated[str, Field(min_length=1, max_length=128)] = "satellite"
+    name: Name = "satellite"
     hub: HubConfig
     appendages: Annotated[list[AppendageConfig], Field(min_length=1, max_length=64)]
 
@@ -198,4 +220,14 @@ class SatelliteConfig(_Frozen):
         duplicated = sorted({n for n in names if names.count(n) > 1})
         if duplicated:
             raise ValueError(f"appendage names must be unique, repeated: {duplicated}")
+        hub = self.hub
+        if hub.radius_m is not None:  # a cylinder: its surface is known
+            for k, app in enumerate(self.appendages):
+                x, y, z = app.mount_point_m
+                if np.hypot(x, y) < hub.radius_m and abs(z) < 0.5 * hub.height_m:
+                    raise ValueError(
+                        f"appendages[{k}].mount_point_m {list(app.mount_point_m)} is inside the "
+                        f"hub (radius {hub.radius_m:g} m, height {hub.height_m:g} m); mount "
+                        "appendages on or outside its surface"
+                    )
         return self

@@ -4,14 +4,26 @@ from __future__ import annotations
 
 import json
 import math
+import os
+import warnings
+from dataclasses import dataclass
 
 from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
 
 from flexsat import __version__
 from flexsat.dynamics import kernels
 from flexsat.dynamics.integrators import STATUS_NOT_FINITE
+from flexsat.errors import ConfigError
 
-__all__ = ["PROGRESS_MIN_STEPS", "chunk_steps", "progress_bar", "run_attributes"]
+__all__ = [
+    "PROGRESS_MIN_STEPS",
+    "LongRunWarning",
+    "RunEstimate",
+    "check_run_size",
+    "chunk_steps",
+    "progress_bar",
+    "run_attributes",
+]
 
 PROGRESS_MIN_STEPS = 200_000  # runs shorter than this (~1 s of wall time) show no bar
 _CHUNK_STEPS = 10_000  # compiled steps between progress updates
@@ -70,3 +82,79 @@ class progress_bar:
             self.progress.stop()
 
 
+
+
+# Measured on the nominal satellite (18 DOF): about 830 B per record of an open-loop
+# dataset and 980 B of a slew's, i.e. 8 B x (5 per DOF + 40) at most; the records,
+# the dataset built from them and the NetCDF writer hold up to three copies.
+_BYTES_PER_RECORD_PER_DOF = 40.0
+_BYTES_PER_RECORD = 320.0
+_COPIES = 3.0
+_SECONDS_PER_STEP_PER_DOF = 0.25e-6  # 3.4-3.9 us per RK4 step at 18 DOF (docs/performance.md)
+LONG_RUN_S = 600.0
+"""Runs estimated to take longer than this [s] are announced with their estimate."""
+
+
+class LongRunWarning(UserWarning):
+    """A run is expected to take long; the message gives the estimate."""
+
+
+@dataclass(frozen=True)
+class RunEstimate:
+    """What a run will cost: steps, records, peak memory [bytes] and wall time [s]."""
+
+    steps: int
+    records: int
+    memory_bytes: float
+    wall_time_s: float
+
+
+def check_run_size(n_dof: int, scenario, available_bytes: float | None = None) -> RunEstimate:
+    """Estimate a run's cost before it starts; refuse what cannot fit in memory.
+
+    Parameters
+    ----------
+    n_dof : int
+        Generalized coordinates of the plant.
+    scenario : OpenLoopScenario or SlewScenario
+    available_bytes : float, optional
+        Memory the run may use; default: half the machine's physical memory.
+
+    Raises
+    ------
+    ConfigError
+        If the records would not fit; the message gives the estimate and the fix.
+
+    Warns
+    -----
+    LongRunWarning
+        If the run is expected to take more than :data:`LONG_RUN_S`.
+    """
+    steps = scenario.n_steps
+    records = steps // scenario.record_every + 1
+    per_record = _BYTES_PER_RECORD + _BYTES_PER_RECORD_PER_DOF * n_dof
+    estimate = RunEstimate(
+        steps, records, _COPIES * per_record * records, _SECONDS_PER_STEP_PER_DOF * n_dof * steps
+    )
+    limit = available_bytes if available_bytes is not None else 0.5 * _physical_memory()
+    if estimate.memory_bytes > limit:
+        raise ConfigError(
+            f"record_dt_s: the run would keep {records:.3g} records, about "
+            f"{estimate.memory_bytes / 2**30:.3g} GiB in memory (at most {limit / 2**30:.3g} "
+            "GiB here); record less often (a larger record_dt_s) or shorten duration_s"
+        )
+    if estimate.wall_time_s > LONG_RUN_S:
+        warnings.warn(
+            f"this run takes {steps:.3g} steps, about {estimate.wall_time_s / 60:.0f} min, "
+            f"and keeps about {estimate.memory_bytes / 2**30:.2g} GiB of records",
+            LongRunWarning,
+            stacklevel=2,
+        )
+    return estimate
+
+
+def _physical_memory() -> float:
+    try:
+        return float(os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES"))
+    except (ValueError, OSError, AttributeError):  # not reported: assume 8 GiB
+        return 8.0 * 2**30

@@ -9,15 +9,18 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 from flexsat.dynamics.integrators import (
+    STATUS_NOT_FINITE,
     applied_torque,
     augmented_derivative,
     rk4_open_loop,
 )
+from flexsat.dynamics.kernels import STATUS_HUB_GIMBAL_LOCK, STATUS_OK
 from flexsat.dynamics.linalg3 import euler_rate_matrix_inv
 from flexsat.dynamics.plant import Plant
-from flexsat.errors import ConfigError, SimulationError
+from flexsat.errors import ConfigError
 from flexsat.simulate.common import (
     PROGRESS_MIN_STEPS,
+    check_run_size,
     chunk_steps,
     progress_bar,
     run_attributes,
@@ -86,8 +89,15 @@ def run_openloop(
         Recorded every ``record_dt_s``. A diverging run stops at the failing step and
         returns its history up to there with ``status = "failed"`` and a message
         that names the time; it does not raise.
+
+    Raises
+    ------
+    ConfigError
+        Before it starts, if its records would not fit in memory
+        (:func:`flexsat.simulate.common.check_run_size`).
     """
     scenario = scenario or thesis_openloop()
+    check_run_size(plant.n_dof, scenario)
     q0, qd0 = initial_state(plant, scenario)
     profile = _profile(scenario)
     start = time.perf_counter()
@@ -143,8 +153,18 @@ def _run_rk4(plant, scenario, q0, qd0, profile, progress):
     return rec_t, rec_x, rec_tau, status, t_fail, done
 
 
+_DOP853_MIN_COS = 1e-4
+"""DOP853 stops when cos(pitch) falls below this (pitch within 0.006 deg of +-90 deg):
+the ZYX rates S(Theta)^-1 grow as 1/cos(pitch), and the adaptive steps would shrink
+to nothing there instead of stopping as the RK4 kernel does."""
+
+
 def _run_dop853(plant, scenario, q0, qd0, profile):
-    """Adaptive DOP853 (scipy), integrated piecewise between torque switching times."""
+    """Adaptive DOP853 (scipy), integrated piecewise between torque switching times.
+
+    A run that reaches the pitch singularity or diverges stops there, like RK4: the
+    records up to the failure and the last good state are kept, with its status.
+    """
     n = plant.n_dof
     seg_start, seg_end, _, _ = profile
     every = scenario.record_every
@@ -154,29 +174,45 @@ def _run_dop853(plant, scenario, q0, qd0, profile):
     )
     x = np.concatenate([q0, qd0, [0.0, 0.0]])
     X = np.empty((t_rec.size, x.size))
+    X[0] = x
     Q = np.empty(n)
     evaluations = 0
+    kernel_status = STATUS_OK
 
+    def pitch_lock(t, y, torque=None):  # cos(pitch) > 0 from the start (|pitch| < 89 deg)
+        return np.cos(y[4]) - _DOP853_MIN_COS
+
+    pitch_lock.terminal = True
+    status, t_fail = STATUS_OK, -1.0
     for a, b in itertools.pairwise(breaks):
         torque = applied_torque(0.5 * (a + b), *profile)
 
         def rhs(t, y, torque=torque):
-            nonlocal evaluations
+            nonlocal evaluations, kernel_status
             evaluations += 1
             dy = np.empty_like(y)
-            if augmented_derivative(y, torque, n, Q, dy, plant.dynamics_args) != 0:
-                raise SimulationError(f"singular kinematics at t = {t:.6g} s")
+            code = augmented_derivative(y, torque, n, Q, dy, plant.dynamics_args)
+            if code != STATUS_OK:  # a joint's singularity: make the step fail here
+                kernel_status = code
+                dy[:] = np.nan
             return dy
 
-        inside = (t_rec >= a) & (t_rec <= b)
         sol = solve_ivp(
             rhs, (a, b), x, method="DOP853", rtol=scenario.rtol, atol=scenario.atol,
-            dense_output=True,
+            dense_output=True, events=pitch_lock,
         )  # fmt: skip
-        if not sol.success:
-            raise SimulationError(f"DOP853 failed between {a} and {b} s: {sol.message}")
+        t_end = float(sol.t[-1])
+        inside = (t_rec >= a) & (t_rec <= t_end)
         X[inside] = sol.sol(t_rec[inside]).T
         x = sol.y[:, -1]
+        if sol.status != 0:  # 1: the pitch singularity; -1: the steps failed (diverged)
+            status = STATUS_HUB_GIMBAL_LOCK if sol.status == 1 else kernel_status
+            status = status or STATUS_NOT_FINITE
+            t_fail = t_end
+            break
+    if status:
+        kept = int(np.searchsorted(t_rec, t_fail, side="right"))
+        t_rec = np.append(t_rec[:kept], t_fail) if t_fail > t_rec[kept - 1] else t_rec[:kept]
+        X = np.vstack([X[:kept], x]) if t_rec.size > kept else X[:kept]
     tau = np.array([applied_torque(t, *profile) for t in t_rec]).reshape(-1, 3)
-    return t_rec, X, tau, 0, -1.0, evaluations
-
+    return t_rec, X, tau, status, t_fail, evaluations

@@ -9,7 +9,7 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Annotated, ClassVar, Literal
 
-from pydantic import Field, model_validator
+from pydantic import Field, Strict, model_validator
 
 from flexsat.analysis.requirements import Requirements
 from flexsat.config.load import read_toml, validate_config
@@ -17,6 +17,7 @@ from flexsat.config.models import Positive, Real, Vector3, _Frozen
 from flexsat.control.config import ActuatorConfig, ASMCConfig, ControllerConfig, DisturbanceConfig
 
 __all__ = [
+    "MAX_STEPS",
     "AppendageInitialState",
     "InitialState",
     "OpenLoopScenario",
@@ -36,7 +37,7 @@ _ZERO3 = (0.0, 0.0, 0.0)
 class TorqueSegment(_Frozen):
     """A constant body torque applied over [start_s, end_s); ``end_s`` omitted: to the end."""
 
-    start_s: Annotated[float, Field(ge=0.0, allow_inf_nan=False)] = 0.0
+    start_s: Annotated[float, Strict(), Field(ge=0.0, allow_inf_nan=False)] = 0.0
     end_s: Positive | None = None
     torque_nm: Vector3 = Field(description="torque on the hub, hub frame B [N m]")
 
@@ -88,7 +89,16 @@ class InitialState(_Frozen):
     def _pitch(self) -> InitialState:
         if abs(self.attitude_deg[1]) >= 89.0:
             raise ValueError("attitude_deg pitch must be within (-89, 89) deg (ZYX singularity)")
+        names = [app.name for app in self.appendages]
+        repeated = sorted({name for name in names if names.count(name) > 1})
+        if repeated:
+            raise ValueError(f"appendages: one initial state per appendage, repeated: {repeated}")
         return self
+
+
+MAX_STEPS = 1e9
+"""Most integration steps of one run: the longest documented run (1e6 s) at the
+default 1 ms step; about an hour of wall time on one core."""
 
 
 class _TimedRun(_Frozen):
@@ -112,6 +122,13 @@ class _TimedRun(_Frozen):
                 )
         if self.duration_s < self.record_dt_s:
             raise ValueError(f"duration_s must be at least record_dt_s ({self.record_dt_s})")
+        steps = self.duration_s / self.dt_s
+        if steps > MAX_STEPS:
+            raise ValueError(
+                f"duration_s / dt_s = {steps:.3g} steps is more than the {MAX_STEPS:.0e} "
+                f"allowed (duration_s {self.duration_s:g} s at dt_s {self.dt_s:g} s); "
+                "use a larger dt_s or a shorter run"
+            )
         return self
 
     @property
@@ -136,6 +153,16 @@ class OpenLoopScenario(_TimedRun):
         default_factory=lambda: [TorqueSegment(start_s=0.0, end_s=10.0, torque_nm=(0, 0, 1.0))]
     )
     disturbance_torque_nm: Vector3 = Field(_ZERO3, description="constant body torque [N m]")
+
+    @model_validator(mode="after")
+    def _segments_inside_the_run(self) -> OpenLoopScenario:
+        for k, segment in enumerate(self.torque):
+            if segment.start_s >= self.duration_s:
+                raise ValueError(
+                    f"torque[{k}].start_s = {segment.start_s:g} s is at or after the end of "
+                    f"the run (duration_s = {self.duration_s:g} s): it would never act"
+                )
+        return self
 
 
 class SlewScenario(_TimedRun):

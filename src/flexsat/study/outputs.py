@@ -9,10 +9,12 @@ the one source of the numbers that the CLI prints and the study report shows.
 from __future__ import annotations
 
 import json
+import tempfile
 from collections.abc import Callable
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from flexsat.errors import ConfigError
 from flexsat.jsonable import jsonable
 
 if TYPE_CHECKING:  # the CLI imports this module at start-up: keep numba out of it
@@ -23,9 +25,30 @@ __all__ = [
     "fly_campaign",
     "fly_openloop",
     "fly_slew",
+    "prepare_output_dir",
     "write_json",
     "write_modal",
 ]
+
+
+def prepare_output_dir(path: str | Path, option: str = "--out") -> Path:
+    """Create an output folder now and check it can be written, before any work.
+
+    Raises
+    ------
+    ConfigError
+        If ``path`` is a file, or the folder cannot be created or written.
+    """
+    path = Path(path)
+    if path.exists() and not path.is_dir():
+        raise ConfigError(f"{option} {path}: exists and is not a folder")
+    try:
+        path.mkdir(parents=True, exist_ok=True)
+        with tempfile.TemporaryFile(dir=path):
+            pass
+    except OSError as exc:
+        raise ConfigError(f"{option} {path}: cannot write there ({exc.strerror or exc})") from None
+    return path
 
 
 def write_json(path: str | Path, payload: dict) -> Path:
@@ -76,6 +99,8 @@ def write_modal(plant: Plant, out: Path | None = None, animate: list[int] | None
     from flexsat.analysis.modal import modal_analysis
     from flexsat.plots.modal import write_modal_figures
 
+    if out is not None:
+        prepare_output_dir(out)
     analysis = modal_analysis(plant)
     summary = analysis.to_dict()
     if out is not None:
@@ -112,6 +137,8 @@ def fly_openloop(plant: Plant, scenario=None, out: Path | None = None, progress=
 
         return write_openloop_figures(result.dataset, modal_analysis(plant), Path(out))
 
+    if out is not None:
+        prepare_output_dir(out)
     result = run_openloop(plant, scenario or OpenLoopScenario(), progress=progress)
     metrics = openloop_metrics(result.dataset)
     if out is not None:
@@ -139,6 +166,7 @@ def fly_slew(plant: Plant, scenario=None, out: Path | None = None, progress=None
     """
     from flexsat.analysis.requirements import slew_metrics
     from flexsat.simulate import SlewScenario, run_slew
+    from flexsat.simulate.common import check_run_size
 
     def figures() -> list[Path]:
         from flexsat.plots.slew import write_slew_figures
@@ -146,6 +174,9 @@ def fly_slew(plant: Plant, scenario=None, out: Path | None = None, progress=None
         return write_slew_figures(result.dataset, Path(out))
 
     scenario = scenario or SlewScenario()
+    check_run_size(plant.n_dof, scenario)
+    if out is not None:
+        prepare_output_dir(out)
     result = run_slew(plant, scenario, progress=progress)
     metrics = slew_metrics(result.dataset)  # the stored scenario's requirements
     if out is not None:
@@ -158,10 +189,12 @@ def _write_run(result, metrics: dict, out: Path, figures: Callable[[], list[Path
     metrics.json into ``out``; the written paths are added to ``metrics["files"]``."""
     out.mkdir(parents=True, exist_ok=True)
     files = [result.to_netcdf(out / "result.nc")]
+    metrics["files"] = [str(p) for p in [*files, out / "metrics.json"]]
+    write_json(out / "metrics.json", metrics)  # first: a figure that fails loses no number
     if result.ok:
         files += figures()
-    metrics["files"] = [str(p) for p in [*files, out / "metrics.json"]]
-    write_json(out / "metrics.json", metrics)
+        metrics["files"] = [str(p) for p in [*files, out / "metrics.json"]]
+        write_json(out / "metrics.json", metrics)
 
 
 def fly_campaign(definition, config, store: Path, *, progress: bool = True, **backend) -> dict:

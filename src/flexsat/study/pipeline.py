@@ -20,6 +20,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from rich.console import Console
+from rich.markup import escape
 
 from flexsat import __version__
 from flexsat.config.models import SatelliteConfig
@@ -28,6 +29,7 @@ from flexsat.study.outputs import (
     fly_campaign,
     fly_openloop,
     fly_slew,
+    prepare_output_dir,
     write_json,
     write_modal,
 )
@@ -206,8 +208,7 @@ def run_study(
     """
     from flexsat.study.report import write_report
 
-    out = Path(out)
-    out.mkdir(parents=True, exist_ok=True)
+    out = prepare_output_dir(out)
     console = console or Console(stderr=True)
     ctx = StudyContext(config, out, quick, progress, workers)
     manifest = {
@@ -264,5 +265,5 @@ def _announce(console: Console, part: Part, entry: dict) -> None:
     style = {"ok": "green", "failed": "bold red", "skipped": "yellow"}[entry["status"]]
     line = f"[{style}]{entry['status']:>7}[/] {part.title} ({entry['wall_time_s']:.1f} s)"
     if entry["status"] != "ok":
-        line += f": {entry['error']}"
+        line += f": {escape(entry['error'])}"
     console.print(line, highlight=False)

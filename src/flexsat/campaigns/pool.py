@@ -1,0 +1,172 @@
+"""A local pool of worker processes that stops when told to and never outlives its parent.
+
+Unlike :class:`concurrent.futures.ProcessPoolExecutor`, which is handed every case
+up front and waits for all of them, :class:`LocalPool` gives each worker one item
+at a time. So:
+
+- leaving the pool (an exception, Ctrl-C, SIGTERM turned into ``KeyboardInterrupt``)
+  cancels what is pending and stops the workers at once (SIGTERM, then SIGKILL
+  after a grace period);
+- a worker that dies (killed, out of memory) is replaced and its item given to the
+  new worker; an item that kills its worker twice is handed to ``on_lost``;
+- a worker whose parent dies (even by SIGKILL, as the out-of-memory killer does)
+  notices within a fraction of a second and exits.
+
+Workers are started with the ``spawn`` method: they share nothing with the parent
+(no inherited threads or locks, no inherited signal handlers).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import ctypes
+import ctypes.util
+import multiprocessing
+import os
+import signal
+import sys
+import threading
+import time
+from collections import deque
+from collections.abc import Callable, Iterable, Iterator
+from multiprocessing.connection import wait
+
+__all__ = ["LocalPool"]
+
+_PARENT_POLL_S = 0.2  # how often a worker checks that its parent is alive
+_GRACE_S = 1.0  # time given to a worker to exit on SIGTERM before SIGKILL
+_ATTEMPTS = 2  # runs of an item whose worker died before it is given up
+_PR_SET_PDEATHSIG = 1  # prctl(2) option: signal sent to this process when its parent dies
+
+
+class LocalPool:
+    """Run ``function`` on items in ``n_workers`` processes, one item per worker at a time.
+
+    Parameters
+    ----------
+    function : callable
+        Importable (module-level) function of one item; it must not raise.
+    n_workers : int
+        Worker processes.
+    on_lost : callable
+        ``on_lost(item, exitcode)`` gives the result of an item whose worker died
+        ``_ATTEMPTS`` times running it.
+
+    Use it as a context manager; leaving the block stops every worker.
+    """
+
+    def __init__(self, function: Callable, n_workers: int, on_lost: Callable) -> None:
+        self.function, self.n_workers, self.on_lost = function, n_workers, on_lost
+        self._context = multiprocessing.get_context("spawn")
+        self._workers: list[_Worker] = []
+
+    def __enter__(self) -> LocalPool:
+        self._workers = [self._start() for _ in range(self.n_workers)]
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()
+
+    def _start(self) -> _Worker:
+        ours, theirs = self._context.Pipe()
+        process = self._context.Process(
+            target=_serve, args=(theirs, self.function, os.getpid()), daemon=True
+        )
+        process.start()
+        theirs.close()
+        return _Worker(process, ours)
+
+    def map_unordered(self, items: Iterable) -> Iterator:
+        """Results of ``function(item)`` as they come, in completion order."""
+        pending = deque(items)
+        attempts: dict[int, int] = {}
+        while pending or any(w.item is not None for w in self._workers):
+            for k, worker in enumerate(self._workers):
+                if worker.item is None and pending:
+                    item = pending.popleft()
+                    try:
+                        worker.give(item)
+                    except OSError:  # it died while idle: a new worker takes the item
+                        self._replace(worker)
+                        self._workers[k].give(item)
+            busy = [w for w in self._workers if w.item is not None]
+            ready = wait([w.conn for w in busy] + [w.process.sentinel for w in busy])
+            for worker in busy:
+                if worker.conn in ready and worker.conn.poll():
+                    try:
+                        result = worker.conn.recv()
+                    except (EOFError, OSError):  # died while sending: handled below
+                        result = None
+                    else:
+                        worker.item = None
+                        yield result
+                        continue
+                if worker.process.sentinel in ready or not worker.process.is_alive():
+                    item, exitcode = worker.item, worker.process.exitcode
+                    self._replace(worker)
+                    attempts[id(item)] = attempts.get(id(item), 0) + 1
+                    if attempts[id(item)] >= _ATTEMPTS:
+                        yield self.on_lost(item, exitcode)
+                    else:
+                        pending.appendleft(item)
+
+    def _replace(self, worker: _Worker) -> None:
+        worker.stop()
+        self._workers[self._workers.index(worker)] = self._start()
+
+    def close(self) -> None:
+        """Stop every worker: SIGTERM, then SIGKILL after a grace period."""
+        for worker in self._workers:
+            worker.process.terminate()
+        deadline = time.monotonic() + _GRACE_S
+        for worker in self._workers:
+            worker.process.join(max(0.0, deadline - time.monotonic()))
+            worker.stop()
+        self._workers = []
+
+
+class _Worker:
+    def __init__(self, process, conn) -> None:
+        self.process, self.conn, self.item = process, conn, None
+
+    def give(self, item) -> None:
+        self.item = item
+        self.conn.send(item)
+
+    def stop(self) -> None:
+        if self.process.is_alive():
+            self.process.kill()
+        self.process.join()
+        self.conn.close()
+
+
+def _serve(conn, function: Callable, parent_pid: int) -> None:
+    """Worker loop: run each received item, send the result back; exit with the parent."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)  # the parent decides what Ctrl-C stops
+    _die_with_parent()
+    threading.Thread(target=_exit_with_parent, args=(parent_pid,), daemon=True).start()
+    while True:
+        try:
+            item = conn.recv()
+        except (EOFError, OSError):  # the parent closed the pipe
+            return
+        conn.send(function(item))
+
+
+def _die_with_parent() -> None:
+    """On Linux, have the kernel send SIGKILL to this worker when its parent dies.
+
+    Immediate even while the worker holds the GIL (compiling, in a compiled loop);
+    elsewhere :func:`_exit_with_parent` alone watches the parent.
+    """
+    if not sys.platform.startswith("linux"):
+        return
+    with contextlib.suppress(OSError, AttributeError):
+        libc = ctypes.CDLL(ctypes.util.find_library("c") or "libc.so.6", use_errno=True)
+        libc.prctl(_PR_SET_PDEATHSIG, signal.SIGKILL)
+
+
+def _exit_with_parent(parent_pid: int) -> None:
+    while os.getppid() == parent_pid:
+        time.sleep(_PARENT_POLL_S)
+    os._exit(1)

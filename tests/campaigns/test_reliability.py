@@ -1,0 +1,244 @@
+"""Campaign reliability with real processes, signals and files: resume rules, Ctrl-C,
+SIGTERM, dead workers and parents, damaged stores, the lock, paths."""
+
+from __future__ import annotations
+
+import json
+import os
+import resource
+import signal
+import subprocess
+import sys
+import time
+
+import psutil
+import pytest
+
+from flexsat.campaigns import CampaignStore, load_campaign, replay_case, run_campaign, summarize
+from flexsat.campaigns.definition import CampaignDefinition, campaign_fingerprint, resolve_cases
+from flexsat.config import nominal, validate_config
+from flexsat.errors import ConfigError
+from tests.conftest import nominal_dict
+
+FLEXSAT = [sys.executable, "-m", "flexsat"]
+
+
+def _short(name: str, duration: float) -> CampaignDefinition:
+    data = load_campaign(name).model_dump(mode="json")
+    data["base"] = {**data["base"], "duration_s": duration}
+    return validate_config(data, model=CampaignDefinition)
+
+
+def _heavy():
+    data = nominal_dict()
+    data["hub"]["mass_kg"] = 300.0
+    return validate_config(data)
+
+
+@pytest.fixture(scope="module")
+def small_store(tmp_path_factory):
+    """A finished 3-case random campaign (1 s slews), the store the resume tests start from."""
+    store = tmp_path_factory.mktemp("small")
+    definition = _short("montecarlo-random", 1.0)
+    run_campaign(definition, nominal(), store, workers=1, n_random=2, progress=False)
+    return store, definition
+
+
+def test_resume_refuses_another_satellite_naming_it(small_store):
+    store, definition = small_store
+    with pytest.raises(ConfigError, match="the satellite config"):
+        run_campaign(definition, _heavy(), store, resume=True, n_random=2, progress=False)
+
+
+def test_resume_refuses_another_case_count_naming_both(small_store):
+    store, definition = small_store
+    with pytest.raises(ConfigError, match=r"the number of cases \(stored 3, given 5\)"):
+        run_campaign(definition, nominal(), store, resume=True, n_random=4, progress=False)
+
+
+def test_the_study_resumes_only_an_identical_campaign(tmp_path):
+    """The study resumes its campaigns (``fly_campaign(..., resume=True)``): another
+    satellite in the same folder is refused, naming it; the same one runs nothing."""
+    from flexsat.study.outputs import fly_campaign
+
+    definition = _short("montecarlo-random", 1.0)
+    options = {"workers": 1, "resume": True, "n_random": 1, "progress": False}
+    assert fly_campaign(definition, nominal(), tmp_path, **options)["ran"] == 2
+    with pytest.raises(ConfigError, match="the satellite config"):
+        fly_campaign(definition, _heavy(), tmp_path, **options)
+    assert fly_campaign(definition, nominal(), tmp_path, **options)["ran"] == 0
+
+
+def test_damaged_cases_are_named_then_recomputed_alone(tmp_path, small_store):
+    source, definition = small_store
+    store = tmp_path / "store"
+    subprocess.run(["cp", "-r", str(source), str(store)], check=True)
+    cases = store / "cases"
+    truncated, emptied = cases / "random-00000.json", cases / "random-00001.json"
+    truncated.write_text(truncated.read_text()[:40])
+    emptied.write_text("{}")
+    (store / "histories" / "tmpabc.partial").write_text("left by a kill")
+    with pytest.raises(ConfigError, match=r"damaged case file .*random-00000\.json"):
+        summarize(store)
+    untouched = (cases / "nominal.json").stat().st_mtime_ns
+    run = run_campaign(
+        definition, nominal(), store, workers=1, resume=True, n_random=2, progress=False
+    )
+    assert run["ran"] == 2  # only the two damaged cases
+    assert (cases / "nominal.json").stat().st_mtime_ns == untouched
+    assert summarize(store)["cases"] == 3
+    assert not list(store.rglob("*.partial"))
+
+
+def test_a_live_store_is_locked_and_the_holder_named(tmp_path):
+    definition = _short("montecarlo-random", 1.0)
+    cases = resolve_cases(definition, nominal(), n_random=1)
+    store = CampaignStore(tmp_path)
+    with store.opened(campaign_fingerprint(definition, nominal(), cases), "x", False):
+        with pytest.raises(ConfigError, match=f"in use by process {os.getpid()} on "):
+            run_campaign(definition, nominal(), tmp_path, resume=True, n_random=1, progress=False)
+
+
+def test_store_files_share_one_mode(small_store):
+    store, _ = small_store
+    umask = os.umask(0)
+    os.umask(umask)
+    expected = 0o666 & ~umask
+    for path in [*store.glob("cases/*.json"), *store.glob("histories/*.nc"),
+                 store / "campaign.json", store / "results.parquet"]:  # fmt: skip
+        assert path.stat().st_mode & 0o777 == expected, path
+
+
+@pytest.mark.parametrize("name", ["../../outside", "/tmp/absolute", ".hidden", "a/b"])
+def test_campaign_names_cannot_leave_the_output_folder(tmp_path, name):
+    path = tmp_path / "c.toml"
+    path.write_text(f'name = "{name}"\n')
+    with pytest.raises(ConfigError, match="name: contains characters that are not allowed"):
+        load_campaign(path)
+
+
+@pytest.mark.parametrize("case_id", ["../../outside", "/etc/passwd", "..", "a/b"])
+def test_replay_validates_the_case_id(small_store, case_id):
+    store, _ = small_store
+    with pytest.raises(ConfigError, match="is not a case id"):
+        replay_case(store, case_id)
+
+
+def test_replay_needs_a_campaign_store(tmp_path):
+    with pytest.raises(ConfigError, match="not a campaign store"):
+        replay_case(tmp_path, "nominal")
+
+
+# -- signals and processes ---------------------------------------------------------
+
+
+def _start(store, *extra: str, duration: str = "5") -> subprocess.Popen:
+    """The 12 sensitivity cases on 2 workers (``extra`` options may change the campaign)."""
+    command = [*FLEXSAT, "campaign", *(extra or ("sensitivity",)), "--duration", duration,
+               "--workers", "2", "--out", str(store), "--json"]  # fmt: skip
+    return subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+
+
+def _wait_for(predicate, timeout: float = 240.0) -> None:
+    deadline = time.monotonic() + timeout
+    while not predicate():
+        if time.monotonic() > deadline:
+            raise AssertionError("timed out waiting for the campaign")
+        time.sleep(0.05)
+
+
+def _workers_of(process: subprocess.Popen) -> list[psutil.Process]:
+    _wait_for(lambda: len(_children(process)) >= 2)
+    return _children(process)
+
+
+def _children(process: subprocess.Popen) -> list[psutil.Process]:
+    """The pool's worker processes (spawned Pythons), not the other children (resource tracker)."""
+    try:
+        children = psutil.Process(process.pid).children()
+    except psutil.NoSuchProcess:
+        return []
+    return [c for c in children if "spawn_main" in " ".join(_cmdline(c))]
+
+
+def _cmdline(child: psutil.Process) -> list[str]:
+    try:
+        return child.cmdline()
+    except psutil.Error:
+        return []
+
+
+def _stored(store) -> int:
+    return len(list((store / "cases").glob("*.json")))
+
+
+def _gone_within(workers: list[psutil.Process], seconds: float) -> bool:
+    """Every worker exited (an orphan may stay a zombie until its new parent reaps it)."""
+    deadline = time.monotonic() + seconds
+    while any(_running(w) for w in workers):
+        if time.monotonic() > deadline:
+            return False
+        time.sleep(0.02)
+    return True
+
+
+def _running(process: psutil.Process) -> bool:
+    try:
+        return process.status() != psutil.STATUS_ZOMBIE
+    except psutil.NoSuchProcess:
+        return False
+
+
+@pytest.mark.parametrize(("signum", "code"), [(signal.SIGINT, 130), (signal.SIGTERM, 143)])
+def test_interrupt_cancels_pending_cases_and_stops_the_workers(tmp_path, signum, code):
+    store = tmp_path / "store"
+    process = _start(store)
+    workers = _workers_of(process)
+    _wait_for(lambda: _stored(store) >= 1)
+    process.send_signal(signum)
+    _, stderr = process.communicate(timeout=30)
+    assert _gone_within(workers, 2.0)  # the brief: workers exit within 2 s
+    assert process.returncode == code
+    stored = _stored(store)
+    assert stored < 12  # pending cases were cancelled, not run to the end
+    assert f"{stored} of 12 cases are stored" in stderr
+    assert "--resume" in stderr
+    assert "Traceback" not in stderr
+
+
+def test_killing_the_parent_leaves_no_worker_behind(tmp_path):
+    store = tmp_path / "store"
+    process = _start(store)
+    workers = _workers_of(process)
+    _wait_for(lambda: _stored(store) >= 1)  # the workers are past their start-up
+    process.send_signal(signal.SIGKILL)  # as the out-of-memory killer does
+    process.wait()
+    assert _gone_within(workers, 2.0)
+
+
+def test_a_killed_worker_is_replaced_and_the_campaign_completes(tmp_path):
+    store = tmp_path / "store"
+    process = _start(store, "montecarlo-random", "--cases", "4", duration="2")
+    workers = _workers_of(process)
+    workers[0].kill()
+    stdout, stderr = process.communicate(timeout=300)
+    assert process.returncode == 0, stderr
+    summary = json.loads(stdout)
+    assert (summary["cases"], summary["failed"]) == (5, 0)
+
+
+def test_a_write_error_stops_the_run_at_once_with_one_message(tmp_path):
+    """Files above 8 kB cannot be written (as on a full disk): the first history fails."""
+
+    def small_files() -> None:
+        resource.setrlimit(resource.RLIMIT_FSIZE, (8192, 8192))
+
+    store = tmp_path / "store"
+    command = [*FLEXSAT, "campaign", "sensitivity", "--duration", "1", "--workers", "1",
+               "--out", str(store), "--json"]  # fmt: skip
+    result = subprocess.run(command, capture_output=True, text=True, timeout=300,
+                            preexec_fn=small_files)  # fmt: skip
+    assert result.returncode == 2
+    assert "cannot write to the campaign store" in result.stderr
+    assert "0 of 12 cases are stored" in result.stderr and "--resume" in result.stderr
+    assert "Traceback" not in result.stderr

@@ -1,0 +1,226 @@
+"""Every bad input a user can give ends with one message and exit code 2, never a traceback.
+
+Each row: the files the user wrote, the command, a fragment the message must hold.
+The command runs through the real entry point (:func:`flexsat.cli.main.main`), in
+this process (see ``harness.py``). Nothing may be written outside the folders the
+command was given, and the message is one line of bounded length.
+"""
+
+from __future__ import annotations
+
+import copy
+import math
+from dataclasses import dataclass, field
+
+import pytest
+
+from tests.cli.harness import flexsat, to_toml
+from tests.conftest import nominal_dict
+
+
+@dataclass(frozen=True)
+class Bad:
+    id: str
+    argv: list[str]
+    fragment: str
+    files: dict = field(default_factory=dict)
+
+
+def _satellite(edit) -> str:
+    data = nominal_dict()
+    edit(data)
+    return to_toml(data)
+
+
+def _set(path: str, value):
+    """An edit of the nominal config: set (or, with ``...``, delete) a dotted path."""
+
+    def edit(data):
+        *parents, last = path.split(".")
+        node = data
+        for part in parents:
+            node = node[int(part)] if part.isdigit() else node[part]
+        if value is ...:
+            del node[int(last) if last.isdigit() else last]
+        else:
+            node[int(last) if last.isdigit() else last] = copy.deepcopy(value)
+
+    return edit
+
+
+def _config(id: str, path: str, value, fragment: str, command: str = "show") -> Bad:
+    argv = ["config", "show", "--config", "{tmp}/c.toml"] if command == "show" else [
+        "modal", "--config", "{tmp}/c.toml"]  # fmt: skip
+    return Bad(id, argv, fragment, {"c.toml": _satellite(_set(path, value))})
+
+
+def _scenario(id: str, body: str, fragment: str, command: str = "openloop") -> Bad:
+    return Bad(id, [command, "--scenario", "{tmp}/s.toml"], fragment, {"s.toml": body})
+
+
+def _campaign(id: str, body: str, fragment: str, *extra: str) -> Bad:
+    argv = ["campaign", "{tmp}/k.toml", "--out", "{tmp}/store", *extra]
+    return Bad(id, argv, fragment, {"k.toml": body})
+
+
+_CYLINDER_OFF = {"mass_kg": 150.0}
+_FREQ = "appendages.0.target_frequencies_hz"
+
+CONFIGS = [
+    _config("unknown top-level key", "colour", "red", "unknown key 'colour'"),
+    _config("misspelt key", "hub.mass", 150.0, "did you mean 'mass_kg'"),
+    _config("radians-style key", "appendages.0.sadm_angle", 0.5, "did you mean 'sadm_angle_deg'"),
+    _config("missing hub mass", "hub.mass_kg", ..., "missing required field 'hub.mass_kg'"),
+    _config("negative hub mass", "hub.mass_kg", -150.0, "hub.mass_kg: Input should be greater"),
+    _config("zero panel length", "appendages.0.length_m", 0.0, "appendages[0].length_m"),
+    _config("string for a number", "hub.radius_m", "0.6", "hub.radius_m: Input should be a valid number"),
+    _config("boolean for a number", "appendages.1.width_m", True, "appendages[1].width_m"),
+    _config("NaN mass", "hub.mass_kg", math.nan, "hub.mass_kg: Input should be a finite number"),
+    _config("infinite density", "appendages.0.surface_density_kg_m2", math.inf, "finite number"),
+    _config("zero frequency", f"{_FREQ}.flapping", 0.0, "target_frequencies_hz.flapping"),
+    _config("negative damping", "appendages.0.damping_ratio", -0.01, "damping_ratio"),
+    _config("damping ratio of one", "appendages.1.damping_ratio", 1.0, "less than 1"),
+    _config("SADM angle 400 deg", "appendages.0.sadm_angle_deg", 400.0, "sadm_angle_deg"),
+    _config("mass and density", "appendages.0.mass_kg", 6.75, "exactly one of"),
+    _config("neither mass nor density", "appendages.0.surface_density_kg_m2", ..., "exactly one of"),
+    _config("mount point of two numbers", "appendages.0.mount_point_m", [0.0, 0.8], "mount_point_m"),
+    _config("bad span direction", "appendages.0.span_direction", "+x", "span_direction"),
+    _config("no appendages", "appendages", [], "at least 1 item"),
+    _config("duplicate names", "appendages.1.name", "panel_1", "names must be unique"),
+    _config("cylinder and inertia", "hub.inertia_kg_m2", [[1, 0, 0], [0, 1, 0], [0, 0, 1]], "not both"),
+    _config("hub without geometry", "hub.radius_m", ..., "give both radius_m and height_m"),
+    _config("thick plate", "appendages.0.thickness_m", 2.0, "thickness_m must not exceed"),
+    _config("hub as a number", "hub", 3, "hub: expected a TOML table"),
+    _config("asymmetric inertia", "hub", {**_CYLINDER_OFF, "inertia_kg_m2": [[40, 1, 0], [0, 40, 0], [0, 0, 27]]}, "must be symmetric"),
+    _config("indefinite inertia", "hub", {**_CYLINDER_OFF, "inertia_kg_m2": [[40, 0, 0], [0, -1, 0], [0, 0, 27]]}, "positive definite"),
+    _config("non-physical inertia", "hub", {**_CYLINDER_OFF, "inertia_kg_m2": [[1, 0, 0], [0, 1, 0], [0, 0, 5]]}, "J1 + J2 >= J3"),
+    _config("all-zero inertia", "hub", {**_CYLINDER_OFF, "inertia_kg_m2": [[0, 0, 0], [0, 0, 0], [0, 0, 0]]}, "got all zeros"),
+    _config("huge inertia entry", "hub", {**_CYLINDER_OFF, "inertia_kg_m2": [[1e300, 0, 0], [0, 1e300, 0], [0, 0, 1e300]]}, "less than or equal to 1000000000000"),
+    _config("hub radius 1.34e154 (Hypothesis)", "hub.radius_m", 1.34e154, "hub.radius_m: Input should be less than or equal to 1000"),
+    _config("panel length 1e200", "appendages.0.length_m", 1e200, "appendages[0].length_m"),
+    _config("frequency 1e300", f"{_FREQ}.torsion", 1e300, "less than or equal to 10000"),
+    _config("flapping target 1e9 Hz", f"{_FREQ}.flapping", 1e9, "target_frequencies_hz.flapping"),
+    _config("panel width 7.5e5 m", "appendages.0.width_m", 7.5e5, "appendages[0].width_m"),
+    _config("hub mass 5e-324", "hub.mass_kg", 5e-324, "greater than or equal to 0.0001"),
+    _config("hub mass markup", "hub.mass_kg", "[/x]", "hub.mass_kg: Input should be a valid number (got '[/x]')"),
+    _config("appendage named with markup", "appendages.1.name", "[/]p2", "appendages[1].name: contains characters", command="modal"),
+    _config("appendage named with mathtext", "appendages.0.name", "$p_1$", "appendages[0].name: contains characters"),
+    _config("satellite named with markup", "name", "[bold]sat", "name: contains characters"),
+    _config("mount point inside the hub", "appendages.0.mount_point_m", [0.0, 0.3, 0.0], "is inside the hub"),
+    _config("mount point at the hub centre", "appendages.0.mount_point_m", [0.0, 0.0, 0.0], "is inside the hub"),
+    _config("mount point 1e6 m away", "appendages.0.mount_point_m", [0.0, 1e6, 0.0], "mount_point_m"),
+    _config("ill-conditioned modes", "appendages", [
+        {**nominal_dict()["appendages"][k], "target_frequencies_hz": {
+            **nominal_dict()["appendages"][k]["target_frequencies_hz"],
+            "flapping": 1e-3, "translation_x": 1e4}} for k in range(2)],
+        "modal analysis ill-conditioned", command="modal"),
+    Bad("TOML nested 100000 deep", ["config", "show", "--config", "{tmp}/c.toml"],
+        "nested too deep", {"c.toml": "x = " + "[" * 100_000 + "]" * 100_000 + "\n"}),
+    Bad("not valid TOML", ["modal", "--config", "{tmp}/c.toml"], "not valid TOML", {"c.toml": "[hub\n"}),
+    Bad("not UTF-8", ["modal", "--config", "{tmp}/c.toml"], "cannot read config file", {"c.toml": b"name = \"\xff\"\n"}),
+    Bad("missing config file", ["modal", "--config", "{tmp}/absent.toml"], "config file not found"),
+    Bad("config is a folder", ["modal", "--config", "{tmp}"], "cannot read config file"),
+]
+
+SCENARIOS = [
+    _scenario("dt 1e-9 s", "dt_s = 1e-9\nrecord_dt_s = 1e-2\n", "steps is more than the 1e+09 allowed"),
+    _scenario("duration 1e6 s", "duration_s = 1e6\n", "GiB in memory"),
+    _scenario("slew of 1e6 s", "duration_s = 1e6\n", "GiB in memory", command="slew"),
+    _scenario("start_s as a string", '[[torque]]\nstart_s = "0"\ntorque_nm = [0, 0, 1]\n', "torque[0].start_s"),
+    _scenario("start_s as a boolean", "[[torque]]\nstart_s = true\ntorque_nm = [0, 0, 1]\n", "torque[0].start_s"),
+    _scenario("end before start", "[[torque]]\nstart_s = 5.0\nend_s = 2.0\ntorque_nm = [0, 0, 1]\n", "end_s must be > start_s"),
+    _scenario("torque after the end", "duration_s = 10.0\n[[torque]]\nstart_s = 20.0\ntorque_nm = [0, 0, 1]\n", "it would never act"),
+    _scenario("two initial states for one panel", '[[initial.appendages]]\nname = "panel_1"\n[[initial.appendages]]\nname = "panel_1"\n', "one initial state per appendage"),
+    _scenario("initial state of an unknown panel", '[[initial.appendages]]\nname = "panel_9"\n', "unknown appendage 'panel_9'"),
+    _scenario("initial pitch at the singularity", "[initial]\nattitude_deg = [0, 89.5, 0]\n", "pitch must be within"),
+    _scenario("large root rotation", '[[initial.appendages]]\nname = "panel_1"\nrho_deg = [50, 0, 0]\n', "rho_deg must stay below 45"),
+    _scenario("unknown solver", 'solver = "euler"\n', "solver"),
+    _scenario("record step not a multiple", "dt_s = 0.003\nrecord_dt_s = 0.01\n", "whole multiple of dt_s"),
+    _scenario("unknown scenario key", "duraton_s = 5.0\n", "did you mean 'duration_s'"),
+    _scenario("unknown law", '[controller]\nkind = "magic"\n', "controller"),
+    _scenario("negative requirement", "[requirements]\npointing_deg = -1.0\n", "requirements.pointing_deg", command="slew"),
+    Bad("missing scenario file", ["openloop", "--scenario", "{tmp}/absent.toml"], "scenario file not found"),
+]  # fmt: skip
+
+PATHS = [
+    Bad("openloop --out a file", ["openloop", "--out", "{tmp}/f"], "exists and is not a folder", {"f": "x"}),
+    Bad("openloop --out /proc", ["openloop", "--out", "/proc/flexsat-test"], "cannot write there"),
+    Bad("slew --out under a file", ["slew", "--out", "{tmp}/f/sub"], "cannot write there", {"f": "x"}),
+    Bad("modal --out /proc", ["modal", "--out", "/proc/flexsat-test"], "cannot write there"),
+    Bad("study --out a file", ["study", "--quick", "--out", "{tmp}/f"], "exists and is not a folder", {"f": "x"}),
+    Bad("campaign --out a file", ["campaign", "sensitivity", "--out", "{tmp}/f"], "exists and is not a folder", {"f": "x"}),
+    Bad("preset into a missing folder", ["config", "preset", "-o", "{tmp}/no/such/x.toml"], "does not exist"),
+    Bad("preset over a file", ["config", "preset", "-o", "{tmp}/f"], "exists", {"f": "x"}),
+    Bad("unknown preset", ["config", "preset", "heavy"], "unknown preset 'heavy'"),
+    Bad("replay outside the store", ["campaign", "replay", "{tmp}", "../../outside"], "not a campaign store"),
+    Bad("replay of a path as case id", ["campaign", "replay", "{tmp}/store", "../../outside"], "is not a case id",
+        {"store/campaign.json": '{"name": "x", "fingerprint": {}}'}),
+    Bad("replay of a missing case", ["campaign", "replay", "{tmp}/store", "nominal"], "no case 'nominal'",
+        {"store/campaign.json": '{"name": "x", "fingerprint": {}}'}),
+    Bad("replay of a damaged case", ["campaign", "replay", "{tmp}/store", "nominal"], "damaged case file",
+        {"store/campaign.json": '{"name": "x", "fingerprint": {}}', "store/cases/nominal.json": '{"case_id": "nomi'}),
+    Bad("replay without a case", ["campaign", "replay", "{tmp}"], "usage: flexsat campaign replay"),
+    Bad("slew target of two numbers", ["slew", "--target-euler-deg", "1,2"], "expected three comma-separated"),
+    Bad("animate a missing file", ["animate", "{tmp}/absent.nc"], "file not found"),
+    Bad("animate a non-NetCDF file", ["animate", "{tmp}/f.nc"], "not a readable NetCDF file", {"f.nc": "x"}),
+    Bad("modal --animate out of range", ["modal", "--animate", "99"], "mode index must be in 1..18"),
+    Bad("equations in an unknown format", ["equations", "--format", "html"], "--format must be"),
+]  # fmt: skip
+
+CAMPAIGNS = [
+    _campaign("campaign named with ../", 'name = "../../../outside"\n', "name: contains characters"),
+    _campaign("campaign named with an absolute path", 'name = "/tmp/outside"\n', "name: contains characters"),
+    _campaign("unknown modifier path", 'name = "k"\n[[cases]]\nid = "a"\nplant = [{ path = "hub.colour", value = 1.0 }]\n', "no 'colour'"),
+    _campaign("uniform bounds reversed", 'name = "k"\n[[cases]]\nid = "a"\nplant = [{ path = "hub.mass_kg", uniform = [2.0, 1.0] }]\n', "low < high"),
+    _campaign("case value out of range", 'name = "k"\n[[cases]]\nid = "a"\nplant = [{ path = "hub.mass_kg", value = -5.0 }]\n', "campaign case 'a' (plant): hub.mass_kg"),
+    _campaign("case id with a slash", 'name = "k"\n[[cases]]\nid = "a/b"\n', "cases[0].id"),
+    _campaign("random n negative", 'name = "k"\n[random]\nn = -3\n', "random.n"),
+    _campaign("base dt 1e-9 s", 'name = "k"\n[base]\ndt_s = 1e-9\ncontrol_dt_s = 1e-3\nrecord_dt_s = 1e-2\n', "steps is more than"),
+    _campaign("base of 1e6 s", 'name = "k"\n[base]\nduration_s = 1e6\n', "GiB in memory"),
+    _campaign("scheduler and local cluster", 'name = "k"\n', "either --scheduler or --dask-local", "--scheduler", "tcp://127.0.0.1:1", "--dask-local", "2"),
+    Bad("unknown campaign", ["campaign", "no-such-campaign"], "neither a preset"),
+    Bad("negative case count", ["campaign", "montecarlo-random", "--cases", "-3", "--out", "{tmp}/s"], "--cases must be >= 1"),
+    Bad("zero workers", ["campaign", "sensitivity", "--workers", "0"], "Invalid value for '--workers'"),
+]  # fmt: skip
+
+TABLE = CONFIGS + SCENARIOS + PATHS + CAMPAIGNS
+
+
+def test_the_table_is_at_least_sixty_rows():
+    assert len(TABLE) >= 60
+    assert len({row.id for row in TABLE}) == len(TABLE)
+
+
+@pytest.mark.parametrize("row", TABLE, ids=[row.id for row in TABLE])
+def test_bad_input_gives_one_message_and_exit_code_2(row: Bad, tmp_path, capsys, monkeypatch):
+    monkeypatch.chdir(tmp_path)  # default output folders land in the test's folder
+    for name, content in row.files.items():
+        path = tmp_path / name
+        path.parent.mkdir(parents=True, exist_ok=True)
+        path.write_bytes(content if isinstance(content, bytes) else content.encode())
+    before = sorted(p.relative_to(tmp_path) for p in tmp_path.rglob("*"))
+    outcome = flexsat([arg.replace("{tmp}", str(tmp_path)) for arg in row.argv], capsys)
+    assert outcome.code == 2, outcome.stderr
+    assert row.fragment in outcome.stderr, outcome.stderr
+    assert "Traceback" not in outcome.stderr
+    assert len(outcome.stderr) < 3000  # one bounded message
+    created = sorted(set(p.relative_to(tmp_path) for p in tmp_path.rglob("*")) - set(before))
+    # Refused before any work: nothing but (at most) the empty output folders given.
+    assert all((tmp_path / p).is_dir() and not any((tmp_path / p).iterdir()) for p in created), created
+
+
+def test_an_unreachable_scheduler_is_refused_before_the_store_exists(tmp_path, capsys):
+    outcome = flexsat(["campaign", "sensitivity", "--scheduler", "tcp://127.0.0.1:1",
+                       "--out", str(tmp_path / "store")], capsys)  # fmt: skip
+    assert outcome.code == 2
+    assert "cannot connect to the Dask scheduler tcp://127.0.0.1:1" in outcome.stderr
+    assert not (tmp_path / "store").exists()
+
+
+def test_a_5_mb_name_gives_a_short_message(tmp_path, capsys):
+    path = tmp_path / "c.toml"
+    path.write_text(_satellite(_set("name", "x" * 5_000_000)))
+    outcome = flexsat(["config", "show", "--config", str(path)], capsys)
+    assert outcome.code == 2
+    assert "name: String should have at most 64 characters" in outcome.stderr
+    assert len(outcome.stderr) < 1000
