@@ -24,8 +24,12 @@ COMPILED_MODULES = (
     "dynamics/integrators.py",
     "dynamics/records.py",
     "control/quaternion.py",
-    "control/actuation.py",
-    "control/laws.py",
+    "control/stages/ideal_sensor.py",
+    "control/stages/static_actuator.py",
+    "control/laws/_sliding.py",
+    "control/laws/asmc.py",
+    "control/laws/smc.py",
+    "control/laws/pd.py",
     "simulate/loops.py",
 )
 """Modules with ``@njit(cache=True)`` functions, relative to the package folder."""
