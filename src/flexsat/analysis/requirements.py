@@ -31,7 +31,8 @@ def slew_metrics(ds: xr.Dataset, pointing_deg: float, jitter_deg_s: float, t_max
     t = ds["time"].values
     pointing = ds["pointing_error_deg"].values
     jitter = ds["rate_error_deg_s"].values
-    lam = ds["lambda_act"].values
+    # a law without an adaptive slope records no lambda_act: no switch time
+    lam = ds["lambda_act"].values if "lambda_act" in ds else np.zeros(t.size)
     applied = np.abs(ds["tau_applied"].values)
     commanded = np.abs(ds["tau_cmd"].values)
     leaves = np.nonzero(lam > lam[0] * (1 + 1e-9))[0]

@@ -145,7 +145,8 @@ class Registry(Generic[Spec]):
                 suggestion = f"; did you mean {hint[0]!r}?" if hint else ""
                 raise PydanticCustomError(
                     "unknown_key",
-                    "unknown key '{key}' of the {kind} {what}{suggestion} (allowed here: {allowed})",
+                    "unknown key '{key}' of the {kind} {what}{suggestion} "
+                    "(allowed here: {allowed})",
                     {"key": key, "kind": kind, "what": self.what, "suggestion": suggestion,
                      "allowed": ", ".join(allowed)},
                 )  # fmt: skip

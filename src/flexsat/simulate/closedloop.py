@@ -111,7 +111,6 @@ def run_slew(
     layout = LoopLayout(plant.n_dof, law, SENSORS.get(scenario.sensor.kind),
                         ACTUATORS.get(scenario.actuator.kind))  # fmt: skip
     q0, qd0 = initial_state(plant, scenario)
-    n = plant.n_dof
     steps, every = scenario.n_steps, scenario.record_every
     n_records = steps // every + 2  # + the last good state of a failed run
     rec_t = np.full(n_records, np.nan)
@@ -241,8 +240,10 @@ def _python_loop(plant, scenario, x, stages, d, rec_t, rec_x, rec_ctrl, bar, tas
                 raise SimulationError(f"controller returned {tau_cmd!r} at t = {t:.6g} s")
             d.tau_cmd[:] = np.clip(tau_cmd, -limit, limit)
             d.pointing[0] = pointing_error(d.q_d, d.q_meas)
-            status |= stages.actuator[0](d.tau_cmd, t, control_dt, d.actuator_params,
-                                         d.actuator_state, d.tau_applied, d.actuator_record)  # fmt: skip
+            status |= stages.actuator[0](
+                d.tau_cmd, t, control_dt, d.actuator_params, d.actuator_state, d.tau_applied,
+                d.actuator_record,
+            )  # fmt: skip
             if status:
                 return STATUS_CONTROL_FAILED, k, rows
         if k % every == 0:

@@ -119,8 +119,10 @@ def rk4_closed_loop(x, clock, stages, d, records, plant_args):
                 d.law_gains, d.law_state, t, control_dt, d.tau_cmd, d.law_diag,
             )  # fmt: skip
             d.pointing[0] = pointing_error(d.q_d, d.q_meas)
-            status |= stages.actuator[0](d.tau_cmd, t, control_dt, d.actuator_params,
-                                         d.actuator_state, d.tau_applied, d.actuator_record)  # fmt: skip
+            status |= stages.actuator[0](
+                d.tau_cmd, t, control_dt, d.actuator_params, d.actuator_state, d.tau_applied,
+                d.actuator_record,
+            )  # fmt: skip
             if status != 0:
                 return STATUS_CONTROL_FAILED, k, row - records.start
         if k % clock.record_every == 0:

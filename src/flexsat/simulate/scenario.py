@@ -10,7 +10,6 @@ from pathlib import Path
 from typing import Annotated, ClassVar, Literal
 
 import numpy as np
-
 from pydantic import Field, SerializeAsAny, field_validator, model_validator
 
 from flexsat.config.load import read_toml, validate_config

@@ -135,7 +135,8 @@ def fly_slew(plant: Plant, scenario=None, out: Path | None = None, progress=None
     result : Result
     metrics : dict
         :func:`flexsat.analysis.requirements.slew_metrics` (R1-R3 from the
-        scenario's requirements), plus ``files``.
+        scenario's requirements), plus the controller's ``design_inertia_kg_m2``
+        (3x3) and ``files``.
     """
     from flexsat.analysis.requirements import slew_metrics
     from flexsat.simulate import SlewScenario, run_slew
@@ -151,6 +152,8 @@ def fly_slew(plant: Plant, scenario=None, out: Path | None = None, progress=None
     metrics = slew_metrics(
         result.dataset, req.pointing_deg, req.jitter_deg_s, scenario.actuator.t_max_nm
     )
+    J = result.dataset.attrs["design_inertia"]
+    metrics["design_inertia_kg_m2"] = [list(J[3 * i : 3 * i + 3]) for i in range(3)]
     if out is not None:
         _write_run(result, metrics, Path(out), figures)
     return result, metrics

@@ -24,6 +24,7 @@ from flexsat.control.laws.registry import (
     validate_law_config,
 )
 from flexsat.control.laws.smc import SMC
+from flexsat.control.registry import channel_columns
 
 __all__ = [
     "LAWS",
@@ -82,3 +83,11 @@ class CompiledLaw:
             tau, self.diag,
         )  # fmt: skip
         return tau
+
+    def diagnostics(self) -> dict[str, np.ndarray | float]:
+        """The last call's diagnostics by name: (3,) arrays per axis, floats otherwise."""
+        out: dict[str, np.ndarray | float] = {}
+        for channel, columns in channel_columns(self.spec.diagnostics).items():
+            values = self.diag[columns]
+            out[channel] = values.copy() if values.size > 1 else float(values[0])
+        return out
