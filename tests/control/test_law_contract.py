@@ -131,7 +131,6 @@ def test_cli_picks_up_the_registered_law(qpid):
 
 def test_unknown_law_lists_the_registered_ones(qpid):
     from flexsat.cli.main import app
-
     from flexsat.errors import ConfigError
 
     # The flexsat command turns this error into one line and exit code 2 (tests/cli).
