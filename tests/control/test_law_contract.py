@@ -58,14 +58,17 @@ def pid_step(q_d, omega_d, omega_dot_d, q, omega_B, J, gains, state, t, dt, tau_
     if e[1] ** 2 + e[2] ** 2 + e[3] ** 2 < gains[G.window] ** 2:  # no wind-up while slewing
         for a in range(3):
             state[a] += e[1 + a] * dt
-    u = np.empty(3)
+    # u = kp q_v,e + ki int q_v,e dt + kd w, kept in tau_cmd (nothing allocated)
     for a in range(3):
-        u[a] = gains[G.kp] * e[1 + a] + gains[G.ki] * state[a] + gains[G.kd] * omega_B[a]
-    Jw = J @ omega_B
-    gyro = np.array([omega_B[1] * Jw[2] - omega_B[2] * Jw[1],
-                     omega_B[2] * Jw[0] - omega_B[0] * Jw[2],
-                     omega_B[0] * Jw[1] - omega_B[1] * Jw[0]])  # fmt: skip
-    Ju = J @ u
+        tau_cmd[a] = gains[G.kp] * e[1 + a] + gains[G.ki] * state[a] + gains[G.kd] * omega_B[a]
+    w = omega_B
+    Jw = (J[0, 0] * w[0] + J[0, 1] * w[1] + J[0, 2] * w[2],
+          J[1, 0] * w[0] + J[1, 1] * w[1] + J[1, 2] * w[2],
+          J[2, 0] * w[0] + J[2, 1] * w[1] + J[2, 2] * w[2])  # fmt: skip
+    gyro = (w[1] * Jw[2] - w[2] * Jw[1], w[2] * Jw[0] - w[0] * Jw[2], w[0] * Jw[1] - w[1] * Jw[0])
+    Ju = (J[0, 0] * tau_cmd[0] + J[0, 1] * tau_cmd[1] + J[0, 2] * tau_cmd[2],
+          J[1, 0] * tau_cmd[0] + J[1, 1] * tau_cmd[1] + J[1, 2] * tau_cmd[2],
+          J[2, 0] * tau_cmd[0] + J[2, 1] * tau_cmd[1] + J[2, 2] * tau_cmd[2])  # fmt: skip
     for a in range(3):
         tau_cmd[a] = min(gains[G.limit], max(-gains[G.limit], gyro[a] - Ju[a]))
         diag[a] = state[a]
