@@ -86,7 +86,7 @@ QPID = LawSpec(
 def qpid():
     register_law(QPID)  # the one line a user writes
     yield QPID
-    LAWS._specs.pop(QPID.name)
+    LAWS.unregister(QPID.name)
 
 
 @pytest.fixture(scope="module")
@@ -157,7 +157,7 @@ def test_installed_laws_are_found_through_the_entry_point_group(qpid, tmp_path, 
         found = [EntryPoint("qpid", "installed_flexsat_law", group)]
         return found if group == "flexsat.laws" else []
 
+    LAWS.unregister(QPID.name)
     monkeypatch.setattr(registry, "entry_points", entry_points)
-    monkeypatch.setattr(LAWS, "_discovered", False)
-    LAWS._specs.pop(QPID.name)
+    monkeypatch.setattr(LAWS, "_discovered", False)  # as in a fresh process
     assert law_names() == ("asmc", "smc", "pd", "qpid")

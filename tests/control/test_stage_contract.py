@@ -81,8 +81,8 @@ def stages():
     register_sensor(BIASED)  # the one line a user writes, per stage
     register_actuator(SCALING)
     yield
-    SENSORS._specs.pop(BIASED.name)
-    ACTUATORS._specs.pop(SCALING.name)
+    SENSORS.unregister(BIASED.name)
+    ACTUATORS.unregister(SCALING.name)
 
 
 def test_sensor_bias_moves_the_true_attitude_by_the_bias(stages, nominal_plant):

@@ -85,6 +85,15 @@ class Registry(Generic[Spec]):
             self._default = name
         return spec
 
+    def unregister(self, name: str) -> Spec:
+        """Remove the specification registered as ``name`` and return it."""
+        if name not in self._specs:
+            raise ValueError(f"no {self.what} {name!r} is registered")
+        spec = self._specs.pop(name)
+        if self._default == name:
+            self._default = None
+        return spec
+
     def names(self) -> tuple[str, ...]:
         """Every registered name, built-ins first, in registration order."""
         self._discover()
@@ -126,16 +135,24 @@ class Registry(Generic[Spec]):
         pydantic ``mode="before"`` validator, so pieces registered after import count.
         """
         if isinstance(value, BaseModel):
-            return value
-        if not isinstance(value, dict):
+            kind = getattr(value, "kind", None)
+        elif isinstance(value, dict):
+            kind = value.get("kind", self.default)
+        else:
             raise PydanticCustomError("model_type", "expected a TOML table (section)")
-        kind = value.get("kind", self.default)
         if kind not in self.names():
             raise PydanticCustomError(
                 "union_tag_invalid", "unknown kind",
                 {"expected_tags": ", ".join(self.names()), "tag": kind},
             )  # fmt: skip
         model = config_of(self._specs[kind])
+        if isinstance(value, BaseModel):
+            if not isinstance(value, model):
+                raise PydanticCustomError(
+                    "model_type", "expected the model of the {kind} {what}",
+                    {"kind": kind, "what": self.what},
+                )  # fmt: skip
+            return value
         allowed = sorted(
             {f.alias or name for name, f in model.model_fields.items()} | set(model.model_fields)
         )
