@@ -52,7 +52,7 @@ def plot_controller_comparison(datasets: dict[str, xr.Dataset]) -> Figure:
                 _positive(ds[name].values),
                 color=colour,
                 linewidth=1.0,
-                label=f"{law.upper()}: final {float(ds[name].values[-1]):.3g}",
+                label=f"{_label(law, ds)}: final {float(ds[name].values[-1]):.3g}",
             )
         ax.axhline(
             bound,
@@ -67,7 +67,7 @@ def plot_controller_comparison(datasets: dict[str, xr.Dataset]) -> Figure:
     ax = axes[2, 0]
     for (law, ds), colour in zip(datasets.items(), _COLOURS, strict=False):
         norm = np.linalg.norm(np.asarray(ds["tau_applied"].values), axis=1)
-        _line(ax, _time(ds), norm, color=colour, linewidth=1.0, label=law.upper())
+        _line(ax, _time(ds), norm, color=colour, linewidth=1.0, label=_label(law, ds))
     limit = scenario.actuator.t_max_nm
     ax.axhline(
         limit * np.sqrt(3.0),
@@ -97,3 +97,9 @@ def write_comparison_figure(
     fig.savefig(path, dpi=dpi)
     fig.clear()
     return path
+
+
+def _label(key: str, ds) -> str:
+    """The law's display name the run recorded (the key upper-cased for older results)."""
+    return str(ds.attrs.get("controller_label", key.upper()))
+

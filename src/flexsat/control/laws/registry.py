@@ -1,8 +1,10 @@
 """The control-law contract: what a law declares, its compiled step, and the registry.
 
-A law is one module that builds a :class:`LawSpec` and calls :func:`register_law`.
-The closed loop, the slew scenario's ``[controller]`` table, ``--controller``, the
-study, the report and the plots find it here; none of them names a law.
+A law is one module that builds a :class:`LawSpec`, and one :func:`register_law`
+line (for the built-ins in :mod:`flexsat.control.laws`, for a user's law in their
+own file). The closed loop, the slew scenario's ``[controller]`` table,
+``--controller``, the study, the report and the plots find it here; none of them
+names a law.
 
 The compiled step
 -----------------
