@@ -31,7 +31,7 @@ from flexsat.simulate.openloop import initial_state
 from flexsat.simulate.result import Result, build_dataset
 from flexsat.simulate.scenario import SlewScenario
 
-__all__ = ["Controller", "design_inertia", "run_slew"]
+__all__ = ["Controller", "design_inertia", "run_slew", "slew_design_inertia"]
 
 
 class Controller(Protocol):
