@@ -117,3 +117,6 @@ def test_actuator_stage_replaces_the_static_one(stages, nominal_plant):
     np.testing.assert_array_equal(ds["tau_applied"].values, 0.5 * ds["tau_cmd"].values)
     np.testing.assert_array_equal(ds["actuator_scale"].values, 0.5)
     assert ds["actuator_scale"].attrs["units"] == "1"
+    from flexsat.plots.slew import plot_disturbances
+
+    plot_disturbances(ds)  # says there is no static disturbance model to draw

@@ -653,6 +653,11 @@ def plot_disturbances(ds: xr.Dataset) -> Figure:
     surface = _surface(ds)
     dist, act = scenario.disturbances, scenario.actuator
     t = _time(ds)
+    if not hasattr(act, "gain"):  # an actuator stage other than the static gain model
+        fig, axes = _figure(1, 1, size=(11.0, 4.0))
+        _no_data(axes[0, 0], f"the {act.kind} actuator stage adds no static disturbance model")
+        _suptitle(fig, ds, "Disturbance torques of the actuator model (frame B)")
+        return fig
     cmd = np.asarray(ds["tau_cmd"].values, dtype=float)
     total = np.asarray(ds["tau_applied"].values, dtype=float) - cmd
     slosh = dist.sloshing_ratio * cmd * np.sin(2.0 * np.pi * dist.sloshing_hz * t)[:, None]
