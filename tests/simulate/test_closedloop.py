@@ -184,6 +184,7 @@ BAD_SCENARIOS = [
     ({"actuator": {"kind": "wheels"}}, "actuator.kind: must be one of static"),
     ({"design_inertia_kg_m2": [[1, 2, 0], [0, 1, 0], [0, 0, 1]]}, "must be symmetric"),
     ({"design_inertia_kg_m2": [[1, 0, 0], [0, -1, 0], [0, 0, 1]]}, "positive definite"),
+    ({"design_inertia_kg_m2": [[1e300, 0, 0], [0, 1, 0], [0, 0, 1]]}, "within +-1e+09 kg m^2"),
     ({"control_dt_s": 0.0015}, "control_dt_s must be a whole multiple of dt_s"),
     ({"disturbances": {"sloshing_ratio": -0.1}}, "sloshing_ratio"),
     ({"requirements": {"pointing_deg": 0.0}}, "requirements.pointing_deg"),

@@ -40,6 +40,7 @@ __all__ = [
 ]
 
 _ZERO3 = (0.0, 0.0, 0.0)
+_MAX_INERTIA_KG_M2 = 1e9  # a bound far beyond any spacecraft, so J's algebra cannot overflow
 
 
 class TorqueSegment(_Frozen):
@@ -208,6 +209,8 @@ class SlewScenario(_TimedRun):
         if value is None:
             return value
         J = np.array(value, dtype=float)
+        if np.abs(J).max() > _MAX_INERTIA_KG_M2:
+            raise ValueError(f"entries must be within +-{_MAX_INERTIA_KG_M2:.0e} kg m^2")
         if not np.allclose(J, J.T, rtol=1e-12, atol=1e-12 * np.abs(J).max()):
             raise ValueError("must be symmetric (J = J^T)")
         if np.linalg.eigvalsh(J).min() <= 0.0:
