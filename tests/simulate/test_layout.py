@@ -25,11 +25,11 @@ def test_plant_state_offsets():
 
 def test_record_columns_follow_each_other_without_gaps():
     layout = _layout()
-    # tau_cmd (3), tau_applied (3), pointing error (1), then the ASMC's 16 diagnostics
-    assert layout.law_diag == slice(7, 23)
-    assert layout.record_size == 23 and layout.state_size == 2
+    # tau_cmd (3), tau_applied (3), then the ASMC's 16 diagnostics
+    assert layout.law_diag == slice(6, 22)
+    assert layout.record_size == 22 and layout.state_size == 2
     columns = [columns for _, columns in layout.channels()]
-    assert columns[0].start == 7 and columns[-1].stop == 23
+    assert columns[0].start == 6 and columns[-1].stop == 22
     assert all(a.stop == b.start for a, b in itertools.pairwise(columns))
 
 
@@ -38,8 +38,8 @@ def test_stage_records_come_after_the_law_diagnostics():
         ACTUATORS.get("static"), state_size=4, records=(Channel("extra", "N m", "", True),)
     )
     layout = LoopLayout(18, get_law("pd"), SENSORS.get("ideal"), actuator)
-    assert layout.law_diag == slice(7, 13)  # the PD's tau_gyro and tau_guide
-    assert layout.actuator_record == slice(13, 16)
+    assert layout.law_diag == slice(6, 12)  # the PD's tau_gyro and tau_guide
+    assert layout.actuator_record == slice(12, 15)
     assert layout.actuator_state == slice(0, 4)  # the PD and the ideal sensor keep none
 
 

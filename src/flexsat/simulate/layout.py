@@ -13,7 +13,7 @@ from flexsat.control.stages import StageSpec
 
 __all__ = ["LoopLayout"]
 
-_LOOP_COLUMNS = ("tau_cmd", "tau_applied", "pointing_error")
+_LOOP_COLUMNS = ("tau_cmd", "tau_applied")
 
 
 @dataclass(frozen=True)
@@ -27,8 +27,7 @@ class LoopLayout:
     ``[sensor_state]`` and the actuator's ``[actuator_state]``, zero at t = 0.
 
     Control record row (``record_size``,), held between control instants:
-    ``[tau_cmd]`` (3) and ``[tau_applied]`` (3) [N m], ``[pointing_error]`` (1)
-    [rad] (2 asin |q_v,e| of the measured attitude), the law's diagnostics
+    ``[tau_cmd]`` (3) and ``[tau_applied]`` (3) [N m], the law's diagnostics
     ``[law_diag]``, the sensor's and the actuator's records.
     """
 
@@ -75,11 +74,10 @@ class LoopLayout:
 
     tau_cmd = slice(0, 3)
     tau_applied = slice(3, 6)
-    pointing_error = slice(6, 7)
 
     @property
     def law_diag(self) -> slice:
-        return _after(self.pointing_error, self.law.diag_size)
+        return _after(self.tau_applied, self.law.diag_size)
 
     @property
     def sensor_record(self) -> slice:

@@ -16,7 +16,6 @@ import numpy as np
 from numba import njit
 from numba.core.errors import NumbaExperimentalFeatureWarning
 
-from flexsat.control.quaternion import pointing_error
 from flexsat.dynamics.integrators import rk4_step
 from flexsat.dynamics.kernels import STATUS_OK
 
@@ -76,7 +75,6 @@ class LoopData(NamedTuple):
     held: np.ndarray  # (record_size,) the control record row held between instants
     tau_cmd: np.ndarray  # views into held ...
     tau_applied: np.ndarray
-    pointing: np.ndarray
     law_diag: np.ndarray
     sensor_record: np.ndarray
     actuator_record: np.ndarray
@@ -118,7 +116,6 @@ def rk4_closed_loop(x, clock, stages, d, records, plant_args):
                 d.q_d, d.omega_d, d.omega_dot_d, d.q_meas, d.omega_meas, d.J_design,
                 d.law_gains, d.law_state, t, control_dt, d.tau_cmd, d.law_diag,
             )  # fmt: skip
-            d.pointing[0] = pointing_error(d.q_d, d.q_meas)
             status |= stages.actuator[0](
                 d.tau_cmd, t, control_dt, d.actuator_params, d.actuator_state, d.tau_applied,
                 d.actuator_record,
