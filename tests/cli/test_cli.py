@@ -151,6 +151,12 @@ def test_slew_unknown_controller_exits_2():
     assert "controller.kind: must be one of" in result.stderr
 
 
+def test_study_unknown_controller_exits_2(tmp_path):
+    result = run("study", "--controller", "asmc,lqr", "--out", str(tmp_path))
+    assert result.returncode == 2
+    assert "--controller: unknown control law 'lqr': must be one of asmc, smc, pd" in result.stderr
+
+
 def test_slew_compares_all_controllers():
     result = run("slew", "--controller", "all", "--duration", "10", "--json")
     assert result.returncode == 0, result.stderr
