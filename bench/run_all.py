@@ -125,6 +125,12 @@ def targets(results: dict) -> list[tuple[str, str, bool | None, str]]:
         "plant only",
     )
     from_slew("ASMC, compiled", SLEW_MAX_S, f"ASMC slew, 120 s, nominal <= {SLEW_MAX_S} s", "ASMC")
+    target = "a user's compiled law per step <= 1.2x the built-in PD"
+    if slew is None:
+        rows.append((target, "-", None, "bench_slew not run"))
+    else:
+        ratio = slew["user_law_ratio"]
+        rows.append((target, f"{ratio:.3f}x", ratio <= 1.2, "examples/compiled_law.py, 120 s"))
 
     target = "cost linear in the number of appendages (1, 2, 4, 8)"
     if scaling is None:

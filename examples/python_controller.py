@@ -23,7 +23,7 @@ class QuaternionPID:
     """tau = w x Jw - J (kp q_v,e + ki integral(q_v,e) + kd w), rest-to-rest."""
 
     def __init__(self, target_euler_deg, natural_frequency=0.3, damping_ratio=0.9, ki=0.002):
-        self.J = design_inertia()  # [kg m^2], rigid nominal satellite
+        self.J = design_inertia()  # [kg m^2], the rigidized nominal satellite
         self.q_d = target_quaternion(target_euler_deg)  # scalar first
         self.kp = 2.0 * natural_frequency**2  # [1/s^2] (q_v,e ~ theta / 2)
         self.kd = 2.0 * damping_ratio * natural_frequency  # [1/s]

@@ -58,7 +58,7 @@ def test_caches_under_numba_cache_dir_are_dropped_too(tmp_path, monkeypatch):
     folder.mkdir(parents=True)
     cached = folder / "loops.rk4_closed_loop-20.py311.nbi"
     cached.write_bytes(b"machine code")
-    laws = package / "control" / "laws.py"
+    laws = package / "control" / "laws" / "asmc.py"
     laws.write_text(laws.read_text() + "\n# an edit\n")
     assert drop_stale_caches(package)
     assert not cached.exists()

@@ -14,21 +14,29 @@ from __future__ import annotations
 
 import hashlib
 import os
+import re
 from pathlib import Path
 
-__all__ = ["COMPILED_MODULES", "drop_stale_caches"]
+__all__ = ["COMPILED_MODULES", "compiled_modules", "drop_stale_caches"]
 
-COMPILED_MODULES = (
-    "dynamics/linalg3.py",
-    "dynamics/kernels.py",
-    "dynamics/integrators.py",
-    "dynamics/records.py",
-    "control/quaternion.py",
-    "control/actuation.py",
-    "control/laws.py",
-    "simulate/loops.py",
-)
-"""Modules with ``@njit(cache=True)`` functions, relative to the package folder."""
+_DECORATED = re.compile(r"^@njit", re.MULTILINE)
+
+
+def compiled_modules(package: Path | None = None) -> tuple[str, ...]:
+    """Modules with ``@njit`` functions, relative to the package folder, sorted.
+
+    Found by reading the sources, so a new compiled module (a law, a stage, a
+    kernel) needs no entry in a list.
+    """
+    package = package or Path(__file__).parent
+    return tuple(sorted(
+        path.relative_to(package).as_posix() for path in package.rglob("*.py")
+        if _DECORATED.search(path.read_text(encoding="utf-8"))
+    ))  # fmt: skip
+
+
+COMPILED_MODULES = compiled_modules()
+"""The package's compiled modules (:func:`compiled_modules`)."""
 
 _STAMP = "compiled_sources.sha256"
 
@@ -57,9 +65,10 @@ def drop_stale_caches(package: Path | None = None) -> bool:
         True if caches were removed. A read-only installation is left alone (numba
         then caches elsewhere, keyed by the installed files, which do not change).
     """
+    modules = COMPILED_MODULES if package is None else compiled_modules(package)
     package = package or Path(__file__).parent
     digest = hashlib.sha256()
-    for module in COMPILED_MODULES:
+    for module in modules:
         digest.update(module.encode())
         digest.update((package / module).read_bytes())
     current = digest.hexdigest()
@@ -67,7 +76,7 @@ def drop_stale_caches(package: Path | None = None) -> bool:
     try:
         if stamp.exists() and stamp.read_text() == current:
             return False
-        for module in COMPILED_MODULES:
+        for module in modules:
             stem = Path(module).stem
             for folder in _cache_dirs(package, module):
                 for cached in folder.glob(f"{stem}.*.nb[ic]"):

@@ -47,6 +47,19 @@ def test_presets_expand_to_the_thesis_case_counts(name, count):
     assert len(resolve_cases(load_campaign(name), nominal())) == count
 
 
+def test_every_case_keeps_the_base_configurations_design_model():
+    # Uncertainty cases perturb the truth plant only: the controller of every case
+    # is designed for the base configuration (its rigidized J_tot), stated in the
+    # case's scenario so a replay uses it too.
+    from flexsat.simulate import design_inertia
+
+    cases = resolve_cases(load_campaign("sensitivity"), nominal())
+    plants = {json.dumps(case.plant, sort_keys=True) for case in cases}
+    assert len(plants) == len(cases)  # every case is another truth plant
+    for case in cases:
+        assert case.scenario["design_inertia_kg_m2"] == design_inertia(nominal()).tolist()
+
+
 def test_random_campaign_is_seeded_and_sized_from_the_cli():
     a = resolve_cases(load_campaign("montecarlo-random"), nominal(), n_random=4)
     b = resolve_cases(load_campaign("montecarlo-random"), nominal(), n_random=6)

@@ -6,6 +6,7 @@ import json
 import subprocess
 import sys
 
+import numpy as np
 import pytest
 
 FLEXSAT = [sys.executable, "-m", "flexsat"]
@@ -133,10 +134,37 @@ def test_slew_shorter_than_the_deadline_does_not_pass_r1():
     assert not metrics["r1_pass"] and not metrics["r2_pass"]
 
 
+def test_slew_design_inertia_is_the_configs(tmp_path):
+    # A 300 kg hub: the controller is designed for that satellite (its rigidized
+    # J_tot), not for the thesis's; the thesis slew keeps the nominal J_tot.
+    from flexsat.config import load_config, preset_path
+    from flexsat.simulate import design_inertia
+
+    heavy = tmp_path / "heavy.toml"
+    text = preset_path("nominal").read_text()
+    heavy.write_text(text.replace("mass_kg = 150.0", "mass_kg = 300.0", 1))
+    result = run("slew", "--config", str(heavy), "--duration", "1", "--json")
+    assert result.returncode == 0, result.stderr
+    reported = np.array(json.loads(result.stdout)["design_inertia_kg_m2"])
+    np.testing.assert_allclose(reported, design_inertia(load_config(heavy)), rtol=1e-15)
+    # the hub's J_xx doubles (41.6 -> 83.3 kg m^2): J_tot,xx grows by ~41.6
+    assert reported[0, 0] == pytest.approx(189.99 + 41.6, abs=0.1)
+    nominal = run("slew", "--duration", "1", "--json")
+    J = np.array(json.loads(nominal.stdout)["design_inertia_kg_m2"])
+    # J_tot of the thesis satellite (section 3.1, appendix B), to the printed digits
+    np.testing.assert_allclose(np.diag(J), [189.99, 44.16, 177.90], atol=0.006)
+
+
 def test_slew_unknown_controller_exits_2():
     result = run("slew", "--controller", "lqr")
     assert result.returncode == 2
     assert "controller.kind: must be one of" in result.stderr
+
+
+def test_study_unknown_controller_exits_2(tmp_path):
+    result = run("study", "--controller", "asmc,lqr", "--out", str(tmp_path))
+    assert result.returncode == 2
+    assert "--controller: unknown control law 'lqr': must be one of asmc, smc, pd" in result.stderr
 
 
 def test_slew_compares_all_controllers():

@@ -11,7 +11,7 @@ import xarray as xr
 from matplotlib.figure import Figure
 
 import flexsat.config
-from flexsat.control.config import PDConfig
+from flexsat.control.laws.pd import PDConfig
 from flexsat.dynamics.plant import Plant
 from flexsat.plots.slew import (
     SLEW_FIGURES,

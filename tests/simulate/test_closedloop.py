@@ -67,15 +67,24 @@ def test_adaptive_gains_stay_in_their_bounds(thesis_slew):
     assert lam[-1] == pytest.approx(5.0, abs=0.01)  # Lambda_max at convergence
 
 
-def test_controller_knows_only_the_nominal_design_model():
-    # A heavier hub is a different plant; the controller keeps the nominal J_tot.
+def test_design_model_is_the_rigidized_satellite_of_the_config():
+    # A heavier hub: the controller's design model is that satellite's J_tot (its
+    # rigidized nominal configuration), not the thesis satellite's.
     heavy = variant()
     heavy["hub"]["mass_kg"] = 180.0
-    plant = Plant.from_config(config_from(heavy))
+    config = config_from(heavy)
+    plant = Plant.from_config(config)
     result = run_slew(plant, SlewScenario(duration_s=1.0))
-    np.testing.assert_array_equal(
-        np.array(result.dataset.attrs["design_inertia"]).reshape(3, 3), design_inertia()
-    )
+    J = np.array(result.dataset.attrs["design_inertia"]).reshape(3, 3)
+    np.testing.assert_array_equal(J, design_inertia(config))
+    assert not np.allclose(J, design_inertia())  # the heavier hub changes J_tot
+
+
+def test_explicit_design_inertia_of_the_scenario_is_used(nominal_plant):
+    J = [[200.0, 1.0, 0.0], [1.0, 50.0, 0.0], [0.0, 0.0, 180.0]]
+    scenario = SlewScenario.model_validate({"duration_s": 1.0, "design_inertia_kg_m2": J})
+    result = run_slew(nominal_plant, scenario)
+    np.testing.assert_array_equal(np.array(result.dataset.attrs["design_inertia"]), np.ravel(J))
 
 
 @pytest.mark.parametrize("kind", ["smc", "pd"])
@@ -167,9 +176,16 @@ BAD_SCENARIOS = [
     ({"actuator": {"t_max_nm": -2.0}}, "actuator.t_max_nm: Input should be greater than 0"),
     ({"actuator": {"reduction_factor": 1.2}}, "reduction_factor: Input should be less than or"),
     ({"actuator": {"reduction_factor": 0.0}}, "reduction_factor: Input should be greater than 0"),
-    ({"controller": {"phi": 0.0}}, "controller.asmc.phi: Input should be greater than 0"),
+    ({"controller": {"phi": 0.0}}, "controller.phi: Input should be greater than 0"),
     ({"controller": {"lambda_min": 6.0}}, "lambda_max must be >= lambda_min"),
-    ({"controller": {"kind": "lqr"}}, "controller.kind: must be one of"),
+    ({"controller": {"kind": "lqr"}}, "controller.kind: must be one of asmc, smc, pd"),
+    ({"controller": {"jk_mn_nm": 1.0}}, "did you mean 'jk_min_nm'? (allowed here: include_"),
+    ({"controller": {"kind": "smc", "lambda_": 1.0, "lamda": 1.0}}, "unknown key 'lamda'"),
+    ({"sensor": {"kind": "gyro"}}, "sensor.kind: must be one of ideal"),
+    ({"actuator": {"kind": "wheels"}}, "actuator.kind: must be one of static"),
+    ({"design_inertia_kg_m2": [[1, 2, 0], [0, 1, 0], [0, 0, 1]]}, "must be symmetric"),
+    ({"design_inertia_kg_m2": [[1, 0, 0], [0, -1, 0], [0, 0, 1]]}, "positive definite"),
+    ({"design_inertia_kg_m2": [[1e300, 0, 0], [0, 1, 0], [0, 0, 1]]}, "within +-1e+09 kg m^2"),
     ({"control_dt_s": 0.0015}, "control_dt_s must be a whole multiple of dt_s"),
     ({"disturbances": {"sloshing_ratio": -0.1}}, "sloshing_ratio"),
     ({"requirements": {"pointing_deg": 0.0}}, "requirements.pointing_deg"),

@@ -227,7 +227,8 @@ def slew_metrics(
     )
     ape = absolute_performance_error(pointing[inside])
     max_rate = absolute_performance_error(jitter[inside])
-    lam = ds["lambda_act"].values if "lambda_act" in ds else np.zeros(1)  # laws without Lambda
+    # a law without an adaptive slope records no lambda_act: no switch time
+    lam = ds["lambda_act"].values if "lambda_act" in ds else np.zeros(t.size)
     applied = np.abs(ds["tau_applied"].values)
     commanded = np.abs(ds["tau_cmd"].values)
     leaves = np.nonzero(lam > lam[0] * (1 + 1e-9))[0]

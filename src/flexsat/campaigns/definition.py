@@ -30,6 +30,7 @@ from flexsat.campaigns.modifiers import Modifier, apply_modifiers
 from flexsat.config.load import read_toml, validate_config
 from flexsat.config.models import SatelliteConfig, _Frozen
 from flexsat.errors import ConfigError
+from flexsat.simulate.closedloop import design_inertia
 from flexsat.simulate.scenario import SlewScenario
 
 __all__ = [
@@ -168,6 +169,8 @@ def resolve_cases(
     scenario_base = SlewScenario.model_validate(definition.base).model_dump(
         mode="json", by_alias=True
     )
+    if scenario_base["design_inertia_kg_m2"] is None:  # the base configuration's design model
+        scenario_base["design_inertia_kg_m2"] = design_inertia(satellite).tolist()
     # (id, (root seed, case index) of its random stream, plant and scenario modifiers)
     specs: list[tuple[str, tuple[int, int], list[Modifier], list[Modifier]]] = []
     if definition.include_nominal:

@@ -1,19 +1,28 @@
-"""Attitude control: laws (ASMC, SMC, PD), actuators and disturbances, their configs."""
+"""Attitude control: the law and loop-stage contracts and registries, disturbances.
 
-from flexsat.control.config import (
-    ActuatorConfig,
-    ASMCConfig,
-    DisturbanceConfig,
-    PDConfig,
-    SMCConfig,
-)
+Laws live in :mod:`flexsat.control.laws`, sensors and actuators in
+:mod:`flexsat.control.stages`, one module each.
+"""
+
+from flexsat.control.config import DisturbanceConfig
+from flexsat.control.laws import LawConfig, LawSpec, get_law, law_names, register_law
 from flexsat.control.quaternion import target_quaternion
+from flexsat.control.registry import Channel
+from flexsat.control.stages import StageConfig, StageSpec, register_actuator, register_sensor
+from flexsat.control.stages.static_actuator import ActuatorConfig
 
 __all__ = [
-    "ASMCConfig",
     "ActuatorConfig",
+    "Channel",
     "DisturbanceConfig",
-    "PDConfig",
-    "SMCConfig",
+    "LawConfig",
+    "LawSpec",
+    "StageConfig",
+    "StageSpec",
+    "get_law",
+    "law_names",
+    "register_actuator",
+    "register_law",
+    "register_sensor",
     "target_quaternion",
 ]

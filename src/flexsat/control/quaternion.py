@@ -3,13 +3,19 @@ conversion point to scipy's scalar-last convention."""
 
 from __future__ import annotations
 
-from math import cos, sin
+from math import asin, cos, sin, sqrt
 
 import numpy as np
 from numba import njit
 from scipy.spatial.transform import Rotation
 
-__all__ = ["euler_zyx_to_quaternion", "quaternion_error", "target_quaternion"]
+__all__ = [
+    "euler_zyx_to_quaternion",
+    "pointing_error",
+    "pointing_errors",
+    "quaternion_error",
+    "target_quaternion",
+]
 
 
 @njit(cache=True)
@@ -47,3 +53,20 @@ def target_quaternion(euler_deg: tuple[float, float, float]) -> np.ndarray:
     roll, pitch, yaw = euler_deg
     x, y, z, w = Rotation.from_euler("ZYX", [yaw, pitch, roll], degrees=True).as_quat()
     return np.array([w, x, y, z])
+
+
+@njit(cache=True)
+def pointing_error(q_d, q):
+    """Absolute pointing error 2 asin |q_v,e| [rad] of attitude ``q`` from ``q_d``."""
+    e = quaternion_error(q_d, q)
+    return 2.0 * asin(min(1.0, sqrt(e[1] ** 2 + e[2] ** 2 + e[3] ** 2)))
+
+
+@njit(cache=True)
+def pointing_errors(q_d, euler):
+    """Pointing error [rad] of each ZYX Euler attitude (rows of ``euler``, (m, 3)) from q_d."""
+    out = np.empty(euler.shape[0])
+    for k in range(euler.shape[0]):
+        out[k] = pointing_error(q_d, euler_zyx_to_quaternion(euler[k, 0], euler[k, 1], euler[k, 2]))
+    return out
+

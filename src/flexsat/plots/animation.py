@@ -295,7 +295,7 @@ def _title(result: Result, frames: RunFrames) -> str:
     head = str(attrs.get("title", "flexsat run")).removeprefix("flexsat ")
     head = head[:1].upper() + head[1:]
     if attrs.get("controller"):
-        head += f", {str(attrs['controller']).upper()}"
+        head += f", {attrs.get('controller_label', str(attrs['controller']).upper())}"
     head += f", {frames.time[-1] - frames.time[0]:.4g} s"
     if attrs.get("status", "ok") != "ok":
         head += f" (run failed at t = {float(attrs.get('failure_time_s', frames.time[-1])):.4g} s)"

@@ -52,7 +52,7 @@ def plot_controller_comparison(datasets: dict[str, xr.Dataset]) -> Figure:
                 style.positive(ds[name].values),
                 color=colour,
                 linewidth=1.0,
-                label=f"{law.upper()}: final {float(ds[name].values[-1]):.3g}",
+                label=f"{_label(law, ds)}: final {float(ds[name].values[-1]):.3g}",
             )
         ax.axhline(
             bound,
@@ -67,7 +67,7 @@ def plot_controller_comparison(datasets: dict[str, xr.Dataset]) -> Figure:
     ax = axes[2, 0]
     for (law, ds), colour in zip(datasets.items(), _COLOURS, strict=False):
         norm = np.linalg.norm(np.asarray(ds["tau_applied"].values), axis=1)
-        style.line(ax, style.time_s(ds), norm, color=colour, linewidth=1.0, label=law.upper())
+        style.line(ax, style.time_s(ds), norm, color=colour, linewidth=1.0, label=_label(law, ds))
     limit = scenario.actuator.t_max_nm
     ax.axhline(
         limit * np.sqrt(3.0),
@@ -92,3 +92,8 @@ def write_comparison_figure(
 ) -> Path:
     """Write :func:`plot_controller_comparison` to ``path`` (PNG); returns the path."""
     return style.save_figure(plot_controller_comparison(datasets), path, dpi=dpi)
+
+
+def _label(key: str, ds) -> str:
+    """The law's display name the run recorded (the key upper-cased for older results)."""
+    return str(ds.attrs.get("controller_label", key.upper()))

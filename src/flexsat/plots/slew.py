@@ -84,14 +84,13 @@ _PHASE_COLOURS = 400  # pieces of the trajectory, each drawn in one colour
 
 @dataclass(frozen=True)
 class _Surface:
-    """Sliding-surface parameters of the law that flew the run."""
+    """Sliding-surface parameters of the law that flew the run (from the result's attributes)."""
 
-    kind: str
     lambda_min: float  # rad/s
     lambda_max: float  # rad/s
     phi: float  # rad/s
     jk_min: float  # N m
-    theta_threshold_deg: float | None  # ASMC only
+    theta_threshold_deg: float | None  # where the slope adapts, if it does
 
 
 def _scenario(ds: xr.Dataset) -> SlewScenario:
@@ -104,17 +103,16 @@ def _scenario(ds: xr.Dataset) -> SlewScenario:
         raise ValueError(f"the dataset's scenario is not a slew scenario: {exc}") from exc
 
 
-def _surface(ds: xr.Dataset, scenario: SlewScenario) -> _Surface | None:
-    """The surface of an ASMC or SMC run; None for a PD or a plain-Python law."""
-    law = scenario.controller
-    if ds.attrs.get("controller", law.kind) != law.kind:
+def _surface(ds: xr.Dataset) -> _Surface | None:
+    """The sliding surface the law wrote into the result; None if it has none."""
+    a = ds.attrs
+    keys = ("surface_lambda_min_rad_s", "surface_lambda_max_rad_s", "boundary_layer_rad_s",
+            "jk_floor_nm")  # fmt: skip
+    if not all(k in a for k in keys):
         return None
-    if law.kind == "asmc":
-        return _Surface("ASMC", law.lambda_min, law.lambda_max, law.phi, law.jk_min_nm,
-                        law.theta_threshold_deg)  # fmt: skip
-    if law.kind == "smc":
-        return _Surface("SMC", law.lambda_, law.lambda_, law.phi, law.jk_nm, None)
-    return None
+    threshold = a.get("theta_threshold_deg")
+    return _Surface(*(float(a[k]) for k in keys),
+                    None if threshold is None else float(threshold))  # fmt: skip
 
 
 def _target_quaternion(ds: xr.Dataset, scenario: SlewScenario) -> np.ndarray:
@@ -124,7 +122,8 @@ def _target_quaternion(ds: xr.Dataset, scenario: SlewScenario) -> np.ndarray:
 
 
 def _law_name(ds: xr.Dataset) -> str:
-    return str(ds.attrs.get("controller", "")).upper() or "controller"
+    label = ds.attrs.get("controller_label", str(ds.attrs.get("controller", "")).upper())
+    return str(label) or "controller"
 
 
 def _no_data(ax: Axes, text: str) -> None:
@@ -136,6 +135,13 @@ def _no_surface(ds: xr.Dataset, what: str) -> str:
     if ds.attrs.get("controller") == "python":
         return f"no {what}: not recorded for a plain-Python controller"
     return f"no {what}: the {_law_name(ds)} law has no sliding surface"
+
+
+def _values(ds: xr.Dataset, name: str, shape: tuple[int, ...]) -> np.ndarray:
+    """A recorded variable as floats; NaN where the run's law does not record it."""
+    if name not in ds:
+        return np.full(shape, np.nan)
+    return np.asarray(ds[name].values, dtype=float)
 
 
 def _recorded(values: np.ndarray) -> bool:
@@ -460,7 +466,7 @@ def plot_phase_plane(ds: xr.Dataset) -> Figure:
     matplotlib.figure.Figure
     """
     scenario = _scenario(ds)
-    surface = _surface(ds, scenario)
+    surface = _surface(ds)
     t = style.time_s(ds)
     qv = attitude_error_vector(ds)
     omega = np.asarray(ds["omega"].values, dtype=float)
@@ -520,9 +526,9 @@ def plot_sliding_variables(ds: xr.Dataset) -> Figure:
     -------
     matplotlib.figure.Figure
     """
-    surface = _surface(ds, _scenario(ds))
+    surface = _surface(ds)
     t = style.time_s(ds)
-    s = np.asarray(ds["sliding_variable"].values, dtype=float)
+    s = _values(ds, "sliding_variable", (t.size, 3))
     fig, axes = style.figure(3, 1, size=(11.0, 9.0))
     for k in range(3):
         ax = axes[k, 0]
@@ -572,12 +578,12 @@ def plot_adaptation(ds: xr.Dataset) -> Figure:
     matplotlib.figure.Figure
     """
     scenario = _scenario(ds)
-    surface = _surface(ds, scenario)
+    surface = _surface(ds)
     act = scenario.actuator
     ceiling = act.reduction_factor * act.t_max_nm
     t = style.time_s(ds)
-    lam = np.asarray(ds["lambda_act"].values, dtype=float)
-    jk = np.asarray(ds["jk"].values, dtype=float)
+    lam = _values(ds, "lambda_act", (t.size,))
+    jk = _values(ds, "jk", (t.size, 3))
     fig, axes = style.figure(2, 1, size=(11.0, 8.0))
     top, bottom = axes[0, 0], axes[1, 0]
     top.set_ylabel("Λ_act [rad/s]")
@@ -647,7 +653,7 @@ def plot_adaptation(ds: xr.Dataset) -> Figure:
 def plot_disturbances(ds: xr.Dataset) -> Figure:
     """Disturbance torques of the actuator model per body axis [N m].
 
-    The model of :mod:`flexsat.control.actuation`, with the scenario's
+    The model of :mod:`flexsat.control.stages.static_actuator`, with the scenario's
     parameters: the constant environment + residual torque, the sloshing torque
     ratio * tau_cmd * sin(2 pi f t) and the actuator-gain shortfall
     -(1 - G_act) tau_cmd (the torque the actuators fail to deliver, signed as it
@@ -665,9 +671,14 @@ def plot_disturbances(ds: xr.Dataset) -> Figure:
     matplotlib.figure.Figure
     """
     scenario = _scenario(ds)
-    surface = _surface(ds, scenario)
+    surface = _surface(ds)
     dist, act = scenario.disturbances, scenario.actuator
     t = style.time_s(ds)
+    if not hasattr(act, "gain"):  # an actuator stage other than the static gain model
+        fig, axes = style.figure(1, 1, size=(11.0, 4.0))
+        _no_data(axes[0, 0], f"the {act.kind} actuator stage adds no static disturbance model")
+        style.suptitle(fig, ds, "Disturbance torques of the actuator model (frame B)")
+        return fig
     cmd = np.asarray(ds["tau_cmd"].values, dtype=float)
     total = np.asarray(ds["tau_applied"].values, dtype=float) - cmd
     slosh = dist.sloshing_ratio * cmd * np.sin(2.0 * np.pi * dist.sloshing_hz * t)[:, None]
@@ -796,7 +807,8 @@ def plot_torque_breakdown(ds: xr.Dataset) -> Figure:
         for sign in (1.0, -1.0):
             ax.axhline(sign * soft, color=_SOFT_LIMIT, linestyle=":", linewidth=1.0,
                        label=f"±RF·T_max = {soft:.3g} N m" if sign > 0 else None)  # fmt: skip
-        recorded = [name for name, _, _ in parts if _recorded(ds[name].values[:, k])]
+        recorded = [name for name, _, _ in parts
+                    if name in ds and _recorded(ds[name].values[:, k])]  # fmt: skip
         for name, colour, label in parts:
             if name in recorded:
                 style.line(ax, t, ds[name].values[:, k], color=colour, linewidth=1.0, label=label)

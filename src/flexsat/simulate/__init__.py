@@ -1,6 +1,6 @@
 """Simulation drivers: scenarios in, :class:`Result` (an xarray Dataset) out."""
 
-from flexsat.simulate.closedloop import design_inertia, run_slew
+from flexsat.simulate.closedloop import design_inertia, run_slew, slew_design_inertia
 from flexsat.simulate.openloop import initial_state, run_openloop
 from flexsat.simulate.result import Result
 from flexsat.simulate.scenario import (
@@ -28,6 +28,7 @@ __all__ = [
     "pulse",
     "run_openloop",
     "run_slew",
+    "slew_design_inertia",
     "step",
     "thesis_openloop",
 ]

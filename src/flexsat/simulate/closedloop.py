@@ -9,25 +9,29 @@ from typing import Protocol
 import numpy as np
 
 from flexsat.config import nominal
-from flexsat.control.actuation import applied_torque
-from flexsat.control.laws import ASMC, DIAG_NAMES, PD, SMC
-from flexsat.control.quaternion import (
-    euler_zyx_to_quaternion,
-    quaternion_error,
-    target_quaternion,
-)
+from flexsat.config.models import SatelliteConfig
+from flexsat.control.laws import get_law
+from flexsat.control.quaternion import pointing_errors, target_quaternion
+from flexsat.control.stages import ACTUATORS, SENSORS
 from flexsat.dynamics.integrators import rk4_hold
-from flexsat.dynamics.linalg3 import euler_rate_matrix
 from flexsat.dynamics.plant import Plant
 from flexsat.dynamics.rigid import rigid_inertia
 from flexsat.errors import SimulationError
 from flexsat.simulate.common import PROGRESS_MIN_STEPS, chunk_steps, progress_bar, run_attributes
-from flexsat.simulate.loops import CTRL_RECORD_SIZE, rk4_closed_loop
+from flexsat.simulate.layout import LoopLayout
+from flexsat.simulate.loops import (
+    STATUS_CONTROL_FAILED,
+    LoopClock,
+    LoopData,
+    LoopRecords,
+    LoopStages,
+    run_closed_loop,
+)
 from flexsat.simulate.openloop import initial_state
 from flexsat.simulate.result import Result, build_dataset
 from flexsat.simulate.scenario import SlewScenario
 
-__all__ = ["Controller", "design_inertia", "run_slew"]
+__all__ = ["Controller", "design_inertia", "run_slew", "slew_design_inertia"]
 
 
 class Controller(Protocol):
@@ -43,12 +47,28 @@ class Controller(Protocol):
 
     def __call__(self, t: float, q: np.ndarray, omega_B: np.ndarray) -> np.ndarray: ...
 
-_KINDS = {"asmc": ASMC, "smc": SMC, "pd": PD}
+def design_inertia(config: SatelliteConfig | None = None) -> np.ndarray:
+    """J_tot of a rigidized satellite [kg m^2], shape (3, 3): the controllers' design model.
+
+    Parameters
+    ----------
+    config : SatelliteConfig, optional
+        The user's nominal configuration; default the thesis's nominal satellite.
+    """
+    return rigid_inertia(Plant.from_config(config or nominal()))
 
 
-def design_inertia() -> np.ndarray:
-    """J_tot of the rigidized nominal satellite: the only model the controllers know."""
-    return rigid_inertia(Plant.from_config(nominal()))
+def slew_design_inertia(plant: Plant, scenario: SlewScenario) -> np.ndarray:
+    """The design inertia a slew's controller uses [kg m^2], shape (3, 3).
+
+    The scenario's ``design_inertia_kg_m2`` if given, else J_tot of the rigidized
+    ``plant`` configuration. Uncertainty studies perturb the truth plant only: they
+    give the nominal design model explicitly (campaigns write it into each case's
+    scenario from the base configuration).
+    """
+    if scenario.design_inertia_kg_m2 is not None:
+        return np.array(scenario.design_inertia_kg_m2, dtype=float)
+    return rigid_inertia(plant)
 
 
 def run_slew(
@@ -67,77 +87,80 @@ def run_slew(
     scenario : SlewScenario, optional
         Default: the thesis's 45/45/45 deg ASMC slew with disturbances at maximum.
     design_J : ndarray, shape (3, 3), optional
-        The controller's inertia; default :func:`design_inertia` (nominal, rigid).
+        The controller's inertia [kg m^2]; default :func:`slew_design_inertia`.
     progress : bool, optional
         Progress bar; default only for runs of at least 200 000 steps.
     controller : Controller, optional
         A plain-Python law used instead of ``scenario.controller`` (whose compiled
-        form runs inside the RK4 loop). Its diagnostics (s, Lambda, JK, breakdown)
-        are recorded as NaN.
+        form runs inside the RK4 loop). The sensor and actuator stages of the
+        scenario still run; the law's diagnostics are recorded as NaN.
 
     Returns
     -------
     Result
-        As :func:`flexsat.simulate.run_openloop`, plus the control variables
-        (sliding variable, Lambda, JK, torque breakdown, pointing error). A
-        diverging run stops cleanly with its history and ``status = "failed"``.
+        As :func:`flexsat.simulate.run_openloop`, plus the pointing and rate errors,
+        the law's declared diagnostics and the stages' records (each a variable with
+        its units) and, in the attributes, what the law's plots need. A diverging
+        run stops cleanly with its history and ``status = "failed"``.
     """
     scenario = scenario or SlewScenario()
-    J = np.ascontiguousarray(design_inertia() if design_J is None else design_J, dtype=float)
+    J = np.ascontiguousarray(
+        slew_design_inertia(plant, scenario) if design_J is None else design_J, dtype=float
+    )
+    law = get_law(scenario.controller.kind)
+    layout = LoopLayout(plant.n_dof, law, SENSORS.get(scenario.sensor.kind),
+                        ACTUATORS.get(scenario.actuator.kind))  # fmt: skip
     q0, qd0 = initial_state(plant, scenario)
-    n = plant.n_dof
     steps, every = scenario.n_steps, scenario.record_every
     n_records = steps // every + 2  # + the last good state of a failed run
     rec_t = np.full(n_records, np.nan)
-    rec_x = np.full((n_records, 2 * n + 2), np.nan)
-    rec_ctrl = np.full((n_records, CTRL_RECORD_SIZE), np.nan)
+    rec_x = np.full((n_records, layout.x_size), np.nan)
+    rec_ctrl = np.full((n_records, layout.record_size), np.nan)
     x = np.concatenate([q0, qd0, [0.0, 0.0]])
-    gains = scenario.controller.gains(scenario.actuator)
-    dist = scenario.disturbances.packed(scenario.actuator)
-    q_d = tuple(target_quaternion(scenario.target_euler_deg))
-    memory = np.zeros(2)
-    held = np.zeros(CTRL_RECORD_SIZE)
-    kind = _KINDS[scenario.controller.kind]
+    data = _loop_data(layout, scenario, J)
+    stages = LoopStages((layout.sensor.step,), (law.step,), (layout.actuator.step,))
     show = steps >= PROGRESS_MIN_STEPS if progress is None else progress
     start = time.perf_counter()
     with progress_bar(show, scenario.duration_s) as (bar, task):
-        run = _compiled_loop if controller is None else _python_loop
-        status, done, rows = run(
-            plant, scenario, x, kind, gains, J, q_d, dist, memory, held, rec_t, rec_x,
-            rec_ctrl, bar, task, controller,
-        )  # fmt: skip
+        if controller is None:
+            status, done, rows = _compiled_loop(plant, scenario, x, stages, data, rec_t, rec_x,
+                                                rec_ctrl, bar, task)  # fmt: skip
+        else:
+            status, done, rows = _python_loop(plant, scenario, x, stages, data, rec_t, rec_x,
+                                              rec_ctrl, bar, task, controller)  # fmt: skip
     wall = time.perf_counter() - start
     t_fail = done * scenario.dt_s if status else -1.0
     if status:  # keep the last good state as the final record
-        rec_t[rows], rec_x[rows], rec_ctrl[rows] = t_fail, x, held
+        rec_t[rows], rec_x[rows], rec_ctrl[rows] = t_fail, x, data.held
         rows += 1
     rec_t, rec_x, rec_ctrl = rec_t[:rows], rec_x[:rows], rec_ctrl[:rows]
     attrs = run_attributes(plant, scenario, "closed-loop", status, t_fail, wall, done)
-    attrs["controller"] = scenario.controller.kind if controller is None else "python"
+    attrs["controller"] = law.name if controller is None else "python"
+    attrs["controller_label"] = law.label if controller is None else "Python law"
+    attrs["sensor"] = layout.sensor.name
+    attrs["actuator"] = layout.actuator.name
+    if controller is None:
+        attrs.update(scenario.controller.plot_attributes())
     attrs["design_inertia"] = J.ravel().tolist()
-    attrs["target_quaternion"] = list(q_d)
+    attrs["target_quaternion"] = data.q_d.tolist()
     # gain (3), environment (3), sloshing ratio and Hz, residual (3), T_max
-    attrs["realised_disturbances"] = dist.tolist()
+    attrs["realised_disturbances"] = data.actuator_params.tolist()
     ds = build_dataset(
-        plant, rec_t, rec_x[:, :n], rec_x[:, n : 2 * n], rec_x[:, 2 * n], rec_x[:, 2 * n + 1],
-        rec_ctrl[:, 0:3], rec_ctrl[:, 3:6], attrs,
+        plant, rec_t, rec_x[:, layout.q], rec_x[:, layout.qd], rec_x[:, layout.work],
+        rec_x[:, layout.dissipated], rec_ctrl[:, layout.tau_cmd], rec_ctrl[:, layout.tau_applied],
+        attrs,
     )  # fmt: skip
-    diag = rec_ctrl[:, 6:]
-    column = {name: diag[:, k] for k, name in enumerate(DIAG_NAMES)}
-
-    def axes(prefix: str) -> np.ndarray:
-        return np.column_stack([column[f"{prefix}_{a}"] for a in "xyz"])
-
     ta = ("time", "axis")
-    ds["sliding_variable"] = (ta, axes("s"), {"units": "rad/s", "description": "s = w_e + L q_v,e"})
-    ds["lambda_act"] = ("time", column["lambda"], {"units": "rad/s", "description": "Lambda_act"})
-    ds["jk"] = (ta, axes("jk"), {"units": "N m", "description": "robust torque gain JK per axis"})
-    ds["tau_gyro"] = (ta, axes("tau_gyro"), {"units": "N m", "description": "w x J w"})
-    ds["tau_guide"] = (ta, axes("tau_guide"), {"units": "N m", "description": "-J L q_v,e_dot"})
-    ds["tau_rob"] = (ta, axes("tau_rob"), {"units": "N m", "description": "-JK sat(s/Phi)"})
+    for channel, columns in layout.channels():
+        values = rec_ctrl[:, columns] if channel.per_axis else rec_ctrl[:, columns.start]
+        attributes = {"units": channel.units, "description": channel.description}
+        ds[channel.name] = (ta if channel.per_axis else "time", values, attributes)
+    # of the true attitude, whatever the sensor measured
+    pointing = pointing_errors(data.q_d, np.ascontiguousarray(rec_x[:, layout.q][:, 3:6]))
     ds["pointing_error_deg"] = (
-        "time", np.degrees(column["theta_err"]),
-        {"units": "deg", "description": "2 asin |q_v,e|: absolute pointing error"},
+        "time", np.degrees(pointing),
+        {"units": "deg", "description": "2 asin |q_v,e| of the true attitude: absolute "
+         "pointing error"},
     )  # fmt: skip
     with np.errstate(over="ignore", invalid="ignore"):  # a diverged run's last state
         rate_error = np.degrees(np.linalg.norm(ds["omega"].values, axis=1))
@@ -148,19 +171,48 @@ def run_slew(
     return Result(ds)
 
 
-def _compiled_loop(plant, scenario, x, kind, gains, J, q_d, dist, memory, held, rec_t, rec_x,
-                   rec_ctrl, bar, task, controller):  # fmt: skip
-    """The whole loop, controller included, in compiled chunks."""
+def _loop_data(layout: LoopLayout, scenario: SlewScenario, J: np.ndarray) -> LoopData:
+    """The arrays of one run, record-row pieces as views into ``held``."""
+    held = np.zeros(layout.record_size)
+    state = np.zeros(layout.state_size)
+
+    def packed(values) -> np.ndarray:
+        return np.ascontiguousarray(values, dtype=float)
+
+    return LoopData(
+        J_design=J,
+        q_d=packed(target_quaternion(scenario.target_euler_deg)),
+        omega_d=np.zeros(3),  # rest-to-rest
+        omega_dot_d=np.zeros(3),
+        law_gains=packed(scenario.controller.gains(scenario.actuator)),
+        law_state=state[layout.law_state],
+        sensor_params=packed(scenario.sensor.packed(scenario)),
+        sensor_state=state[layout.sensor_state],
+        actuator_params=packed(scenario.actuator.packed(scenario)),
+        actuator_state=state[layout.actuator_state],
+        q_meas=np.zeros(4),
+        omega_meas=np.zeros(3),
+        held=held,
+        tau_cmd=held[layout.tau_cmd],
+        tau_applied=held[layout.tau_applied],
+        law_diag=held[layout.law_diag],
+        sensor_record=held[layout.sensor_record],
+        actuator_record=held[layout.actuator_record],
+    )
+
+
+def _compiled_loop(plant, scenario, x, stages, data, rec_t, rec_x, rec_ctrl, bar, task):
+    """The whole loop, stages and law included, in compiled chunks."""
     steps, every, control = scenario.n_steps, scenario.record_every, scenario.control_every
     chunk = chunk_steps(every, control)
     done, rows, status = 0, 0, 0
     while status == 0:
         n_chunk = min(chunk, steps - done)
         final = done + n_chunk == steps
-        status, ran, written = rk4_closed_loop(
-            x, done * scenario.dt_s, scenario.dt_s, n_chunk, final, control, every, kind,
-            gains, J, q_d, dist, memory, held, plant.dynamics_args, rec_t, rec_x, rec_ctrl, rows,
-        )  # fmt: skip
+        clock = LoopClock(done * scenario.dt_s, scenario.dt_s, n_chunk, final, control, every)
+        status, ran, written = run_closed_loop(
+            x, clock, stages, data, LoopRecords(rec_t, rec_x, rec_ctrl, rows), plant.dynamics_args
+        )
         done += ran
         rows += written
         if bar is not None:
@@ -170,35 +222,38 @@ def _compiled_loop(plant, scenario, x, kind, gains, J, q_d, dist, memory, held, 
     return status, done, rows
 
 
-def _python_loop(plant, scenario, x, kind, gains, J, q_d, dist, memory, held, rec_t, rec_x,
-                 rec_ctrl, bar, task, controller):  # fmt: skip
-    """Python controller at each control instant; the plant steps compiled in between."""
+def _python_loop(plant, scenario, x, stages, d, rec_t, rec_x, rec_ctrl, bar, task, controller):
+    """Python controller at each control instant between the compiled stages; the plant
+    steps compiled in between."""
     n = plant.n_dof
     steps, every, control = scenario.n_steps, scenario.record_every, scenario.control_every
     block = math.gcd(every, control)
+    control_dt = control * scenario.dt_s
     limit = scenario.actuator.reduction_factor * scenario.actuator.t_max_nm
-    held[6:] = np.nan
+    d.law_diag[:] = np.nan
     rows, status, k = 0, 0, 0
     while True:
         t = k * scenario.dt_s
         if k % control == 0:
-            q_meas = np.array(euler_zyx_to_quaternion(x[3], x[4], x[5]))
-            omega_B = np.array(euler_rate_matrix(x[3], x[4])) @ x[n + 3 : n + 6]
-            tau_cmd = np.asarray(controller(t, q_meas, omega_B), dtype=float)
+            status = stages.sensor[0](x, n, t, d.sensor_params, d.sensor_state, d.q_meas,
+                                      d.omega_meas, d.sensor_record)  # fmt: skip
+            tau_cmd = np.asarray(controller(t, d.q_meas.copy(), d.omega_meas.copy()), dtype=float)
             if tau_cmd.shape != (3,) or not np.all(np.isfinite(tau_cmd)):
                 raise SimulationError(f"controller returned {tau_cmd!r} at t = {t:.6g} s")
-            tau_cmd = np.clip(tau_cmd, -limit, limit)
-            held[0:3] = tau_cmd
-            held[3:6] = applied_torque(tuple(tau_cmd), t, dist)
-            e = quaternion_error(q_d, tuple(q_meas))
-            held[6 + DIAG_NAMES.index("theta_err")] = 2.0 * math.asin(min(1.0, math.hypot(*e[1:])))
+            d.tau_cmd[:] = np.clip(tau_cmd, -limit, limit)
+            status |= stages.actuator[0](
+                d.tau_cmd, t, control_dt, d.actuator_params, d.actuator_state, d.tau_applied,
+                d.actuator_record,
+            )  # fmt: skip
+            if status:
+                return STATUS_CONTROL_FAILED, k, rows
         if k % every == 0:
-            rec_t[rows], rec_x[rows], rec_ctrl[rows] = t, x, held
+            rec_t[rows], rec_x[rows], rec_ctrl[rows] = t, x, d.held
             rows += 1
         if k == steps:
             return 0, k, rows
-        status, ran = rk4_hold(x, scenario.dt_s, block, (held[3], held[4], held[5]),
-                               plant.dynamics_args)  # fmt: skip
+        torque = (d.tau_applied[0], d.tau_applied[1], d.tau_applied[2])
+        status, ran = rk4_hold(x, scenario.dt_s, block, torque, plant.dynamics_args)
         k += ran
         if status:
             return status, k, rows

@@ -14,6 +14,7 @@ from flexsat import __version__
 from flexsat.dynamics import kernels
 from flexsat.dynamics.integrators import STATUS_NOT_FINITE
 from flexsat.errors import ConfigError
+from flexsat.simulate.loops import STATUS_CONTROL_FAILED
 
 __all__ = [
     "PROGRESS_MIN_STEPS",
@@ -31,6 +32,7 @@ FAILURES = {
     kernels.STATUS_HUB_GIMBAL_LOCK: "hub pitch reached +-90 deg (ZYX Euler-angle singularity)",
     kernels.STATUS_JOINT_GIMBAL_LOCK: "a joint root rotation rho_y reached +-90 deg",
     STATUS_NOT_FINITE: "the state became non-finite (the integration diverged)",
+    STATUS_CONTROL_FAILED: "the control law or a loop stage returned a failure status",
 }
 
 

@@ -9,12 +9,22 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Annotated, ClassVar, Literal
 
-from pydantic import Field, Strict, model_validator
+import numpy as np
+from pydantic import Field, SerializeAsAny, Strict, field_validator, model_validator
 
 from flexsat.analysis.requirements import Requirements
 from flexsat.config.load import read_toml, validate_config
-from flexsat.config.models import Positive, Real, Vector3, _Frozen
-from flexsat.control.config import ActuatorConfig, ASMCConfig, ControllerConfig, DisturbanceConfig
+from flexsat.config.models import Matrix3, Positive, Real, Vector3, _Frozen
+from flexsat.control.config import DisturbanceConfig
+from flexsat.control.laws import LAWS, LawConfig, validate_law_config
+from flexsat.control.stages import (
+    ACTUATORS,
+    SENSORS,
+    ActuatorStageConfig,
+    StageConfig,
+    validate_actuator_config,
+    validate_sensor_config,
+)
 
 __all__ = [
     "MAX_STEPS",
@@ -32,6 +42,7 @@ __all__ = [
 ]
 
 _ZERO3 = (0.0, 0.0, 0.0)
+_MAX_INERTIA_KG_M2 = 1e9  # a bound far beyond any spacecraft, so J's algebra cannot overflow
 
 
 class TorqueSegment(_Frozen):
@@ -176,12 +187,56 @@ class SlewScenario(_TimedRun):
     target_euler_deg: Vector3 = Field(
         (45.0, 45.0, 45.0), description="target ZYX Euler angles (roll, pitch, yaw) [deg]"
     )
-    controller: ControllerConfig = Field(default_factory=ASMCConfig)
-    actuator: ActuatorConfig = Field(default_factory=ActuatorConfig)
+    controller: SerializeAsAny[LawConfig] = Field(
+        default_factory=lambda: LAWS.get(LAWS.default).config(),
+        description="the control law: any registered law's table, by its kind",
+    )
+    sensor: SerializeAsAny[StageConfig] = Field(
+        default_factory=lambda: SENSORS.get(SENSORS.default).config(),
+        description="the sensor stage, by its kind",
+    )
+    actuator: SerializeAsAny[ActuatorStageConfig] = Field(
+        default_factory=lambda: ACTUATORS.get(ACTUATORS.default).config(),
+        description="the actuator stage, by its kind",
+    )
     disturbances: DisturbanceConfig = Field(default_factory=DisturbanceConfig)
     requirements: Requirements = Field(default_factory=Requirements)
+    design_inertia_kg_m2: Matrix3 | None = Field(
+        None,
+        description="the controller's design inertia J [kg m^2] (3x3, symmetric positive "
+        "definite); default: J_tot of the rigidized nominal satellite of the config",
+    )
 
     _MULTIPLES_OF_DT: ClassVar[tuple[str, ...]] = ("control_dt_s", "record_dt_s")
+
+    @field_validator("controller", mode="before")
+    @classmethod
+    def _registered_law(cls, value: object) -> LawConfig:
+        return validate_law_config(value)  # at validation time: laws registered later count
+
+    @field_validator("sensor", mode="before")
+    @classmethod
+    def _registered_sensor(cls, value: object) -> StageConfig:
+        return validate_sensor_config(value)
+
+    @field_validator("actuator", mode="before")
+    @classmethod
+    def _registered_actuator(cls, value: object) -> ActuatorStageConfig:
+        return validate_actuator_config(value)
+
+    @field_validator("design_inertia_kg_m2")
+    @classmethod
+    def _spd(cls, value: Matrix3 | None) -> Matrix3 | None:
+        if value is None:
+            return value
+        J = np.array(value, dtype=float)
+        if np.abs(J).max() > _MAX_INERTIA_KG_M2:
+            raise ValueError(f"entries must be within +-{_MAX_INERTIA_KG_M2:.0e} kg m^2")
+        if not np.allclose(J, J.T, rtol=1e-12, atol=1e-12 * np.abs(J).max()):
+            raise ValueError("must be symmetric (J = J^T)")
+        if np.linalg.eigvalsh(J).min() <= 0.0:
+            raise ValueError("must be positive definite (every eigenvalue > 0 kg m^2)")
+        return value
 
     @property
     def control_every(self) -> int:

@@ -162,7 +162,8 @@ def fly_slew(plant: Plant, scenario=None, out: Path | None = None, progress=None
     result : Result
     metrics : dict
         :func:`flexsat.analysis.requirements.slew_metrics` (R1-R3 from the
-        scenario's requirements), plus ``files``.
+        scenario's requirements), plus the controller's ``design_inertia_kg_m2``
+        (3x3) and ``files``.
     """
     from flexsat.analysis.requirements import slew_metrics
     from flexsat.simulate import SlewScenario, run_slew
@@ -179,6 +180,8 @@ def fly_slew(plant: Plant, scenario=None, out: Path | None = None, progress=None
         prepare_output_dir(out)
     result = run_slew(plant, scenario, progress=progress)
     metrics = slew_metrics(result.dataset)  # the stored scenario's requirements
+    J = result.dataset.attrs["design_inertia"]
+    metrics["design_inertia_kg_m2"] = [list(J[3 * i : 3 * i + 3]) for i in range(3)]
     if out is not None:
         _write_run(result, metrics, Path(out), figures)
     return result, metrics

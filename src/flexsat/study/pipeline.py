@@ -24,6 +24,7 @@ from rich.markup import escape
 
 from flexsat import __version__
 from flexsat.config.models import SatelliteConfig
+from flexsat.control.laws import LAWS
 from flexsat.study.outputs import (
     derived_properties,
     fly_campaign,
@@ -34,10 +35,7 @@ from flexsat.study.outputs import (
     write_modal,
 )
 
-__all__ = ["CAMPAIGNS", "CONTROLLERS", "PARTS", "Part", "StudyContext", "run_study"]
-
-CONTROLLERS = ("asmc", "smc", "pd")
-"""The nominal slew's laws: the thesis's ASMC and the two baselines it is compared with."""
+__all__ = ["CAMPAIGNS", "PARTS", "Part", "StudyContext", "run_study"]
 
 CAMPAIGNS = ("sensitivity", "montecarlo-critical", "deployment-shock")
 """The thesis's three campaigns (chapter 5), in the order of the report."""
@@ -55,7 +53,15 @@ class StudyContext:
     quick: bool = False
     progress: bool | None = None
     workers: int | None = None
+    controllers: tuple[str, ...] = ()  # the comparison's laws; empty: every registered law
     results: dict = field(default_factory=dict)  # part name -> its returned outputs
+
+    @property
+    def laws(self) -> tuple[str, ...]:
+        """The nominal slew's law (the default) first, then the others compared."""
+        default = LAWS.default
+        chosen = self.controllers or LAWS.names()
+        return (default, *(name for name in chosen if name != default))
 
     @property
     def plant(self):
@@ -111,15 +117,15 @@ def _slew_with(ctx: StudyContext, kind: str) -> dict:
 
 
 def _slew(ctx: StudyContext) -> dict:
-    return _slew_with(ctx, "asmc")
+    return _slew_with(ctx, LAWS.default)
 
 
 def _comparison(ctx: StudyContext) -> dict:
     from flexsat.plots.comparison import write_comparison_figure
     from flexsat.simulate.result import Result
 
-    runs = {"asmc": ctx.results["slew"]}
-    runs.update({kind: _slew_with(ctx, kind) for kind in CONTROLLERS[1:]})
+    runs = {LAWS.default: ctx.results["slew"]}
+    runs.update({kind: _slew_with(ctx, kind) for kind in ctx.laws[1:]})
     datasets = {
         kind: Result.from_netcdf(ctx.out / run["result"]).dataset for kind, run in runs.items()
     }
@@ -135,7 +141,7 @@ def _animation(ctx: StudyContext) -> dict:
     from flexsat.simulate.result import Result
 
     result = Result.from_netcdf(ctx.out / ctx.results["slew"]["result"])
-    path = write_animation(result, ctx.out / "slew" / "asmc" / "animation.gif")
+    path = write_animation(result, ctx.out / "slew" / LAWS.default / "animation.gif")
     return {"figures": _relative(ctx, [path])}
 
 
@@ -162,7 +168,7 @@ PARTS = (
     Part("configuration", "Configuration", _configuration),
     Part("modal", "Modal analysis", _modal),
     Part("openloop", "Open-loop validation", _openloop),
-    Part("slew", "Nominal slew with ASMC", _slew),
+    Part("slew", f"Nominal slew with {LAWS.get(LAWS.default).label}", _slew),
     Part("comparison", "Controller comparison", _comparison, needs=("slew",)),
     Part("animation", "Slew animation", _animation, needs=("slew",)),
     Part("campaigns", "Robustness campaigns", _campaigns, full_only=True),
@@ -179,6 +185,7 @@ def run_study(
     progress: bool | None = None,
     workers: int | None = None,
     console: Console | None = None,
+    controllers: tuple[str, ...] = (),
 ) -> dict:
     """Run the study into ``out`` and write ``out/report.html``.
 
@@ -199,6 +206,9 @@ def run_study(
         Campaign worker processes (default: all cores).
     console : rich.console.Console, optional
         Where each part's outcome is announced; default: standard error.
+    controllers : tuple of str, optional
+        Registered laws flown in the comparison besides the default one; empty:
+        every registered law.
 
     Returns
     -------
@@ -210,7 +220,7 @@ def run_study(
 
     out = prepare_output_dir(out)
     console = console or Console(stderr=True)
-    ctx = StudyContext(config, out, quick, progress, workers)
+    ctx = StudyContext(config, out, quick, progress, workers, tuple(controllers))
     manifest = {
         "flexsat_version": __version__,
         "created_utc": dt.datetime.now(dt.UTC).strftime("%Y-%m-%d %H:%M:%S UTC"),

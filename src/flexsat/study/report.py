@@ -26,6 +26,7 @@ from pathlib import Path
 
 import numpy as np
 
+from flexsat.control.laws import get_law, law_names
 from flexsat.study import thesis
 
 __all__ = ["format_value", "write_report"]
@@ -334,11 +335,12 @@ def _comparison(root: Path, outputs: dict, context: dict) -> str:
     first = next(iter(sources.values()))
     keys = [k for k in first.data if k not in ("files", "message", "controller")]
     rows = [[key, *(src.cell(key) for src in sources.values())] for key in keys]
-    header = ["metric", *(kind.upper() for kind in sources)]
+    labels = [get_law(kind).label if kind in law_names() else kind for kind in sources]
+    header = ["metric", *labels]
     return "".join(
         [
-            "<p>The same slew, plant and disturbances flown by the thesis's ASMC and the two "
-            "baselines (classic SMC, PD) with their default gains.</p>",
+            f"<p>The same slew, plant and disturbances flown by {', '.join(labels)} with their "
+            "default gains; the first is the nominal slew's law.</p>",
             _table(header, rows, "Controller comparison"),
             _figures(root, outputs["figures"]),
         ]
@@ -347,7 +349,7 @@ def _comparison(root: Path, outputs: dict, context: dict) -> str:
 
 def _animation(root: Path, outputs: dict, context: dict) -> str:
     return (
-        "<p>The ASMC slew in 3D: hub, panels with their joint deformation magnified "
+        "<p>The nominal slew in 3D: hub, panels with their joint deformation magnified "
         "(factor in the frame), body axes and time.</p>" + _figures(root, outputs["figures"])
     )
 

@@ -1,0 +1,76 @@
+"""Quaternion PD with gyroscopic compensation: tau = w x Jw - J (kp q_v,e + kd w).
+
+The linear baseline of the thesis's comparison (sec. 5.2); no sliding surface.
+"""
+
+from __future__ import annotations
+
+from typing import Annotated, Literal, NamedTuple
+
+import numpy as np
+from numba import njit
+from pydantic import Field
+
+from flexsat.config.models import Positive
+from flexsat.control.laws._sliding import clip_and_store, errors, inertia3
+from flexsat.control.laws.registry import LAW_SIGNATURE, LawConfig, LawSpec
+from flexsat.control.registry import Channel
+from flexsat.dynamics.linalg3 import cross, mv
+
+__all__ = ["PD", "PDConfig", "PDGains"]
+
+
+class PDGains(NamedTuple):
+    """The packed gains, in order (SI)."""
+
+    t_max: float  # T_max per axis [N m]
+    reduction_factor: float  # RF [-]
+    kp: float  # [1/s^2]
+    kd: float  # [1/s]
+
+
+G = PDGains(*range(len(PDGains._fields)))  # index of each gain in the packed array
+
+
+class PDConfig(LawConfig):
+    """Quaternion PD with gyroscopic compensation: tau = w x Jw - J (kp q_v,e + kd w)."""
+
+    kind: Literal["pd"] = "pd"
+    natural_frequency_rad_s: Positive = Field(0.3, description="omega_n [rad/s]")
+    damping_ratio: Annotated[float, Field(gt=0.0, le=5.0)] = 0.9
+
+    def gains(self, actuator) -> np.ndarray:
+        wn = self.natural_frequency_rad_s
+        # q_v,e ~ theta / 2 for small errors: kp = 2 wn^2 gives theta'' = -wn^2 theta.
+        return np.array(PDGains(
+            actuator.t_max_nm, actuator.reduction_factor, 2.0 * wn**2,
+            2.0 * self.damping_ratio * wn,
+        ), dtype=float)  # fmt: skip
+
+
+@njit(LAW_SIGNATURE, cache=True)
+def pd_step(q_d, omega_d, omega_dot_d, q, omega_B, J, gains, state, t, dt, tau_cmd, diag):
+    """The PD command (law contract in :mod:`flexsat.control.laws.registry`); no state."""
+    limit = gains[G.reduction_factor] * gains[G.t_max]
+    qv, _, omega_e, _ = errors(q_d, q, omega_B)
+    J3 = inertia3(J)
+    tau_gyro = cross(omega_B, mv(J3, omega_B))  # omega x (J omega)
+    kp, kd = gains[G.kp], gains[G.kd]
+    u = (kp * qv[0] + kd * omega_e[0], kp * qv[1] + kd * omega_e[1],
+         kp * qv[2] + kd * omega_e[2])  # fmt: skip
+    Ju = mv(J3, u)
+    tau_guide = (-Ju[0], -Ju[1], -Ju[2])
+    clip_and_store(limit, tau_gyro, tau_guide, (0.0, 0.0, 0.0), tau_cmd)
+    diag[0], diag[1], diag[2] = tau_gyro
+    diag[3], diag[4], diag[5] = tau_guide
+    return 0
+
+
+PD = LawSpec(
+    name="pd", label="PD", config=PDConfig, step=pd_step, state_size=0,
+    diagnostics=(
+        Channel("tau_gyro", "N m", "w x J w", per_axis=True),
+        Channel("tau_guide", "N m", "-J (kp q_v,e + kd w)", per_axis=True),
+    ),
+    description="quaternion PD with gyroscopic compensation",
+)  # fmt: skip

@@ -1,0 +1,92 @@
+"""Classical sliding-mode control: constant slope and robust gain on the ASMC's surface.
+
+tau = omega x J omega - J lambda q_v,e_dot - JK sat(s / Phi), s = omega_e + lambda
+q_v,e (thesis eqs. 4.6, 4.14 with Lambda and JK held constant), the baseline of the
+thesis's comparison (sec. 5.2).
+"""
+
+from __future__ import annotations
+
+from typing import Literal, NamedTuple
+
+import numpy as np
+from numba import njit
+from pydantic import Field
+
+from flexsat.config.models import Positive
+from flexsat.control.laws._sliding import (
+    SLIDING_DIAGNOSTICS,
+    clip_and_store,
+    errors,
+    inertia3,
+    sat,
+)
+from flexsat.control.laws.registry import LAW_SIGNATURE, LawConfig, LawSpec
+from flexsat.dynamics.linalg3 import cross, mv
+
+__all__ = ["SMC", "SMCConfig", "SMCGains"]
+
+
+class SMCGains(NamedTuple):
+    """The packed gains, in order (SI)."""
+
+    t_max: float  # T_max per axis [N m]
+    reduction_factor: float  # RF [-]
+    jk: float  # robust torque JK [N m]
+    lambda_: float  # surface slope [rad/s]
+    phi: float  # boundary-layer width [rad/s]
+
+
+G = SMCGains(*range(len(SMCGains._fields)))  # index of each gain in the packed array
+
+
+class SMCConfig(LawConfig):
+    """Classical sliding-mode control: constant slope and robust gain, same surface."""
+
+    kind: Literal["smc"] = "smc"
+    jk_nm: Positive = Field(0.8925, description="robust torque JK [N m]")
+    lambda_: Positive = Field(1.0, alias="lambda", description="surface slope [rad/s]")
+    phi: Positive = Field(0.01, description="boundary-layer width [rad/s]")
+
+    def gains(self, actuator) -> np.ndarray:
+        return np.array(
+            SMCGains(actuator.t_max_nm, actuator.reduction_factor, self.jk_nm, self.lambda_,
+                     self.phi), dtype=float,
+        )  # fmt: skip
+
+    def plot_attributes(self) -> dict[str, float | str]:
+        return {
+            "surface_lambda_min_rad_s": self.lambda_,
+            "surface_lambda_max_rad_s": self.lambda_,
+            "boundary_layer_rad_s": self.phi,
+            "jk_floor_nm": self.jk_nm,
+        }
+
+
+@njit(LAW_SIGNATURE, cache=True)
+def smc_step(q_d, omega_d, omega_dot_d, q, omega_B, J, gains, state, t, dt, tau_cmd, diag):
+    """The SMC command (law contract in :mod:`flexsat.control.laws.registry`); no state."""
+    limit = gains[G.reduction_factor] * gains[G.t_max]
+    qv, qv_dot, omega_e, _ = errors(q_d, q, omega_B)
+    J3 = inertia3(J)
+    tau_gyro = cross(omega_B, mv(J3, omega_B))  # omega x (J omega)
+    J_qv_dot = mv(J3, qv_dot)
+    lam, jk, phi = gains[G.lambda_], gains[G.jk], gains[G.phi]
+    s = (omega_e[0] + lam * qv[0], omega_e[1] + lam * qv[1], omega_e[2] + lam * qv[2])
+    tau_guide = (-lam * J_qv_dot[0], -lam * J_qv_dot[1], -lam * J_qv_dot[2])
+    tau_rob = (-jk * sat(s[0] / phi), -jk * sat(s[1] / phi), -jk * sat(s[2] / phi))
+    clip_and_store(limit, tau_gyro, tau_guide, tau_rob, tau_cmd)
+    diag[0], diag[1], diag[2] = s
+    diag[3] = lam
+    diag[4], diag[5], diag[6] = jk, jk, jk
+    diag[7], diag[8], diag[9] = tau_gyro
+    diag[10], diag[11], diag[12] = tau_guide
+    diag[13], diag[14], diag[15] = tau_rob
+    return 0
+
+
+SMC = LawSpec(
+    name="smc", label="SMC", config=SMCConfig, step=smc_step, state_size=0,
+    diagnostics=SLIDING_DIAGNOSTICS,
+    description="classical sliding-mode control (constant slope and robust gain)",
+)  # fmt: skip

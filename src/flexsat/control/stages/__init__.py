@@ -1,0 +1,39 @@
+"""Loop stages around the law: sensors and actuators, one module each, one registry.
+
+Built in: the thesis's ideal sensor and static actuator. Write your own stage in
+your own file (see ``docs/control.md``): a parameter model, a compiled step of
+:data:`SENSOR_SIGNATURE` or :data:`ACTUATOR_SIGNATURE` and one registration line.
+"""
+
+from flexsat.control.stages.ideal_sensor import IDEAL_SENSOR
+from flexsat.control.stages.registry import (
+    ACTUATOR_SIGNATURE,
+    ACTUATORS,
+    SENSOR_SIGNATURE,
+    SENSORS,
+    ActuatorStageConfig,
+    StageConfig,
+    StageSpec,
+    register_actuator,
+    register_sensor,
+    validate_actuator_config,
+    validate_sensor_config,
+)
+from flexsat.control.stages.static_actuator import STATIC_ACTUATOR
+
+__all__ = [
+    "ACTUATORS",
+    "ACTUATOR_SIGNATURE",
+    "SENSORS",
+    "SENSOR_SIGNATURE",
+    "ActuatorStageConfig",
+    "StageConfig",
+    "StageSpec",
+    "register_actuator",
+    "register_sensor",
+    "validate_actuator_config",
+    "validate_sensor_config",
+]
+
+register_sensor(IDEAL_SENSOR, default=True)
+register_actuator(STATIC_ACTUATOR, default=True)

@@ -1,0 +1,112 @@
+"""Where every piece of a closed-loop run lives: plant state, law and stage states,
+control-record columns. Every consumer (the loop, the drivers, the result) reads
+the offsets here instead of re-deriving them."""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+from dataclasses import dataclass
+
+from flexsat.control.laws import LawSpec
+from flexsat.control.registry import Channel
+from flexsat.control.stages import StageSpec
+
+__all__ = ["LoopLayout"]
+
+_LOOP_COLUMNS = ("tau_cmd", "tau_applied")
+
+
+@dataclass(frozen=True)
+class LoopLayout:
+    """Offsets of a closed loop's state and records.
+
+    Plant state ``x`` (``x_size``,): q ``[q]``, q_dot ``[qd]``, cumulative work of
+    the applied torque ``[work]`` and damper dissipation ``[dissipated]`` [J].
+
+    Control state (``state_size``,): the law's ``[law_state]``, the sensor's
+    ``[sensor_state]`` and the actuator's ``[actuator_state]``, zero at t = 0.
+
+    Control record row (``record_size``,), held between control instants:
+    ``[tau_cmd]`` (3) and ``[tau_applied]`` (3) [N m], the law's diagnostics
+    ``[law_diag]``, the sensor's and the actuator's records.
+    """
+
+    n_dof: int
+    law: LawSpec
+    sensor: StageSpec
+    actuator: StageSpec
+
+    @property
+    def q(self) -> slice:
+        return slice(0, self.n_dof)
+
+    @property
+    def qd(self) -> slice:
+        return slice(self.n_dof, 2 * self.n_dof)
+
+    @property
+    def work(self) -> int:
+        return 2 * self.n_dof
+
+    @property
+    def dissipated(self) -> int:
+        return 2 * self.n_dof + 1
+
+    @property
+    def x_size(self) -> int:
+        return 2 * self.n_dof + 2
+
+    @property
+    def law_state(self) -> slice:
+        return slice(0, self.law.state_size)
+
+    @property
+    def sensor_state(self) -> slice:
+        return _after(self.law_state, self.sensor.state_size)
+
+    @property
+    def actuator_state(self) -> slice:
+        return _after(self.sensor_state, self.actuator.state_size)
+
+    @property
+    def state_size(self) -> int:
+        return self.actuator_state.stop
+
+    tau_cmd = slice(0, 3)
+    tau_applied = slice(3, 6)
+
+    @property
+    def law_diag(self) -> slice:
+        return _after(self.tau_applied, self.law.diag_size)
+
+    @property
+    def sensor_record(self) -> slice:
+        return _after(self.law_diag, self.sensor.record_size)
+
+    @property
+    def actuator_record(self) -> slice:
+        return _after(self.sensor_record, self.actuator.record_size)
+
+    @property
+    def record_size(self) -> int:
+        return self.actuator_record.stop
+
+    def channels(self) -> Iterator[tuple[Channel, slice]]:
+        """Each declared channel of the law and the stages with its record columns."""
+        for block, channels in ((self.law_diag, self.law.diagnostics),
+                                (self.sensor_record, self.sensor.records),
+                                (self.actuator_record, self.actuator.records)):  # fmt: skip
+            start = block.start
+            for channel in channels:
+                yield channel, slice(start, start + channel.size)
+                start += channel.size
+
+    def __post_init__(self) -> None:
+        names = [c.name for c, _ in self.channels()]
+        clash = {n for n in names if names.count(n) > 1} | (set(names) & set(_LOOP_COLUMNS))
+        if clash:
+            raise ValueError(f"recorded channels named twice: {', '.join(sorted(clash))}")
+
+
+def _after(previous: slice, size: int) -> slice:
+    return slice(previous.stop, previous.stop + size)

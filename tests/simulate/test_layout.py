@@ -1,0 +1,49 @@
+"""The loop layout: every piece of a closed loop's state and records has its own place."""
+
+from __future__ import annotations
+
+import dataclasses
+import itertools
+
+import pytest
+
+from flexsat.control.laws import get_law
+from flexsat.control.registry import Channel
+from flexsat.control.stages import ACTUATORS, SENSORS
+from flexsat.simulate.layout import LoopLayout
+
+
+def _layout(law: str = "asmc", n_dof: int = 18) -> LoopLayout:
+    return LoopLayout(n_dof, get_law(law), SENSORS.get("ideal"), ACTUATORS.get("static"))
+
+
+def test_plant_state_offsets():
+    layout = _layout()
+    assert (layout.q, layout.qd) == (slice(0, 18), slice(18, 36))
+    assert (layout.work, layout.dissipated, layout.x_size) == (36, 37, 38)
+
+
+def test_record_columns_follow_each_other_without_gaps():
+    layout = _layout()
+    # tau_cmd (3), tau_applied (3), then the ASMC's 16 diagnostics
+    assert layout.law_diag == slice(6, 22)
+    assert layout.record_size == 22 and layout.state_size == 2
+    columns = [columns for _, columns in layout.channels()]
+    assert columns[0].start == 6 and columns[-1].stop == 22
+    assert all(a.stop == b.start for a, b in itertools.pairwise(columns))
+
+
+def test_stage_records_come_after_the_law_diagnostics():
+    actuator = dataclasses.replace(
+        ACTUATORS.get("static"), state_size=4, records=(Channel("extra", "N m", "", True),)
+    )
+    layout = LoopLayout(18, get_law("pd"), SENSORS.get("ideal"), actuator)
+    assert layout.law_diag == slice(6, 12)  # the PD's tau_gyro and tau_guide
+    assert layout.actuator_record == slice(12, 15)
+    assert layout.actuator_state == slice(0, 4)  # the PD and the ideal sensor keep none
+
+
+def test_a_channel_named_twice_is_refused():
+    law = dataclasses.replace(get_law("pd"), diagnostics=(Channel("tau_cmd", "N m", ""),))
+    with pytest.raises(ValueError, match="named twice: tau_cmd"):
+        LoopLayout(18, law, SENSORS.get("ideal"), ACTUATORS.get("static"))
