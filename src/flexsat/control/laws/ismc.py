@@ -51,8 +51,8 @@ class ISMCConfig(LawConfig):
 
     kind: Literal["ismc"] = "ismc"
     jk_nm: Positive = Field(0.8925, description="robust torque JK = D_max + eta [N m]")
-    lambda_: Positive = Field(0.45, alias="lambda", description="surface slope [rad/s]")
-    k_i: Positive = Field(0.025, description="integral gain of the surface [1/s^2]")
+    lambda_: Positive = Field(0.6, alias="lambda", description="surface slope [rad/s]")
+    k_i: Positive = Field(0.045, description="integral gain of the surface [1/s^2]")
     phi: Positive = Field(0.01, description="boundary-layer width Phi [rad/s]")
 
     def gains(self, actuator) -> np.ndarray:

@@ -74,7 +74,7 @@ class STSMCConfig(LawConfig):
     """Super-twisting sliding mode on s = omega_e + lambda q_v,e ([Nad+19])."""
 
     kind: Literal["stsmc"] = "stsmc"
-    lambda_: Positive = Field(0.3, alias="lambda", description="surface slope [rad/s]")
+    lambda_: Positive = Field(0.5, alias="lambda", description="surface slope [rad/s]")
     d_max_nm: Positive = Field(0.85, description="disturbance bound D_max [N m] (eq. 5.6)")
     disturbance_hz: Positive = Field(
         0.52, description="disturbance frequency f_d: |d_dot| <= 2 pi f_d D_max [Hz]"
