@@ -11,6 +11,7 @@ import subprocess
 import sys
 
 import numpy as np
+import pandas as pd
 import pytest
 
 from flexsat import nominal
@@ -83,3 +84,18 @@ def test_law_meets_r1_r2_r3_in_the_sensitivity_campaign(tmp_path, kind):
         1.0, 1.0, 1.0,
     )  # fmt: skip
     assert np.isfinite(summary["worst_final_pointing_error_deg"])
+
+
+def test_stsmc_meets_r2_after_the_deployment_shock(tmp_path):
+    # Thesis section 5.3: the ASMC never meets R2 within 120 s after the shock (here
+    # 24 of 32 cases by the last sample, R2 held from 45.5-120 s). The STSMC holds R2
+    # from 40.6-44.3 s in all 32 (measured); bound 60 s, a third of margin.
+    data = load_campaign("deployment-shock").model_dump(mode="json")
+    data["base"] = {**data["base"], "controller": {"kind": "stsmc"}}
+    definition = validate_config(data, source="stsmc", model=CampaignDefinition)
+    stored = run_campaign(definition, nominal(), tmp_path, workers=2, progress=False)
+    summary = summarize(tmp_path)
+    assert summary["cases"] == 32 and summary["failed"] == 0
+    assert summary["r1_pass_rate"] == summary["r2_pass_rate"] == summary["r3_pass_rate"] == 1.0
+    rows = pd.read_parquet(stored["parquet"])
+    assert rows["metrics.r2_settling_time_s"].max() < 60.0
