@@ -140,6 +140,12 @@ def _sgn(x):
     return 1.0 if x > 0.0 else (-1.0 if x < 0.0 else 0.0)
 
 
+@njit(cache=True)
+def _twist(k1, s):
+    """-k1 |s|^(1/2) sgn(s), the continuous term of the super-twisting algorithm."""
+    return -k1 * sqrt(abs(s)) * _sgn(s)
+
+
 @njit(LAW_SIGNATURE, cache=True)
 def stsmc_step(q_d, omega_d, omega_dot_d, q, omega_B, J, gains, state, t, dt, tau_cmd, diag):
     """The STSMC command (law contract in :mod:`flexsat.control.laws.registry`).
@@ -155,12 +161,11 @@ def stsmc_step(q_d, omega_d, omega_dot_d, q, omega_B, J, gains, state, t, dt, ta
     s = (omega_e[0] + lam * qv[0], omega_e[1] + lam * qv[1], omega_e[2] + lam * qv[2])
     tau_guide = (-lam * J_qv_dot[0], -lam * J_qv_dot[1], -lam * J_qv_dot[2])
     rows = _inverse_row_sums(J)
-    twist = [0.0, 0.0, 0.0]
-    for a in range(3):
-        rate = gains[G.d_rate] * rows[a]  # L_i
-        twist[a] = -gains[G.c1] * sqrt(rate) * sqrt(abs(s[a])) * _sgn(s[a])  # -k1 |s|^1/2 sgn s
+    c1_root_L = gains[G.c1] * sqrt(gains[G.d_rate])  # k1_i = c1 sqrt(L) sqrt(rows_i)
     v = (state[0], state[1], state[2])
-    u = (twist[0] + v[0], twist[1] + v[1], twist[2] + v[2])
+    u = (_twist(c1_root_L * sqrt(rows[0]), s[0]) + v[0],
+         _twist(c1_root_L * sqrt(rows[1]), s[1]) + v[1],
+         _twist(c1_root_L * sqrt(rows[2]), s[2]) + v[2])  # fmt: skip
     tau_rob = mv(J3, u)
     tau_int = mv(J3, v)
     clip_and_store(limit, tau_gyro, tau_guide, tau_rob, tau_cmd)
