@@ -1,7 +1,9 @@
 """Control laws: one module each, found through one registry.
 
 Built in: the thesis's ASMC (:mod:`~flexsat.control.laws.asmc`), the classical SMC
-and the quaternion PD it is compared with. Write your own law in your own file
+and the quaternion PD it is compared with, and the super-twisting and integral
+sliding modes the thesis proposes beyond it (:mod:`~flexsat.control.laws.stsmc`,
+:mod:`~flexsat.control.laws.ismc`). Write your own law in your own file
 (see ``docs/control.md``): a parameter model, a compiled step of
 :data:`LAW_SIGNATURE` and one :func:`register_law` line; it then runs inside the
 compiled loop, from the scenario TOML and from ``--controller``.
@@ -12,6 +14,7 @@ from __future__ import annotations
 import numpy as np
 
 from flexsat.control.laws.asmc import ASMC
+from flexsat.control.laws.ismc import ISMC
 from flexsat.control.laws.pd import PD
 from flexsat.control.laws.registry import (
     LAW_SIGNATURE,
@@ -24,6 +27,7 @@ from flexsat.control.laws.registry import (
     validate_law_config,
 )
 from flexsat.control.laws.smc import SMC
+from flexsat.control.laws.stsmc import STSMC
 from flexsat.control.registry import channel_columns
 
 __all__ = [
@@ -41,6 +45,8 @@ __all__ = [
 register_law(ASMC, default=True)
 register_law(SMC)
 register_law(PD)
+register_law(STSMC)
+register_law(ISMC)
 
 
 class CompiledLaw:
