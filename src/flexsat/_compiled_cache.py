@@ -14,12 +14,21 @@ from __future__ import annotations
 
 import hashlib
 import os
+import warnings
 from pathlib import Path
+
+from numba.core.errors import NumbaExperimentalFeatureWarning
 
 __all__ = ["COMPILED_MODULES", "drop_stale_caches"]
 
+# Pluggable compiled pieces (appendage kernels) reach the loops as numba first-class
+# functions, which numba flags as experimental on every use; the feature is relied
+# on deliberately (typed by signature, cached), so that one warning is silenced here.
+warnings.filterwarnings("ignore", category=NumbaExperimentalFeatureWarning)
+
 COMPILED_MODULES = (
     "dynamics/linalg3.py",
+    "dynamics/appendages/plate.py",
     "dynamics/kernels.py",
     "dynamics/integrators.py",
     "dynamics/records.py",

@@ -13,16 +13,28 @@ the appendage root), panel frame P_i (moves with the appendage); see
 
 from __future__ import annotations
 
-from typing import Annotated, Literal
+from typing import Annotated, Any, Literal
 
 import numpy as np
-from pydantic import AllowInfNan, BaseModel, ConfigDict, Field, Strict, model_validator
+from pydantic import (
+    AllowInfNan,
+    BaseModel,
+    ConfigDict,
+    Field,
+    SerializeAsAny,
+    Strict,
+    ValidatorFunctionWrapHandler,
+    WrapValidator,
+    model_validator,
+)
 
 __all__ = [
+    "APPENDAGE_CONFIGS",
     "AppendageConfig",
     "HubConfig",
     "SatelliteConfig",
     "TargetFrequencies",
+    "register_appendage_config",
 ]
 
 # A real number: ints are accepted, strings and booleans are not, NaN and inf are not.
@@ -137,6 +149,7 @@ class AppendageConfig(_Frozen):
     """
 
     name: Annotated[str, Field(min_length=1, max_length=64)]
+    model: Literal["plate"] = Field("plate", description="appendage model (registry key)")
     mount_point_m: Vector3 = Field(description="root position from hub centre of mass, frame B [m]")
     mount_yaw_deg: Angle = Field(0.0, description="mount frame rotation about Z_B [deg]")
     sadm_angle_deg: Angle = Field(0.0, description="SADM angle about Y_M [deg]")
@@ -185,12 +198,43 @@ class AppendageConfig(_Frozen):
         return 1.0 if self.span_direction == "+y" else -1.0
 
 
+APPENDAGE_CONFIGS: dict[str, type[BaseModel]] = {"plate": AppendageConfig}
+"""Config class of each appendage model, by its ``model`` key (the registry of
+:mod:`flexsat.dynamics.appendages` adds to it)."""
+
+
+def register_appendage_config(model: str, config_class: type[BaseModel]) -> None:
+    """Accept ``model = "<model>"`` appendage tables, validated as ``config_class``."""
+    fields = config_class.model_fields
+    if "name" not in fields or "model" not in fields:
+        raise TypeError(f"{config_class.__name__} needs the fields 'name' and 'model'")
+    APPENDAGE_CONFIGS[model] = config_class
+
+
+def _by_model(value: Any, handler: ValidatorFunctionWrapHandler) -> Any:
+    """Validate an appendage table with the config class its ``model`` key names."""
+    if isinstance(value, BaseModel):
+        return value if type(value) in APPENDAGE_CONFIGS.values() else handler(value)
+    model = value.get("model", "plate") if isinstance(value, dict) else "plate"
+    if model == "plate":
+        return handler(value)
+    if model not in APPENDAGE_CONFIGS:
+        raise ValueError(
+            f"model: unknown appendage model {model!r} (allowed: {', '.join(APPENDAGE_CONFIGS)})"
+        )
+    return APPENDAGE_CONFIGS[model].model_validate(value)
+
+
+# An appendage table: the plate's by default, else the config class of its model.
+Appendage = SerializeAsAny[Annotated[AppendageConfig, WrapValidator(_by_model)]]
+
+
 class SatelliteConfig(_Frozen):
-    """A hub and its list of flexible appendages."""
+    """A hub and its list of appendages (each validated by its model's config class)."""
 
     name: Annotated[str, Field(min_length=1, max_length=128)] = "satellite"
     hub: HubConfig
-    appendages: Annotated[list[AppendageConfig], Field(min_length=1, max_length=64)]
+    appendages: Annotated[list[Appendage], Field(min_length=1, max_length=64)]
 
     @model_validator(mode="after")
     def _unique_names(self) -> SatelliteConfig:

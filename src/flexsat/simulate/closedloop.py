@@ -159,7 +159,7 @@ def _compiled_loop(plant, scenario, x, kind, gains, J, q_d, dist, memory, held, 
         final = done + n_chunk == steps
         status, ran, written = rk4_closed_loop(
             x, done * scenario.dt_s, scenario.dt_s, n_chunk, final, control, every, kind,
-            gains, J, q_d, dist, memory, held, plant.dynamics_args, rec_t, rec_x, rec_ctrl, rows,
+            gains, J, q_d, dist, memory, held, plant.packed, rec_t, rec_x, rec_ctrl, rows,
         )  # fmt: skip
         done += ran
         rows += written
@@ -198,7 +198,7 @@ def _python_loop(plant, scenario, x, kind, gains, J, q_d, dist, memory, held, re
         if k == steps:
             return 0, k, rows
         status, ran = rk4_hold(x, scenario.dt_s, block, (held[3], held[4], held[5]),
-                               plant.dynamics_args)  # fmt: skip
+                               plant.packed)  # fmt: skip
         k += ran
         if status:
             return status, k, rows

@@ -43,19 +43,17 @@ def initial_state(plant: Plant, scenario: OpenLoopScenario) -> tuple[np.ndarray,
     q[3:6] = np.radians(init.attitude_deg)
     omega_B = np.radians(init.rate_deg_s)
     qd[3:6] = np.array(euler_rate_matrix_inv(q[3], q[4])) @ omega_B  # Theta_dot = S^-1 omega
-    names = [a.name for a in plant.config.appendages]
-    for app in init.appendages:
-        if app.name not in names:
-            raise ConfigError(
-                f"initial.appendages: unknown appendage {app.name!r} (the satellite has "
-                f"{', '.join(names)})"
-            )
-        o = 6 + 6 * names.index(app.name)
-        q[o : o + 3] = app.eta_m
-        q[o + 3 : o + 6] = np.radians(app.rho_deg)
-        qd[o : o + 3] = app.eta_rate_m_s
-        # Relative rate given as ZYX angle rates [deg/s].
-        qd[o + 3 : o + 6] = np.radians(app.rho_rate_deg_s)
+    configs = {a.name: (a, m) for a, m in zip(plant.config.appendages, plant.models, strict=True)}
+    for entry in init.appendages:
+        try:
+            block = plant.layout.block(entry.name)
+        except KeyError as exc:
+            raise ConfigError(f"initial.appendages: {exc.args[0]}") from None
+        config, model = configs[entry.name]
+        try:
+            q[block.slice], qd[block.slice] = model.initial_state(config, entry)
+        except ValueError as exc:
+            raise ConfigError(str(exc)) from None
     return q, qd
 
 
@@ -126,7 +124,7 @@ def _run_rk4(plant, scenario, q0, qd0, profile, progress):
         while done < n_steps and status == 0:
             steps = min(chunk, n_steps - done)
             status, ran = rk4_open_loop(
-                x, done * dt, dt, steps, every, *profile, plant.dynamics_args,
+                x, done * dt, dt, steps, every, *profile, plant.packed,
                 rec_t, rec_x, rec_tau, done // every + 1,
             )  # fmt: skip
             done += ran
@@ -164,7 +162,7 @@ def _run_dop853(plant, scenario, q0, qd0, profile):
             nonlocal evaluations
             evaluations += 1
             dy = np.empty_like(y)
-            if augmented_derivative(y, torque, n, Q, dy, plant.dynamics_args) != 0:
+            if augmented_derivative(y, torque, n, Q, dy, plant.packed) != 0:
                 raise SimulationError(f"singular kinematics at t = {t:.6g} s")
             return dy
 
