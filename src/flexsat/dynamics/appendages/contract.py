@@ -30,6 +30,7 @@ per member its appendage index and the offset of its first coordinate in q;
 from __future__ import annotations
 
 from abc import ABC, abstractmethod
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any, ClassVar, NamedTuple
 
@@ -163,12 +164,17 @@ class AppendageModel(ABC):
     transmits_inertia : bool
         False for a model on a full 6-DOF joint (the engine then skips the 6 x 6
         hub solve); True when ``pass1`` adds an articulated inertia.
+    modifiers : dict
+        Derived campaign modifier paths beyond the config's own fields: name ->
+        function(table, value) that changes the appendage's plain-dict table in place
+        (``appendages[*].<name>``).
     """
 
     name: ClassVar[str]
     config_class: ClassVar[type[BaseModel]]
     kernels: ClassVar[AppendageKernels]
     transmits_inertia: ClassVar[bool] = False
+    modifiers: ClassVar[dict[str, Callable[[dict, float], None]]] = {}
 
     @abstractmethod
     def coordinates(self, config: BaseModel) -> tuple[Coordinate, ...]:
@@ -211,6 +217,31 @@ class AppendageModel(ABC):
             f"initial.appendages: {config.name!r} is a {self.name!r} appendage, which has "
             "no initial state to set"
         )
+
+    def describe(self, config: BaseModel, params: np.ndarray) -> dict:
+        """Derived properties for reports and ``flexsat config`` (JSON-ready). Default:
+        the rigid body's mass [kg] and inertia about its centre of mass in B [kg m^2]."""
+        body = self.rigid_body(params)
+        return {"mass_kg": body.mass, "inertia_B_kg_m2": body.J_B.tolist()}
+
+    def shape_points(self, config: BaseModel, params: np.ndarray, q_block: np.ndarray
+                     ) -> np.ndarray:  # fmt: skip
+        """Drawable points at coordinates ``q_block`` (count,), hub frame B [m], shape (6, 3).
+
+        Rows 0-3: a closed quadrilateral outline; row 4: its root (where the arm from
+        the hub surface ends); row 5: its tip. Default: all at its undeformed centre
+        of mass (a rigid body drawn as a point).
+        """
+        return np.tile(self.rigid_body(params).r_B, (6, 1))
+
+    def extent(self, config: BaseModel) -> float:
+        """Characteristic length [m] that plots relate tip motion to; 0: none."""
+        return 0.0
+
+    def mode_kinds(self, config: BaseModel) -> tuple[str, ...]:
+        """A label per coordinate for modal classification: a mode is of the kind whose
+        coordinates hold most of its strain energy. Default: the coordinate names."""
+        return tuple(c.name for c in self.coordinates(config))
 
     def root_motion(self, q_block: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Root translation eta [m] and rotation rho [rad] of its joint, each (m, 3),

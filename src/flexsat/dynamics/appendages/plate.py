@@ -23,6 +23,7 @@ against ``MIN_COS`` before any ``euler_rate_matrix_inv``.
 from __future__ import annotations
 
 from math import cos
+from typing import ClassVar
 
 import numpy as np
 from numba import njit
@@ -76,6 +77,7 @@ from flexsat.dynamics.linalg3 import (
     transpose,
 )
 from flexsat.dynamics.status import STATUS_JOINT_GIMBAL_LOCK, STATUS_OK
+from flexsat.dynamics.tuning import tune_joints
 
 __all__ = ["JOINT_DOFS", "PlateModel"]
 
@@ -363,6 +365,13 @@ def tips(q, members, params, out):
         out[i, 0], out[i, 1], out[i, 2] = moved
 
 
+def _scale_mass(table: dict, factor: float) -> None:
+    """Campaign path ``appendages[*].inertia``: scale the panel mass and so its inertia
+    (the joints are re-tuned to keep their target frequencies, as the thesis does)."""
+    field = "mass_kg" if table.get("mass_kg") is not None else "surface_density_kg_m2"
+    table[field] = table[field] * factor
+
+
 class PlateModel(AppendageModel):
     """The thesis plate (:class:`flexsat.config.models.AppendageConfig`) on its 6-DOF root joint."""
 
@@ -370,6 +379,7 @@ class PlateModel(AppendageModel):
     config_class = AppendageConfig
     kernels = AppendageKernels(pass1, pass2, mass_matrix, bias_forces, observe, joint_wrench, tips)
     transmits_inertia = False
+    modifiers: ClassVar[dict] = {"inertia": _scale_mass}
 
     def coordinates(self, config: AppendageConfig) -> tuple[Coordinate, ...]:
         return tuple(Coordinate(n, u) for n, u in zip(JOINT_DOFS, _UNITS, strict=True))
@@ -391,10 +401,9 @@ class PlateModel(AppendageModel):
 
     def tune(self, config: AppendageConfig, params: np.ndarray, inertia_diag: np.ndarray
              ) -> np.ndarray:  # fmt: skip
-        # J_eq,j = diag M(0) of joint DOF j: the clamped-root inertia of that DOF alone.
-        omega_n = 2.0 * np.pi * config.target_frequencies_hz.per_dof()
-        stiffness = inertia_diag * omega_n**2  # eq. 2.14
-        damping = 2.0 * config.damping_ratio * omega_n * inertia_diag  # eq. 2.15
+        stiffness, damping = tune_joints(
+            inertia_diag, config.target_frequencies_hz.per_dof(), config.damping_ratio
+        )  # eqs. 2.14-2.15
         return self.with_joints(params, stiffness, damping)
 
     def stiffness(self, params: np.ndarray) -> np.ndarray:
@@ -421,6 +430,33 @@ class PlateModel(AppendageModel):
         # Relative rate given as ZYX angle rates [deg/s].
         qd = np.concatenate([entry.eta_rate_m_s, np.radians(entry.rho_rate_deg_s)])
         return q, qd
+
+    def describe(self, config: AppendageConfig, params: np.ndarray) -> dict:
+        return {
+            "mass_kg": float(params[P_MASS]),
+            "centroidal_inertia_kg_m2": params[P_J : P_J + 9].reshape(3, 3).tolist(),
+            "stiffness": self.stiffness(params).tolist(),
+            "damping": self.damping(params).tolist(),
+        }
+
+    def shape_points(self, config: AppendageConfig, params: np.ndarray, q_block: np.ndarray
+                     ) -> np.ndarray:  # fmt: skip
+        # x_B = r_m + R_BM (eta + R_MP x_P) for the corners, the root and the tip, with
+        # the corners spanning 0..L along +-Y_P and -W/2..W/2 along X_P (mid-plane).
+        w2, span = 0.5 * config.width_m, config.span_sign() * config.length_m
+        local = np.zeros((6, 3))
+        local[0:4, 0] = (-w2, w2, w2, -w2)
+        local[0:4, 1] = (0.0, 0.0, span, span)
+        local[5] = self.tip_point(params)
+        R_MP = Rotation.from_euler("ZYX", q_block[5:2:-1]).as_matrix()
+        in_mount = q_block[:3] + local @ R_MP.T
+        return params[P_MOUNT : P_MOUNT + 3] + in_mount @ self.mount_rotation(params).T
+
+    def extent(self, config: AppendageConfig) -> float:
+        return float(config.length_m)
+
+    def mode_kinds(self, config: AppendageConfig) -> tuple[str, ...]:
+        return ("translation", "translation", "translation", "flapping", "torsion", "in_plane")
 
     def root_motion(self, q_block: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         return q_block[:, :3], q_block[:, 3:]
@@ -452,6 +488,11 @@ class PlateModel(AppendageModel):
     def mount_rotation(params: np.ndarray) -> np.ndarray:
         """R_BM of a packed row, shape (3, 3)."""
         return params[P_R_BM : P_R_BM + 9].reshape(3, 3)
+
+    @staticmethod
+    def mount_point(params: np.ndarray) -> np.ndarray:
+        """r_m, the root position in B of a packed row, shape (3,) [m]."""
+        return params[P_MOUNT : P_MOUNT + 3]
 
     @staticmethod
     def tip_point(params: np.ndarray) -> np.ndarray:
