@@ -94,7 +94,7 @@ def run_openloop(
     else:
         t, X, tau, status, t_fail, steps = _run_dop853(plant, scenario, q0, qd0, profile)
     wall = time.perf_counter() - start
-    n = plant.n_dof
+    lay = plant.layout
     seg_start, seg_end, seg_torque, _ = profile
     tau_cmd = np.array(
         [applied_torque(tk, seg_start, seg_end, seg_torque, np.zeros(3)) for tk in t]
@@ -102,17 +102,17 @@ def run_openloop(
     attrs = run_attributes(plant, scenario, "open-loop", status, t_fail, wall, steps)
     attrs["solver"] = scenario.solver
     dataset = build_dataset(
-        plant, t, X[:, :n], X[:, n : 2 * n], X[:, 2 * n], X[:, 2 * n + 1], tau_cmd, tau, attrs
-    )
+        plant, t, X[:, lay.q], X[:, lay.qd], X[:, lay.work_in], X[:, lay.dissipated], tau_cmd,
+        tau, attrs,
+    )  # fmt: skip
     return Result(dataset)
 
 
 def _run_rk4(plant, scenario, q0, qd0, profile, progress):
-    n = plant.n_dof
     n_steps, every, dt = scenario.n_steps, scenario.record_every, scenario.dt_s
     n_records = n_steps // every + 1
     rec_t = np.empty(n_records)
-    rec_x = np.empty((n_records, 2 * n + 2))
+    rec_x = np.empty((n_records, plant.layout.size))
     rec_tau = np.empty((n_records, 3))
     x = np.concatenate([q0, qd0, [0.0, 0.0]])
     rec_t[0], rec_x[0] = 0.0, x
