@@ -328,3 +328,34 @@ def test_an_initial_state_for_a_model_without_coordinates_is_refused(with_mass):
     )
     with pytest.raises(ConfigError, match="'ballast' is a 'point_mass' appendage"):
         run_openloop(with_mass, scenario)
+
+
+def test_consumers_ask_the_model(with_mass):
+    # Geometry, modal analysis, the mirror operator, derived properties and campaign
+    # modifiers take the mixed plant without assuming six coordinates per appendage.
+    from flexsat.analysis.modal import modal_analysis
+    from flexsat.campaigns.modifiers import Modifier, apply_modifiers
+    from flexsat.dynamics.symmetry import mirror_operator
+    from flexsat.plots.geometry import satellite_geometry
+    from flexsat.study.outputs import derived_properties
+
+    g = satellite_geometry(with_mass)
+    np.testing.assert_allclose(g.tips[2], POSITION, atol=1e-12)  # drawn as a point
+    modes = modal_analysis(with_mass)
+    assert len(modes.modes) == with_mass.n_dof
+    assert mirror_operator(with_mass) is None  # the ballast has no mirror image
+    described = derived_properties(with_mass)["appendages"][2]
+    assert described["model"] == "point_mass" and described["mass_kg"] == MASS
+    realised: dict = {}
+    data = apply_modifiers(
+        _with_mass(),
+        [Modifier(path="appendages[2].mass_kg", op="scale", value=2.0),
+         Modifier(path="appendages[0].inertia", op="scale", value=1.5)],
+        np.random.default_rng(0), realised,
+    )  # fmt: skip
+    assert data["appendages"][2]["mass_kg"] == 2 * MASS
+    assert data["appendages"][0]["surface_density_kg_m2"] == 1.5  # the plate's derived path
+    assert set(realised) == {"appendages[2].mass_kg", "appendages[0].inertia"}
+    with pytest.raises(KeyError, match="inertia"):
+        apply_modifiers(_with_mass(), [Modifier(path="appendages[2].inertia", value=2.0)],
+                        np.random.default_rng(0), {})  # fmt: skip
