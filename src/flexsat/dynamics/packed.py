@@ -13,8 +13,11 @@ from __future__ import annotations
 from typing import NamedTuple
 
 import numpy as np
+from numba import types
+from numba.core.typing.typeof import typeof_impl
+from numba.experimental.function_type import _get_wrapper_address
 
-__all__ = ["PackedPlant"]
+__all__ = ["FirstClassKernel", "PackedPlant", "first_class"]
 
 
 class PackedPlant(NamedTuple):
@@ -60,3 +63,58 @@ class PackedPlant(NamedTuple):
     observe: tuple
     joint_wrench: tuple
     tips: tuple
+
+
+_TYPES: dict[int, object] = {}
+
+
+@typeof_impl.register(PackedPlant)
+def _typeof_packed(value: PackedPlant, context) -> object:
+    """numba type of a PackedPlant, computed once per number of groups.
+
+    numba's generic typing of a named tuple types every field on every call from
+    Python, which for tuples of first-class functions costs about 2 ms. The type
+    depends on the number of groups only (:meth:`flexsat.dynamics.plant.Plant._pack`
+    always builds the same dtypes and layouts, and every kernel has its contract
+    signature), so it is cached by that number.
+    """
+    groups = len(value.members)
+    if groups not in _TYPES:
+        _TYPES[groups] = typeof_impl.dispatch(tuple)(value, context)
+    return _TYPES[groups]
+
+
+class FirstClassKernel:
+    """A compiled kernel as numba passes it to compiled code: typed by its signature.
+
+    numba would type a dispatcher in a tuple the same way, but it looks the machine
+    code address up again on every call from Python (about 0.1 ms per function);
+    this object resolves it once (numba's wrapper-address protocol).
+    """
+
+    def __init__(self, dispatcher, signature) -> None:
+        self._numba_type_ = types.FunctionType(signature)
+        self._address = _get_wrapper_address(dispatcher, signature)
+        self.dispatcher = dispatcher
+
+    def __wrapper_address__(self) -> int:
+        return self._address
+
+    def __call__(self, *args):
+        return self.dispatcher(*args)
+
+
+_KERNELS: dict[tuple[int, str], FirstClassKernel] = {}
+
+
+def first_class(dispatcher, signature) -> FirstClassKernel:
+    """The :class:`FirstClassKernel` of a dispatcher compiled with ``signature`` (cached)."""
+    key = (id(dispatcher), str(signature))
+    if key not in _KERNELS:
+        if signature.args not in dispatcher.signatures:
+            raise TypeError(
+                f"{getattr(dispatcher, '__name__', dispatcher)!r} must be compiled with "
+                f"@njit({signature}, cache=True)"
+            )
+        _KERNELS[key] = FirstClassKernel(dispatcher, signature)
+    return _KERNELS[key]

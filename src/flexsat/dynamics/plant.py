@@ -26,11 +26,12 @@ from flexsat.dynamics.appendages.contract import (
     OBS_LOCKED_INERTIA,
     OBS_MOMENTUM,
     OBS_SIZE,
+    SIGNATURES,
 )
 from flexsat.dynamics.appendages.plate import JOINT_DOFS
 from flexsat.dynamics.layout import HUB_DOFS, StateLayout
 from flexsat.dynamics.linalg3 import euler_rate_matrix
-from flexsat.dynamics.packed import PackedPlant
+from flexsat.dynamics.packed import PackedPlant, first_class
 from flexsat.dynamics.status import STATUS_OK, status_message
 from flexsat.errors import SimulationError
 
@@ -126,8 +127,8 @@ class Plant:
             solve=np.zeros((6, 7)),
             members=tuple(members),
             params=tuple(params),
-            **{name: tuple(getattr(k, name) for k in kernel_sets)
-               for name in kernel_sets[0]._fields},
+            **{name: tuple(first_class(getattr(k, name), signature) for k in kernel_sets)
+               for name, signature in SIGNATURES._asdict().items()},
         )  # fmt: skip
 
     # -- sizes ----------------------------------------------------------------------------

@@ -59,6 +59,7 @@ __all__ = [
     "OBS_SIZE",
     "PASS1_SIGNATURE",
     "PASS2_SIGNATURE",
+    "SIGNATURES",
     "TIPS_SIGNATURE",
     "WRENCH_SIGNATURE",
     "AppendageKernels",
@@ -127,6 +128,13 @@ class AppendageKernels(NamedTuple):
     observe: Any
     joint_wrench: Any
     tips: Any
+
+
+SIGNATURES = AppendageKernels(
+    PASS1_SIGNATURE, PASS2_SIGNATURE, MASS_SIGNATURE, BIAS_SIGNATURE, OBSERVE_SIGNATURE,
+    WRENCH_SIGNATURE, TIPS_SIGNATURE,
+)  # fmt: skip
+"""The signature each kernel of :class:`AppendageKernels` must be compiled with."""
 
 
 @dataclass(frozen=True)
