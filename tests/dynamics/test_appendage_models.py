@@ -75,7 +75,7 @@ class PointMassConfig(BaseModel):
 
 
 @njit(PASS1_SIGNATURE, cache=True)
-def _pass1(q, qd, Q, members, params, hub, qdd):
+def _pass1(q, qd, Q, members, params, work, hub, qdd):
     # Its acceleration is a_hub + alpha x r + w x (w x r): the wrench on the hub at zero
     # hub acceleration is -m w x (w x r) at r, the articulated inertia
     # m [[I, -[r]x], [[r]x, -[r]x [r]x]].
@@ -98,7 +98,7 @@ def _pass1(q, qd, Q, members, params, hub, qdd):
 
 
 @njit(PASS2_SIGNATURE, cache=True)
-def _pass2(q, qd, members, params, hub, qdd):
+def _pass2(q, qd, members, params, work, hub, qdd):
     return 0  # no coordinates
 
 

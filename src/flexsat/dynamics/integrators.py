@@ -43,7 +43,7 @@ def applied_torque(t, seg_start, seg_end, seg_torque, disturbance):
     return (tx, ty, tz)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def augmented_derivative(x, torque_B, n, Q, dx, packed):
     """dx/dt of the augmented state [q, q_dot, W_in, W_diss] under a body torque.
 

@@ -159,7 +159,9 @@ def accelerations(q, qd, Q, packed, qdd):
 
     # Pass 1: each appendage's wrench on the hub (and articulated inertia).
     for g in range(len(packed.pass1)):
-        status = packed.pass1[g](q, qd, Q, packed.members[g], packed.params[g], hub, qdd)
+        status = packed.pass1[g](
+            q, qd, Q, packed.members[g], packed.params[g], packed.work[g], hub, qdd
+        )
         if status != STATUS_OK:
             return status
 
@@ -182,7 +184,9 @@ def accelerations(q, qd, Q, packed, qdd):
 
     # Pass 2: each appendage's coordinate accelerations given the hub's.
     for g in range(len(packed.pass2)):
-        status = packed.pass2[g](q, qd, packed.members[g], packed.params[g], hub, qdd)
+        status = packed.pass2[g](
+            q, qd, packed.members[g], packed.params[g], packed.work[g], hub, qdd
+        )
         if status != STATUS_OK:
             return status
     return STATUS_OK

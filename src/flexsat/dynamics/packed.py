@@ -43,6 +43,8 @@ class PackedPlant(NamedTuple):
         Per group: appendage index and offset of its first coordinate in q.
     params : tuple of ndarray, shape (k_g, p_g)
         Per group: each member's packed parameter row.
+    work : tuple of ndarray, shape (k_g, w_g)
+        Per group: scratch rows pass 1 leaves for pass 2 (``work_size`` of the model).
     pass1, pass2, mass_matrix, bias_forces, observe, joint_wrench, tips : tuple
         Per group: the model's compiled kernels.
     """
@@ -56,6 +58,7 @@ class PackedPlant(NamedTuple):
     solve: np.ndarray
     members: tuple
     params: tuple
+    work: tuple
     pass1: tuple
     pass2: tuple
     mass_matrix: tuple

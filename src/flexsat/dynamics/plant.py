@@ -110,12 +110,13 @@ class Plant:
         groups: dict[str, list[int]] = {}
         for i, model in enumerate(self.models):
             groups.setdefault(model.name, []).append(i)
-        members, params, kernel_sets = [], [], []
+        members, params, kernel_sets, models = [], [], [], []
         for indices in groups.values():
             offsets = [self.layout.blocks[i].offset for i in indices]
             members.append(np.array([indices, offsets], dtype=np.int64).T.copy())
             params.append(np.ascontiguousarray(np.stack([self.params[i] for i in indices])))
             kernel_sets.append(self.models[indices[0]].kernels)
+            models.append(self.models[indices[0]])
         hub_J = np.ascontiguousarray(self.hub_J, dtype=float)
         return PackedPlant(
             n_dof=self.layout.n_dof,
@@ -127,6 +128,8 @@ class Plant:
             solve=np.zeros((6, 7)),
             members=tuple(members),
             params=tuple(params),
+            work=tuple(np.zeros((len(m), max(1, k.work_size)))
+                       for m, k in zip(members, models, strict=True)),
             **{name: tuple(first_class(getattr(k, name), signature) for k in kernel_sets)
                for name, signature in SIGNATURES._asdict().items()},
         )  # fmt: skip

@@ -91,14 +91,15 @@ _v = types.float64[::1]
 _m = types.float64[:, ::1]
 _i = types.int64[:, ::1]
 
-PASS1_SIGNATURE = types.int64(_v, _v, _v, _i, _m, _v, _v)
-"""``pass1(q, qd, Q, members, params, hub, qdd) -> status``: joint wrench on the hub
-(added to ``hub[HUB_FORCE]``, ``hub[HUB_TORQUE]``), articulated inertia (added to
+PASS1_SIGNATURE = types.int64(_v, _v, _v, _i, _m, _m, _v, _v)
+"""``pass1(q, qd, Q, members, params, work, hub, qdd) -> status``: joint wrench on the
+hub (added to ``hub[HUB_FORCE]``, ``hub[HUB_TORQUE]``), articulated inertia (added to
 ``hub[HUB_INERTIA]``), damper power (added to ``hub[HUB_DISSIPATION]``); may keep
-intermediate results in its own rows of ``qdd``."""
-PASS2_SIGNATURE = types.int64(_v, _v, _i, _m, _v, _v)
-"""``pass2(q, qd, members, params, hub, qdd) -> status``: the member's rows of q_ddot
-from ``hub[HUB_ACC]`` and ``hub[HUB_ALPHA]``."""
+intermediate results in its own rows of ``qdd`` and in ``work`` (k, work_size), its
+scratch for pass 2."""
+PASS2_SIGNATURE = types.int64(_v, _v, _i, _m, _m, _v, _v)
+"""``pass2(q, qd, members, params, work, hub, qdd) -> status``: the member's rows of
+q_ddot from ``hub[HUB_ACC]`` and ``hub[HUB_ALPHA]``."""
 MASS_SIGNATURE = types.void(_v, _i, _m, _m)
 """``mass_matrix(q, members, params, M)``: add the member's share of M(q) (eq. 2.39):
 its blocks and its share of the hub block."""
@@ -172,6 +173,8 @@ class AppendageModel(ABC):
     transmits_inertia : bool
         False for a model on a full 6-DOF joint (the engine then skips the 6 x 6
         hub solve); True when ``pass1`` adds an articulated inertia.
+    work_size : int
+        Columns of the scratch rows ``work`` that pass 1 may leave for pass 2.
     modifiers : dict
         Derived campaign modifier paths beyond the config's own fields: name ->
         function(table, value) that changes the appendage's plain-dict table in place
@@ -183,6 +186,7 @@ class AppendageModel(ABC):
     kernels: ClassVar[AppendageKernels]
     transmits_inertia: ClassVar[bool] = False
     modifiers: ClassVar[dict[str, Callable[[dict, float], None]]] = {}
+    work_size: ClassVar[int] = 0
 
     @abstractmethod
     def coordinates(self, config: BaseModel) -> tuple[Coordinate, ...]:

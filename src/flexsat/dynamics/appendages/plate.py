@@ -134,7 +134,8 @@ def _joint_wrench(q, qd, Q, o, p):
     By virtual work the 6 generalized forces on (eta, rho) are a force F_M at the
     root (mount frame) and a torque N_P (panel frame) on the panel, with the
     opposite pair on the hub: F_M = Q_eta, N_P = S(rho)^-T Q_rho.
-    Returns F_M, N_P and a status flag.
+    Returns F_M, N_P, S(rho)^-1 and a status flag (S(rho)^-1 is undefined on a
+    gimbal lock).
     """
     k, c = P_K, P_C
     Q_eta = (
@@ -148,9 +149,10 @@ def _joint_wrench(q, qd, Q, o, p):
         Q[o + 5] - p[k + 5] * q[o + 5] - p[c + 5] * qd[o + 5],
     )
     if abs(cos(q[o + 4])) < MIN_COS:
-        return Q_eta, Q_rho, STATUS_JOINT_GIMBAL_LOCK
-    N_P = mtv(euler_rate_matrix_inv(q[o + 3], q[o + 4]), Q_rho)
-    return Q_eta, N_P, STATUS_OK
+        undefined = ((0.0, 0.0, 0.0), (0.0, 0.0, 0.0), (0.0, 0.0, 0.0))
+        return Q_eta, Q_rho, undefined, STATUS_JOINT_GIMBAL_LOCK
+    S_inv = euler_rate_matrix_inv(q[o + 3], q[o + 4])
+    return Q_eta, mtv(S_inv, Q_rho), S_inv, STATUS_OK
 
 
 @njit(cache=True, error_model="numpy")
@@ -168,23 +170,50 @@ def _add_hub_wrench(out, f, r_P, R_BM, R_BP, F_M, N_P):
     return F_B
 
 
+# Scratch row that pass 1 leaves for pass 2 (terms that depend on q and q_dot only).
+W_R_BP = 0  # (9) R_BP, row-major
+W_R_G = 9  # (3) r_G [m], frame B
+W_OMEGA_REL = 12  # (3) omega_rel_P [rad/s]
+W_RDOT_G = 15  # (3) B-frame rate of r_G [m/s]
+W_S_INV = 18  # (9) S(rho)^-1, row-major
+W_RHO_BIAS = 27  # (3) S_dot(rho) rho_dot
+WORK_SIZE = 30
+
+
+@njit(cache=True, error_model="numpy")
+def _store(w, k, v):
+    w[k], w[k + 1], w[k + 2] = v
+
+
+@njit(cache=True, error_model="numpy")
+def _store_m33(w, k, m):
+    for a in range(3):
+        w[k + 3 * a], w[k + 3 * a + 1], w[k + 3 * a + 2] = m[a]
+
+
 @njit(PASS1_SIGNATURE, cache=True, error_model="numpy")
-def pass1(q, qd, Q, members, params, hub, qdd):
+def pass1(q, qd, Q, members, params, work, hub, qdd):
     """Joint wrenches -> panel absolute accelerations and the reaction on the hub.
 
     Writes the panel's absolute accelerations a_G (B) and alpha_P (P) into its rows
-    of ``qdd`` for :func:`pass2`.
+    of ``qdd`` and its pose and rate terms into its ``work`` row for :func:`pass2`.
     """
     omega_B = load_seg(hub, HUB_OMEGA)
+    force_B = load_seg(hub, HUB_FORCE)
+    torque_B = load_seg(hub, HUB_TORQUE)
+    dissipated = hub[HUB_DISSIPATION]
     for j in range(members.shape[0]):
         o = members[j, 1]
         p = params[j]
+        w = work[j]
         R_BM, R_MP, R_BP, S_rho, r_P, r_G = _pose(q, o, p)
-        omega_rel_P = mv(S_rho, load_seg(qd, o + 3))
-        F_M, N_P, status = _joint_wrench(q, qd, Q, o, p)
+        omega_rel_P, rdot_G_rel = _rates(qd, o, p, R_BM, R_BP, S_rho)
+        F_M, N_P, S_inv, status = _joint_wrench(q, qd, Q, o, p)
         if status != STATUS_OK:
             return status
-        F_B = _add_hub_wrench(hub, HUB_FORCE, r_P, R_BM, R_BP, F_M, N_P)
+        F_B = mv(R_BM, F_M)
+        force_B = sub(force_B, F_B)
+        torque_B = sub(sub(torque_B, cross(r_P, F_B)), mv(R_BP, N_P))
         # Panel Newton-Euler about its centre of mass G (the root force acts at -d from G).
         d = load_seg(p, P_COM)
         J_p = load_m33_at(p, P_J)
@@ -194,16 +223,23 @@ def pass1(q, qd, Q, members, params, hub, qdd):
         a_G = scale(1.0 / p[P_MASS], F_B)
         qdd[o], qdd[o + 1], qdd[o + 2] = a_G
         qdd[o + 3], qdd[o + 4], qdd[o + 5] = alpha_P
-        dissipated = hub[HUB_DISSIPATION]
         for k in range(6):
             v = qd[o + k]
             dissipated += p[P_C + k] * v * v  # q_dot^T C q_dot (eq. 2.36)
-        hub[HUB_DISSIPATION] = dissipated
+        _store_m33(w, W_R_BP, R_BP)
+        _store(w, W_R_G, r_G)
+        _store(w, W_OMEGA_REL, omega_rel_P)
+        _store(w, W_RDOT_G, rdot_G_rel)
+        _store_m33(w, W_S_INV, S_inv)
+        _store(w, W_RHO_BIAS, euler_rate_bias(q[o + 3], q[o + 4], qd[o + 3], qd[o + 4], qd[o + 5]))
+    hub[HUB_FORCE], hub[HUB_FORCE + 1], hub[HUB_FORCE + 2] = force_B
+    hub[HUB_TORQUE], hub[HUB_TORQUE + 1], hub[HUB_TORQUE + 2] = torque_B
+    hub[HUB_DISSIPATION] = dissipated
     return STATUS_OK
 
 
 @njit(PASS2_SIGNATURE, cache=True, error_model="numpy")
-def pass2(q, qd, members, params, hub, qdd):
+def pass2(q, qd, members, params, work, hub, qdd):
     """Relative accelerations of each joint from the absolute ones left by :func:`pass1`."""
     omega_B = load_seg(hub, HUB_OMEGA)
     a_hub_B = load_seg(hub, HUB_ACC)
@@ -211,15 +247,19 @@ def pass2(q, qd, members, params, hub, qdd):
     for j in range(members.shape[0]):
         o = members[j, 1]
         p = params[j]
-        R_BM, R_MP, R_BP, S_rho, r_P, r_G = _pose(q, o, p)
-        omega_rel_P, rdot_G_rel = _rates(qd, o, p, R_BM, R_BP, S_rho)
+        w = work[j]
+        R_BM = load_m33_at(p, P_R_BM)
+        R_BP = load_m33_at(w, W_R_BP)
+        r_G = load_seg(w, W_R_G)
+        omega_rel_P = load_seg(w, W_OMEGA_REL)
+        rdot_G_rel = load_seg(w, W_RDOT_G)
         a_G = load_seg(qdd, o)
         alpha_P = load_seg(qdd, o + 3)
         omega_dot_rel = add(
             sub(alpha_P, mtv(R_BP, omega_dot_B)), cross(omega_rel_P, mtv(R_BP, omega_B))
         )
-        rho_bias = euler_rate_bias(q[o + 3], q[o + 4], qd[o + 3], qd[o + 4], qd[o + 5])
-        rho_dd = mv(euler_rate_matrix_inv(q[o + 3], q[o + 4]), sub(omega_dot_rel, rho_bias))
+        rho_bias = load_seg(w, W_RHO_BIAS)
+        rho_dd = mv(load_m33_at(w, W_S_INV), sub(omega_dot_rel, rho_bias))
         d = load_seg(p, P_COM)
         a_rel_rot = mv(
             R_BP, add(cross(omega_dot_rel, d), cross(omega_rel_P, cross(omega_rel_P, d)))
@@ -346,7 +386,7 @@ def joint_wrench(q, qd, Q, members, params, out):
         o = members[j, 1]
         p = params[j]
         R_BM, R_MP, R_BP, S_rho, r_P, r_G = _pose(q, o, p)
-        F_M, N_P, status = _joint_wrench(q, qd, Q, o, p)
+        F_M, N_P, S_inv, status = _joint_wrench(q, qd, Q, o, p)
         if status != STATUS_OK:
             return status
         _add_hub_wrench(out, 0, r_P, R_BM, R_BP, F_M, N_P)
@@ -380,6 +420,7 @@ class PlateModel(AppendageModel):
     kernels = AppendageKernels(pass1, pass2, mass_matrix, bias_forces, observe, joint_wrench, tips)
     transmits_inertia = False
     modifiers: ClassVar[dict] = {"inertia": _scale_mass}
+    work_size = WORK_SIZE
 
     def coordinates(self, config: AppendageConfig) -> tuple[Coordinate, ...]:
         return tuple(Coordinate(n, u) for n, u in zip(JOINT_DOFS, _UNITS, strict=True))
