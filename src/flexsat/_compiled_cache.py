@@ -28,7 +28,10 @@ warnings.filterwarnings("ignore", category=NumbaExperimentalFeatureWarning)
 
 COMPILED_MODULES = (
     "dynamics/linalg3.py",
+    "dynamics/status.py",
+    "dynamics/appendages/contract.py",
     "dynamics/appendages/plate.py",
+    "dynamics/packed.py",
     "dynamics/kernels.py",
     "dynamics/integrators.py",
     "dynamics/records.py",
@@ -37,7 +40,8 @@ COMPILED_MODULES = (
     "control/laws.py",
     "simulate/loops.py",
 )
-"""Modules with ``@njit(cache=True)`` functions, relative to the package folder."""
+"""Modules with ``@njit(cache=True)`` functions, or whose constants and numba types
+compiled code depends on, relative to the package folder."""
 
 _STAMP = "compiled_sources.sha256"
 

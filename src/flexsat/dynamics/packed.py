@@ -14,8 +14,10 @@ from typing import NamedTuple
 
 import numpy as np
 from numba import types
+from numba.core.datamodel.models import TupleModel
 from numba.core.typing.typeof import typeof_impl
 from numba.experimental.function_type import _get_wrapper_address
+from numba.extending import register_model
 
 __all__ = ["FirstClassKernel", "PackedPlant", "first_class"]
 
@@ -68,22 +70,45 @@ class PackedPlant(NamedTuple):
     tips: tuple
 
 
-_TYPES: dict[int, object] = {}
+class PackedPlantType(types.NamedTuple):
+    """numba type of a :class:`PackedPlant`: a named tuple whose hash is computed once.
+
+    numba hashes an argument's type on every call from Python; for this deeply nested
+    type (tuples of first-class function types) that alone would cost tens of
+    microseconds per call.
+    """
+
+    def __hash__(self) -> int:
+        cached = self.__dict__.get("_hash")
+        if cached is None:
+            cached = self.__dict__["_hash"] = hash(self.key)
+        return cached
+
+    def __reduce__(self):
+        # The cached hash is per process (it hashes class objects): never pickle it.
+        rebuild, (reconstructor, args, state) = super().__reduce__()
+        state = {k: v for k, v in (state or {}).items() if k != "_hash"}
+        return rebuild, (reconstructor, args, state)
+
+
+register_model(PackedPlantType)(TupleModel)
+
+_TYPES: dict[int, PackedPlantType] = {}
 
 
 @typeof_impl.register(PackedPlant)
-def _typeof_packed(value: PackedPlant, context) -> object:
+def _typeof_packed(value: PackedPlant, context) -> PackedPlantType:
     """numba type of a PackedPlant, computed once per number of groups.
 
-    numba's generic typing of a named tuple types every field on every call from
-    Python, which for tuples of first-class functions costs about 2 ms. The type
-    depends on the number of groups only (:meth:`flexsat.dynamics.plant.Plant._pack`
-    always builds the same dtypes and layouts, and every kernel has its contract
-    signature), so it is cached by that number.
+    The type depends on the number of groups only
+    (:meth:`flexsat.dynamics.plant.Plant._pack` always builds the same dtypes and
+    layouts, and every kernel has its contract signature), so it is cached by that
+    number instead of typing every field on every call.
     """
     groups = len(value.members)
     if groups not in _TYPES:
-        _TYPES[groups] = typeof_impl.dispatch(tuple)(value, context)
+        generic = typeof_impl.dispatch(tuple)(value, context)
+        _TYPES[groups] = PackedPlantType(generic.types, PackedPlant)
     return _TYPES[groups]
 
 
