@@ -19,7 +19,7 @@ from numba.core.typing.typeof import typeof_impl
 from numba.experimental.function_type import _get_wrapper_address
 from numba.extending import register_model
 
-__all__ = ["FirstClassKernel", "PackedPlant", "first_class"]
+__all__ = ["FirstClassKernel", "PackedPlant", "first_class", "only"]
 
 
 class PackedPlant(NamedTuple):
@@ -93,23 +93,34 @@ class PackedPlantType(types.NamedTuple):
 
 register_model(PackedPlantType)(TupleModel)
 
-_TYPES: dict[int, PackedPlantType] = {}
+_KERNEL_FIELDS = ("pass1", "pass2", "mass_matrix", "bias_forces", "observe", "joint_wrench",
+                  "tips")  # fmt: skip
+_TYPES: dict[tuple[int, ...], PackedPlantType] = {}
+
+
+def only(packed: PackedPlant, *kernels: str) -> PackedPlant:
+    """``packed`` with only the named kernel tuples kept (the others empty).
+
+    A call from Python unboxes every first-class function it is given (a few
+    microseconds each); a single-kernel evaluation such as M(q) passes only its own.
+    """
+    return packed._replace(**{name: () for name in _KERNEL_FIELDS if name not in kernels})
 
 
 @typeof_impl.register(PackedPlant)
 def _typeof_packed(value: PackedPlant, context) -> PackedPlantType:
     """numba type of a PackedPlant, computed once per number of groups.
 
-    The type depends on the number of groups only
+    The type depends on the number of groups and of kernels in each tuple only
     (:meth:`flexsat.dynamics.plant.Plant._pack` always builds the same dtypes and
-    layouts, and every kernel has its contract signature), so it is cached by that
-    number instead of typing every field on every call.
+    layouts, and every kernel has its contract signature), so it is cached by those
+    numbers instead of typing every field on every call.
     """
-    groups = len(value.members)
-    if groups not in _TYPES:
+    shape = (*(len(getattr(value, name)) for name in _KERNEL_FIELDS), len(value.members))
+    if shape not in _TYPES:
         generic = typeof_impl.dispatch(tuple)(value, context)
-        _TYPES[groups] = PackedPlantType(generic.types, PackedPlant)
-    return _TYPES[groups]
+        _TYPES[shape] = PackedPlantType(generic.types, PackedPlant)
+    return _TYPES[shape]
 
 
 class FirstClassKernel:
