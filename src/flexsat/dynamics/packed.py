@@ -135,12 +135,17 @@ class FirstClassKernel:
         self._numba_type_ = types.FunctionType(signature)
         self._address = _get_wrapper_address(dispatcher, signature)
         self.dispatcher = dispatcher
+        self.signature = signature
 
     def __wrapper_address__(self) -> int:
         return self._address
 
     def __call__(self, *args):
         return self.dispatcher(*args)
+
+    def __reduce__(self):
+        # The address is per process: another process resolves it again.
+        return first_class, (self.dispatcher, self.signature)
 
 
 _KERNELS: dict[tuple[int, str], FirstClassKernel] = {}
