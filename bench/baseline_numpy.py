@@ -150,8 +150,8 @@ def load_parameters(cfg=None):
     c = np.concatenate([np.zeros(6), plant.damping.ravel()])
     return {
         "config": cfg,
-        "stiffness": plant.stiffness,
-        "damping": plant.damping,
+        "stiffness": plant.stiffness.reshape(-1, 6),
+        "damping": plant.damping.reshape(-1, 6),
         "m_hub": cfg.hub.mass_kg,
         "J_hub": cfg.hub.inertia(),
         "panels": panels,

@@ -249,22 +249,26 @@ def build_basilisk(bsk: SimpleNamespace, plant: Plant, scenario: OpenLoopScenari
     keep_alive: list = [sc]
 
     zero3, zero33 = np.zeros(3), np.zeros((3, 3))
+    stiffness, damping = plant.stiffness.reshape(-1, 6), plant.damping.reshape(-1, 6)
     for i, app in enumerate(plant.config.appendages):
+        row, plate = plant.params[i], plant.models[i]
+        panel = plate.describe(app, row)
+        J_panel = np.array(panel["centroidal_inertia_kg_m2"])
         chain = sbn.SpinningBodyNDOFStateEffector()
         chain.ModelTag = app.name
         for k, (axis, dof) in enumerate(_CHAIN):
             first, last = k == 0, k == len(_CHAIN) - 1
             body = sbn.SpinningBody()
-            body.setMass(float(plant.panel_mass[i]) if last else 0.0)
-            body.setISPntSc_S(_matrix(plant.panel_J[i] if last else zero33))
-            body.setR_ScS_S(_column(plant.com_offset[i] if last else zero3))
+            body.setMass(float(panel["mass_kg"]) if last else 0.0)
+            body.setISPntSc_S(_matrix(J_panel if last else zero33))
+            body.setR_ScS_S(_column(plate.com_offset(row) if last else zero3))
             # The first hinge sits at the mount point; its zero-angle frame is the mount
             # frame M ([S0 B] = R_BM^T). The others share its hinge point and frame.
-            body.setR_SP_P(_column(plant.mount_point[i] if first else zero3))
-            body.setDCM_S0P(_matrix(plant.R_BM[i].T if first else np.eye(3)))
+            body.setR_SP_P(_column(plate.mount_point(row) if first else zero3))
+            body.setDCM_S0P(_matrix(plate.mount_rotation(row).T if first else np.eye(3)))
             body.setSHat_S(_column(np.eye(3)[axis]))
-            body.setK(float(plant.stiffness[i, dof]))
-            body.setC(float(plant.damping[i, dof]))
+            body.setK(float(stiffness[i, dof]))
+            body.setC(float(damping[i, dof]))
             chain.addSpinningBody(body)
             keep_alive.append(body)
         chain.setNameOfThetaState(f"{app.name}Theta")

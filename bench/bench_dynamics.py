@@ -21,6 +21,7 @@ from rich.table import Table
 
 from flexsat.config import preset_path, validate_config
 from flexsat.dynamics import kernels
+from flexsat.dynamics.packed import only
 from flexsat.dynamics.plant import Plant
 
 
@@ -74,11 +75,13 @@ def measure(n_appendages: int) -> dict[str, float]:
     M = np.empty((plant.n_dof, plant.n_dof))
     h = np.empty(plant.n_dof)
     qdd = np.empty(plant.n_dof)
-    inertia, dynamics = plant.inertia_args, plant.dynamics_args
+    # Each evaluation gets the plant with only its own kernels, as Plant's methods do.
+    views = {k: only(plant.packed, *v) for k, v in
+             (("M", ("mass_matrix",)), ("h", ("bias_forces",)), ("qdd", ("pass1", "pass2")))}
     return {
-        "M(q)": _per_call_us(lambda: kernels.mass_matrix(q, *inertia, M)),
-        "h(q, qd)": _per_call_us(lambda: kernels.bias_forces(q, qd, *inertia, h)),
-        "q_ddot": _per_call_us(lambda: kernels.accelerations(q, qd, Q, *dynamics, qdd)),
+        "M(q)": _per_call_us(lambda: kernels.mass_matrix(q, views["M"], M)),
+        "h(q, qd)": _per_call_us(lambda: kernels.bias_forces(q, qd, views["h"], h)),
+        "q_ddot": _per_call_us(lambda: kernels.accelerations(q, qd, Q, views["qdd"], qdd)),
         "q_ddot via M, h + np.linalg.solve": _per_call_us(
             lambda: np.linalg.solve(
                 plant.mass_matrix(q),
@@ -97,8 +100,8 @@ from flexsat.dynamics.plant import Plant
 from flexsat.dynamics import kernels
 plant = Plant.from_config(nominal())
 q = np.zeros(plant.n_dof); out = np.empty(plant.n_dof)
-kernels.accelerations(q, q, q, *plant.dynamics_args, out)
-kernels.bias_forces(q, q, *plant.inertia_args, out)
+kernels.accelerations(q, q, q, plant.packed, out)
+kernels.bias_forces(q, q, plant.packed, out)
 print(time.perf_counter() - t0)
 """
 

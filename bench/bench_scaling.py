@@ -80,7 +80,7 @@ def scaled_config(n_appendages: int) -> SatelliteConfig:
 def _evaluate(q, qd, Q, args, qdd, n_calls):
     status = 0
     for _ in range(n_calls):
-        status |= kernels.accelerations(q, qd, Q, *args, qdd)
+        status |= kernels.accelerations(q, qd, Q, args, qdd)
     return status
 
 
@@ -100,7 +100,7 @@ def evaluation_us(plant: Plant) -> tuple[float, float]:
     qd = rng.normal(scale=0.1, size=plant.n_dof)
     Q = rng.normal(size=plant.n_dof)
     qdd = np.empty(plant.n_dof)
-    args = plant.dynamics_args
+    args = plant.packed
     n_calls = 100_000
     _evaluate(q, qd, Q, args, qdd, 10)  # compile (numba specializes on types, not sizes)
     compiled = _best_of(lambda: _evaluate(q, qd, Q, args, qdd, n_calls), 5) / n_calls
@@ -108,7 +108,7 @@ def evaluation_us(plant: Plant) -> tuple[float, float]:
 
     def from_python():
         for _ in range(n_py):
-            kernels.accelerations(q, qd, Q, *args, qdd)
+            kernels.accelerations(q, qd, Q, args, qdd)
 
     python = _best_of(from_python, 5) / n_py
     return 1e6 * compiled, 1e6 * python

@@ -15,23 +15,37 @@ from __future__ import annotations
 import hashlib
 import os
 import re
+import warnings
 from pathlib import Path
+
+from numba.core.errors import NumbaExperimentalFeatureWarning
 
 __all__ = ["COMPILED_MODULES", "compiled_modules", "drop_stale_caches"]
 
-_DECORATED = re.compile(r"^@njit", re.MULTILINE)
+# Pluggable compiled pieces (laws, loop stages, appendage kernels) reach the loops as
+# numba first-class functions, which numba flags as experimental on every use; the
+# feature is relied on deliberately (typed by signature, cached), so that one warning
+# is silenced here.
+warnings.filterwarnings("ignore", category=NumbaExperimentalFeatureWarning)
+
+# A module is part of the compiled code if it compiles functions, builds numba types,
+# or holds constants that numba freezes into compiled code (marked by the comment
+# "# Frozen into compiled code." at the start of a line).
+_COMPILED = re.compile(r"^(@njit|from numba|import numba|# Frozen into compiled code\.)", re.M)
 
 
 def compiled_modules(package: Path | None = None) -> tuple[str, ...]:
-    """Modules with ``@njit`` functions, relative to the package folder, sorted.
+    """Modules compiled code depends on, relative to the package folder, sorted.
 
-    Found by reading the sources, so a new compiled module (a law, a stage, a
-    kernel) needs no entry in a list.
+    Those with ``@njit`` functions, those that import numba (numba types and
+    signatures the cache index pickles) and those marked as holding constants numba
+    freezes into compiled code. Found by reading the sources, so a new compiled module
+    (a law, a stage, a kernel) needs no entry in a list.
     """
     package = package or Path(__file__).parent
     return tuple(sorted(
         path.relative_to(package).as_posix() for path in package.rglob("*.py")
-        if _DECORATED.search(path.read_text(encoding="utf-8"))
+        if _COMPILED.search(path.read_text(encoding="utf-8"))
     ))  # fmt: skip
 
 

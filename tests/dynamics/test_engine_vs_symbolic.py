@@ -43,7 +43,9 @@ def _close(actual, expected, what):
 def test_engine_matches_symbolic_derivation(case):
     config: SatelliteConfig = TOPOLOGIES[case]()
     plant = Plant.from_config(config)
-    params = ReferenceParameters.from_config(config, plant.stiffness, plant.damping)
+    params = ReferenceParameters.from_config(
+        config, plant.stiffness.reshape(-1, 6), plant.damping.reshape(-1, 6)
+    )
     reference = reference_model(plant.n_appendages, "exact")
     rng = np.random.default_rng(20)
     for _ in range(STATES_PER_CASE):

@@ -20,7 +20,9 @@ TORQUE = (0.5, 0.5, 1.0)  # [N m], body frame
 
 
 def _small_angle_run(plant, dt=1e-3, record_every=10):
-    params = ReferenceParameters.from_config(plant.config, plant.stiffness, plant.damping)
+    params = ReferenceParameters.from_config(
+        plant.config, plant.stiffness.reshape(-1, 6), plant.damping.reshape(-1, 6)
+    )
     model = reference_model(plant.n_appendages, "small_angle")
 
     def accelerations(q, qd, torque):

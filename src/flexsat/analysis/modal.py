@@ -28,9 +28,6 @@ from flexsat.errors import SimulationError
 
 __all__ = ["HUB_DOFS", "JOINT_DOFS", "ModalAnalysis", "Mode", "dof_names", "modal_analysis"]
 
-_KIND_OF_JOINT_DOF = (
-    "translation", "translation", "translation", "flapping", "torsion", "in_plane",
-)  # fmt: skip
 _PARITY_MIN = 0.9  # |<phi, P phi>_M| above this: the mode has a definite mirror parity
 _DOMINANT_MIN = 0.5  # normalized mass-weighted amplitude for a DOF to count as dominant
 _HUB_COUPLING_MIN = 0.1
@@ -180,9 +177,12 @@ def modal_analysis(plant: Plant) -> ModalAnalysis:
 
 
 def _kind(plant: Plant, phi: np.ndarray) -> str:
-    strain = (plant.stiffness * phi[6:].reshape(-1, 6) ** 2).sum(axis=0)
-    energy = {}
-    for dof, kind in enumerate(_KIND_OF_JOINT_DOF):
+    """The kind (each model labels its coordinates) holding most of the strain energy."""
+    strain = plant.stiffness * phi[6:] ** 2
+    kinds = [k for app, m in zip(plant.config.appendages, plant.models, strict=True)
+             for k in m.mode_kinds(app)]  # fmt: skip
+    energy: dict[str, float] = {}
+    for dof, kind in enumerate(kinds):
         energy[kind] = energy.get(kind, 0.0) + strain[dof]
     return max(energy, key=energy.get)
 

@@ -20,9 +20,11 @@ from pydantic import Field, model_validator
 from scipy import stats
 
 from flexsat.config.models import HubConfig, _Frozen
+from flexsat.dynamics.appendages import appendage_model
 
 __all__ = ["Modifier", "apply_modifiers"]
 
+_APPENDAGE = re.compile(r"appendages\[\d+\]")
 _TOKEN = re.compile(r"([A-Za-z_][A-Za-z0-9_]*)|\[(\*|\d+)\]")
 
 
@@ -89,11 +91,9 @@ def apply_modifiers(
     for modifier in modifiers:
         for concrete, parent, key in _targets(data, modifier.path):
             value = modifier.draw(rng)
-            if key == "inertia" and concrete.startswith("hub"):
-                _scale_hub_inertia(parent, value)
-            elif key == "inertia":
-                field = "mass_kg" if parent.get("mass_kg") is not None else "surface_density_kg_m2"
-                parent[field] = parent[field] * value
+            derived = _derived(concrete.rsplit(".", 1)[0], parent)
+            if key in derived:
+                derived[key](parent, value)
             elif modifier.op == "scale":
                 parent[key] = _scaled(parent[key], value)
             else:
@@ -106,6 +106,15 @@ def _scaled(current: Any, factor: float) -> Any:
     if isinstance(current, list):
         return [_scaled(item, factor) for item in current]
     return current * factor
+
+
+def _derived(prefix: str, node: Any) -> dict:
+    """Derived paths under ``prefix``: ``hub.inertia``, and each appendage model's own."""
+    if prefix == "hub":
+        return {"inertia": _scale_hub_inertia}
+    if _APPENDAGE.fullmatch(prefix) and isinstance(node, dict):
+        return appendage_model(node.get("model", "plate")).modifiers
+    return {}
 
 
 def _scale_hub_inertia(hub: dict, factor: float) -> None:
@@ -126,7 +135,9 @@ def _targets(data: dict, path: str):
         following = []
         for prefix, node in nodes:
             if name:
-                if not isinstance(node, dict) or (name not in node and name != "inertia"):
+                if not isinstance(node, dict) or (
+                    name not in node and name not in _derived(prefix, node)
+                ):
                     raise KeyError(f"no {name!r} at {prefix or 'the top level'} of {path!r}")
                 concrete = f"{prefix}.{name}" if prefix else name
                 if last:

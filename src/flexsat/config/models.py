@@ -13,16 +13,28 @@ the appendage root), panel frame P_i (moves with the appendage); see
 
 from __future__ import annotations
 
-from typing import Annotated, Literal
+from typing import Annotated, Any, Literal
 
 import numpy as np
-from pydantic import AllowInfNan, BaseModel, ConfigDict, Field, Strict, model_validator
+from pydantic import (
+    AllowInfNan,
+    BaseModel,
+    ConfigDict,
+    Field,
+    SerializeAsAny,
+    Strict,
+    ValidatorFunctionWrapHandler,
+    WrapValidator,
+    model_validator,
+)
 
 __all__ = [
+    "APPENDAGE_CONFIGS",
     "AppendageConfig",
     "HubConfig",
     "SatelliteConfig",
     "TargetFrequencies",
+    "register_appendage_config",
 ]
 
 # A real number: ints are accepted, strings and booleans are not, NaN and inf are not.
@@ -159,6 +171,7 @@ class AppendageConfig(_Frozen):
     """
 
     name: Name
+    model: Literal["plate"] = Field("plate", description="appendage model (registry key)")
     mount_point_m: Point3 = Field(description="root position from hub centre of mass, frame B [m]")
     mount_yaw_deg: Angle = Field(0.0, description="mount frame rotation about Z_B [deg]")
     sadm_angle_deg: Angle = Field(0.0, description="SADM angle about Y_M [deg]")
@@ -207,12 +220,43 @@ class AppendageConfig(_Frozen):
         return 1.0 if self.span_direction == "+y" else -1.0
 
 
+APPENDAGE_CONFIGS: dict[str, type[BaseModel]] = {"plate": AppendageConfig}
+"""Config class of each appendage model, by its ``model`` key (the registry of
+:mod:`flexsat.dynamics.appendages` adds to it)."""
+
+
+def register_appendage_config(model: str, config_class: type[BaseModel]) -> None:
+    """Accept ``model = "<model>"`` appendage tables, validated as ``config_class``."""
+    fields = config_class.model_fields
+    if "name" not in fields or "model" not in fields:
+        raise TypeError(f"{config_class.__name__} needs the fields 'name' and 'model'")
+    APPENDAGE_CONFIGS[model] = config_class
+
+
+def _by_model(value: Any, handler: ValidatorFunctionWrapHandler) -> Any:
+    """Validate an appendage table with the config class its ``model`` key names."""
+    if isinstance(value, BaseModel):
+        return value if type(value) in APPENDAGE_CONFIGS.values() else handler(value)
+    model = value.get("model", "plate") if isinstance(value, dict) else "plate"
+    if model == "plate":
+        return handler(value)
+    if model not in APPENDAGE_CONFIGS:
+        raise ValueError(
+            f"model: unknown appendage model {model!r} (allowed: {', '.join(APPENDAGE_CONFIGS)})"
+        )
+    return APPENDAGE_CONFIGS[model].model_validate(value)
+
+
+# An appendage table: the plate's by default, else the config class of its model.
+Appendage = SerializeAsAny[Annotated[AppendageConfig, WrapValidator(_by_model)]]
+
+
 class SatelliteConfig(_Frozen):
-    """A hub and its list of flexible appendages."""
+    """A hub and its list of appendages (each validated by its model's config class)."""
 
     name: Name = "satellite"
     hub: HubConfig
-    appendages: Annotated[list[AppendageConfig], Field(min_length=1, max_length=64)]
+    appendages: Annotated[list[Appendage], Field(min_length=1, max_length=64)]
 
     @model_validator(mode="after")
     def _unique_names(self) -> SatelliteConfig:
@@ -223,7 +267,10 @@ class SatelliteConfig(_Frozen):
         hub = self.hub
         if hub.radius_m is not None:  # a cylinder: its surface is known
             for k, app in enumerate(self.appendages):
-                x, y, z = app.mount_point_m
+                root = getattr(app, "mount_point_m", None)  # a model without a root point
+                if root is None:
+                    continue
+                x, y, z = root
                 if np.hypot(x, y) < hub.radius_m and abs(z) < 0.5 * hub.height_m:
                     raise ValueError(
                         f"appendages[{k}].mount_point_m {list(app.mount_point_m)} is inside the "

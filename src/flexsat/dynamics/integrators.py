@@ -16,8 +16,10 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from flexsat.dynamics.kernels import STATUS_OK, accelerations
+from flexsat.dynamics.appendages.contract import HUB_DISSIPATION
+from flexsat.dynamics.kernels import accelerations
 from flexsat.dynamics.linalg3 import euler_rate_matrix, mtv
+from flexsat.dynamics.status import STATUS_NOT_FINITE, STATUS_OK
 
 __all__ = [
     "STATUS_NOT_FINITE",
@@ -27,8 +29,6 @@ __all__ = [
     "rk4_open_loop",
     "rk4_step",
 ]
-
-STATUS_NOT_FINITE = 3  # a state component became NaN or infinite
 
 
 @njit(cache=True)
@@ -43,35 +43,30 @@ def applied_torque(t, seg_start, seg_end, seg_torque, disturbance):
     return (tx, ty, tz)
 
 
-@njit(cache=True)
-def augmented_derivative(x, torque_B, n, Q, dx, args):
+@njit(cache=True, inline="always")
+def augmented_derivative(x, torque_B, n, Q, dx, packed):
     """dx/dt of the augmented state [q, q_dot, W_in, W_diss] under a body torque.
 
-    ``torque_B`` is a 3-tuple [N m], ``Q`` scratch of length n, ``dx`` the output.
-    Shared by the compiled RK4 loop and the adaptive scipy solver. Returns a status.
+    ``torque_B`` is a 3-tuple [N m], ``Q`` scratch of length n, ``dx`` the output,
+    ``packed`` the :class:`~flexsat.dynamics.packed.PackedPlant`. Shared by the
+    compiled RK4 loop and the adaptive scipy solver. Returns a status.
     """
     q = x[:n]
     qd = x[n : 2 * n]
     Q[:] = 0.0
     Q[3], Q[4], Q[5] = mtv(euler_rate_matrix(q[3], q[4]), torque_B)  # Q_Theta = S^T tau
     dx[:n] = qd
-    status = accelerations(q, qd, Q, *args, dx[n : 2 * n])
+    status = accelerations(q, qd, Q, packed, dx[n : 2 * n])
     power_in = 0.0
     for j in range(3, 6):
         power_in += Q[j] * qd[j]
-    damping = args[10]
-    dissipated = 0.0
-    for i in range(damping.shape[0]):
-        for j in range(6):
-            v = qd[6 + 6 * i + j]
-            dissipated += damping[i, j] * v * v
     dx[2 * n] = power_in
-    dx[2 * n + 1] = dissipated
+    dx[2 * n + 1] = packed.hub[HUB_DISSIPATION]  # q_dot^T C q_dot, left by accelerations
     return status
 
 
 @njit(cache=True)
-def rk4_step(x, dt, torque_B, n, Q, scratch, args):
+def rk4_step(x, dt, torque_B, n, Q, scratch, packed):
     """One RK4 step of the augmented state x, in place, under a held body torque.
 
     ``scratch`` (5, len(x)) and ``Q`` (n,) are work arrays the caller allocates once.
@@ -79,16 +74,16 @@ def rk4_step(x, dt, torque_B, n, Q, scratch, args):
     """
     size = x.shape[0]
     k1, k2, k3, k4, stage = scratch[0], scratch[1], scratch[2], scratch[3], scratch[4]
-    status = augmented_derivative(x, torque_B, n, Q, k1, args)
+    status = augmented_derivative(x, torque_B, n, Q, k1, packed)
     for j in range(size):
         stage[j] = x[j] + 0.5 * dt * k1[j]
-    status |= augmented_derivative(stage, torque_B, n, Q, k2, args)
+    status |= augmented_derivative(stage, torque_B, n, Q, k2, packed)
     for j in range(size):
         stage[j] = x[j] + 0.5 * dt * k2[j]
-    status |= augmented_derivative(stage, torque_B, n, Q, k3, args)
+    status |= augmented_derivative(stage, torque_B, n, Q, k3, packed)
     for j in range(size):
         stage[j] = x[j] + dt * k3[j]
-    status |= augmented_derivative(stage, torque_B, n, Q, k4, args)
+    status |= augmented_derivative(stage, torque_B, n, Q, k4, packed)
     if status != STATUS_OK:
         return status
     for j in range(size):
@@ -100,13 +95,13 @@ def rk4_step(x, dt, torque_B, n, Q, scratch, args):
 
 
 @njit(cache=True)
-def rk4_hold(x, dt, n_steps, torque_B, args):
+def rk4_hold(x, dt, n_steps, torque_B, packed):
     """``n_steps`` RK4 steps under one held body torque (3-tuple). Returns (status, done)."""
-    n = (x.shape[0] - 2) // 2
+    n = packed.n_dof
     scratch = np.empty((5, x.shape[0]))
     Q = np.empty(n)
     for k in range(n_steps):
-        status = rk4_step(x, dt, torque_B, n, Q, scratch, args)
+        status = rk4_step(x, dt, torque_B, n, Q, scratch, packed)
         if status != STATUS_OK:
             return status, k
     return STATUS_OK, n_steps
@@ -114,7 +109,7 @@ def rk4_hold(x, dt, n_steps, torque_B, args):
 
 @njit(cache=True)
 def rk4_open_loop(
-    x, t0, dt, n_steps, record_every, seg_start, seg_end, seg_torque, disturbance, args,
+    x, t0, dt, n_steps, record_every, seg_start, seg_end, seg_torque, disturbance, packed,
     rec_t, rec_x, rec_tau, rec_start,
 ):  # fmt: skip
     """Advance x in place by ``n_steps`` RK4 steps, recording every ``record_every`` steps.
@@ -129,8 +124,8 @@ def rk4_open_loop(
     seg_start, seg_end : ndarray, shape (k,)
     seg_torque : ndarray, shape (k, 3)
     disturbance : ndarray, shape (3,)
-    args : tuple
-        ``Plant.dynamics_args``.
+    packed : PackedPlant
+        ``Plant.packed``.
     rec_t, rec_x, rec_tau : ndarray
         Record buffers, shapes (m,), (m, 2 n_dof + 2), (m, 3); the state after step
         k is written at row rec_start + (k + 1) / record_every - 1 when
@@ -144,14 +139,14 @@ def rk4_open_loop(
     steps_done : int
         Steps completed without error (x is the state after them).
     """
-    n = (x.shape[0] - 2) // 2
+    n = packed.n_dof
     scratch = np.empty((5, x.shape[0]))
     Q = np.empty(n)
     row = rec_start
     for k in range(n_steps):
         t = t0 + k * dt
         torque = applied_torque(t, seg_start, seg_end, seg_torque, disturbance)
-        status = rk4_step(x, dt, torque, n, Q, scratch, args)
+        status = rk4_step(x, dt, torque, n, Q, scratch, packed)
         if status != STATUS_OK:
             return status, k
         if (k + 1) % record_every == 0:

@@ -20,12 +20,14 @@ from numba import njit
 
 __all__ = [
     "add",
+    "add_block",
     "cross",
     "dot",
     "euler_rate_bias",
     "euler_rate_matrix",
     "euler_rate_matrix_inv",
     "load_m33",
+    "load_m33_at",
     "load_seg",
     "load_v3",
     "mm",
@@ -174,6 +176,26 @@ def load_m33(a, i):
         (a[i, 1, 0], a[i, 1, 1], a[i, 1, 2]),
         (a[i, 2, 0], a[i, 2, 1], a[i, 2, 2]),
     )
+
+
+@njit(cache=True, error_model="numpy")
+def load_m33_at(x, k):
+    """x[k:k+9] (a row-major 3x3 matrix) as nested tuples."""
+    return (
+        (x[k], x[k + 1], x[k + 2]),
+        (x[k + 3], x[k + 4], x[k + 5]),
+        (x[k + 6], x[k + 7], x[k + 8]),
+    )
+
+
+@njit(cache=True, error_model="numpy")
+def add_block(M, r0, c0, A, s):
+    """M[r0:r0+3, c0:c0+3] += s A and, off the diagonal, the transposed block."""
+    for a in range(3):
+        for b in range(3):
+            M[r0 + a, c0 + b] += s * A[a][b]
+            if r0 != c0:
+                M[c0 + b, r0 + a] += s * A[a][b]
 
 
 @njit(cache=True, error_model="numpy")

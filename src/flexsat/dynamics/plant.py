@@ -1,139 +1,172 @@
-"""The flexible-satellite plant: a validated config packed into the kernels' arrays.
+"""The flexible-satellite plant: a validated config packed for the compiled kernels.
 
 :class:`Plant` is the user-level face of the compiled kernels in
-:mod:`flexsat.dynamics.kernels`: it builds the packed arrays once (geometry,
-inertia, tuned joint stiffness and damping) and offers the model's terms at any
-state. Every method takes and returns SI arrays; generalized coordinates are laid
-out as in the kernels' module docstring.
+:mod:`flexsat.dynamics.kernels`: it looks each appendage's model up in the registry
+(:mod:`flexsat.dynamics.appendages`), packs the hub and the models' parameter rows
+once (geometry, inertia, tuned joint stiffness and damping) into
+:attr:`Plant.packed`, and offers the model's terms at any state. Every method takes
+and returns SI arrays; generalized coordinates are laid out as :attr:`Plant.layout`
+says.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.spatial.transform import Rotation
 
 from flexsat.config.models import SatelliteConfig
 from flexsat.dynamics import kernels
+from flexsat.dynamics.appendages import AppendageModel, appendage_model
+from flexsat.dynamics.appendages.contract import (
+    HUB_SIZE,
+    OBS_DISSIPATION,
+    OBS_ELASTIC,
+    OBS_KINETIC,
+    OBS_LOCKED_INERTIA,
+    OBS_MOMENTUM,
+    OBS_SIZE,
+    SIGNATURES,
+)
+from flexsat.dynamics.appendages.plate import JOINT_DOFS
+from flexsat.dynamics.layout import HUB_DOFS, StateLayout
 from flexsat.dynamics.linalg3 import euler_rate_matrix
-from flexsat.dynamics.tuning import tune_joints
+from flexsat.dynamics.packed import PackedPlant, first_class, only
+from flexsat.dynamics.status import STATUS_OK, status_message
 from flexsat.errors import SimulationError
 
 __all__ = ["HUB_DOFS", "JOINT_DOFS", "Plant"]
-
-HUB_DOFS = ("x", "y", "z", "phi", "theta", "psi")
-JOINT_DOFS = ("eta_x", "eta_y", "eta_z", "eta_rx", "eta_ry", "eta_rz")
-
-_STATUS_MESSAGES = {
-    kernels.STATUS_HUB_GIMBAL_LOCK: "hub pitch reached +-90 deg (ZYX Euler-angle singularity)",
-    kernels.STATUS_JOINT_GIMBAL_LOCK: "a joint root rotation rho_y reached +-90 deg",
-}
 
 
 @dataclass(frozen=True, eq=False)
 class Plant:
     """Hub plus appendages, packed for the compiled kernels.
 
-    Build it with :meth:`from_config`. Array attributes (``n`` appendages):
-    ``mount_point`` (n, 3) [m] in hub frame B; ``R_BM`` (n, 3, 3) mount -> hub;
-    ``com_offset`` (n, 3) [m] root -> panel centre of mass in panel frame;
-    ``panel_mass`` (n,) [kg]; ``panel_J`` (n, 3, 3) [kg m^2] about the panel centre
-    of mass; ``stiffness``/``damping`` (n, 6) per joint DOF; ``tip_point`` (n, 3) [m]
-    the panel tip (mid-chord of the free edge) in panel frame.
+    Build it with :meth:`from_config`. ``models[i]`` is appendage i's model and
+    ``params[i]`` its packed parameter row; ``layout`` says where its coordinates
+    live; ``packed`` is what the compiled code takes.
     """
 
     config: SatelliteConfig
     hub_mass: float
     hub_J: np.ndarray
-    hub_J_inv: np.ndarray
-    mount_point: np.ndarray
-    R_BM: np.ndarray
-    com_offset: np.ndarray
-    panel_mass: np.ndarray
-    panel_J: np.ndarray
-    panel_J_inv: np.ndarray
-    stiffness: np.ndarray
-    damping: np.ndarray
-    tip_point: np.ndarray
+    models: tuple[AppendageModel, ...]
+    params: tuple[np.ndarray, ...]
+    layout: StateLayout = field(init=False)
+    packed: PackedPlant = field(init=False)
+
+    def __post_init__(self) -> None:
+        entries = []
+        for app, model in zip(self.config.appendages, self.models, strict=True):
+            coords = model.coordinates(app)
+            names, units = tuple(c.name for c in coords), tuple(c.unit for c in coords)
+            entries.append((app.name, model.name, names, units))
+        layout = StateLayout.build(entries)
+        object.__setattr__(self, "layout", layout)
+        object.__setattr__(self, "packed", self._pack())
+        # Per evaluation, the plant with only the kernels it calls (cheaper from Python).
+        views = {
+            "mass_matrix": ("mass_matrix",), "bias_forces": ("bias_forces",),
+            "accelerations": ("pass1", "pass2"), "observe": ("observe",),
+            "joint_wrench": ("joint_wrench",), "tips": ("tips",),
+        }  # fmt: skip
+        object.__setattr__(self, "_views", {k: only(self.packed, *v) for k, v in views.items()})
 
     @classmethod
     def from_config(cls, config: SatelliteConfig) -> Plant:
-        """Pack a validated config and tune the joints to its target frequencies.
+        """Pack a validated config and tune each appendage to its targets.
 
         The stiffness and damping follow eqs. 2.14-2.15 with J_eq taken from
         diag M(0) of this very configuration (thesis section 2.2.3).
         """
-        apps = config.appendages
-        n = len(apps)
-        hub_J = config.hub.inertia()
-        sign = np.array([a.span_sign() for a in apps])
-        length = np.array([a.length_m for a in apps])
-        panel_J = np.stack([a.centroidal_inertia() for a in apps])
-        angles = np.radians([[a.mount_yaw_deg, a.sadm_angle_deg] for a in apps])
+        models = tuple(appendage_model(app.model) for app in config.appendages)
         untuned = cls(
             config=config,
             hub_mass=float(config.hub.mass_kg),
-            hub_J=hub_J,
-            hub_J_inv=np.linalg.inv(hub_J),
-            mount_point=np.array([a.mount_point_m for a in apps], dtype=float),
-            # R_BM = Rz(yaw) Ry(alpha_sadm): intrinsic Z then Y.
-            R_BM=Rotation.from_euler("ZY", angles).as_matrix().reshape(n, 3, 3),
-            com_offset=np.column_stack([np.zeros(n), 0.5 * sign * length, np.zeros(n)]),
-            panel_mass=np.array([a.mass for a in apps]),
-            panel_J=panel_J,
-            panel_J_inv=np.linalg.inv(panel_J),
-            stiffness=np.zeros((n, 6)),
-            damping=np.zeros((n, 6)),
-            tip_point=np.column_stack([np.zeros(n), sign * length, np.zeros(n)]),
+            hub_J=config.hub.inertia(),
+            models=models,
+            params=tuple(m.pack(app) for m, app in zip(models, config.appendages, strict=True)),
         )
-        stiffness, damping = tune_joints(
-            untuned.mass_matrix(),
-            np.stack([a.target_frequencies_hz.per_dof() for a in apps]),
-            np.array([a.damping_ratio for a in apps]),
+        diag = np.diag(untuned.mass_matrix())
+        tuned = tuple(
+            model.tune(app, row, diag[block.slice])
+            for model, app, row, block in zip(
+                models, config.appendages, untuned.params, untuned.layout.blocks, strict=True
+            )
         )
-        return untuned.with_joints(stiffness, damping)
+        return untuned._with_params(tuned)
+
+    def _with_params(self, params: tuple[np.ndarray, ...]) -> Plant:
+        return Plant(self.config, self.hub_mass, self.hub_J, self.models, params)
 
     def with_joints(self, stiffness: np.ndarray, damping: np.ndarray) -> Plant:
-        """A copy with other joint stiffness and damping, each shape (n, 6)."""
-        fields = {name: getattr(self, name) for name in self.__dataclass_fields__}
-        fields["stiffness"] = np.array(stiffness, dtype=float).reshape(self.n_appendages, 6)
-        fields["damping"] = np.array(damping, dtype=float).reshape(self.n_appendages, 6)
-        return Plant(**fields)
+        """A copy with other joint stiffness and damping, each the diagonal of K_sys and
+        C_damp over the appendage coordinates (any shape of n_dof - 6 values)."""
+        stiffness = np.asarray(stiffness, dtype=float).ravel()
+        damping = np.asarray(damping, dtype=float).ravel()
+        start = self.layout.flexible.start
+        rows = tuple(
+            model.with_joints(row, stiffness[b.slice.start - start : b.slice.stop - start],
+                              damping[b.slice.start - start : b.slice.stop - start])
+            for model, row, b in zip(self.models, self.params, self.layout.blocks, strict=True)
+        )  # fmt: skip
+        return self._with_params(rows)
 
-    # -- sizes and packed argument lists -------------------------------------------------
+    def _pack(self) -> PackedPlant:
+        """Group the appendages by model (one kernel call per group) and pack them."""
+        groups: dict[str, list[int]] = {}
+        for i, model in enumerate(self.models):
+            groups.setdefault(model.name, []).append(i)
+        members, params, kernel_sets, models = [], [], [], []
+        for indices in groups.values():
+            offsets = [self.layout.blocks[i].offset for i in indices]
+            members.append(np.array([indices, offsets], dtype=np.int64).T.copy())
+            params.append(np.ascontiguousarray(np.stack([self.params[i] for i in indices])))
+            kernel_sets.append(self.models[indices[0]].kernels)
+            models.append(self.models[indices[0]])
+        hub_J = np.ascontiguousarray(self.hub_J, dtype=float)
+        return PackedPlant(
+            n_dof=self.layout.n_dof,
+            hub_mass=self.hub_mass,
+            hub_J=hub_J,
+            hub_J_inv=np.linalg.inv(hub_J),
+            articulated=any(m.transmits_inertia for m in self.models),
+            hub=np.zeros(HUB_SIZE),
+            solve=np.zeros((6, 7)),
+            members=tuple(members),
+            params=tuple(params),
+            work=tuple(np.zeros((len(m), max(1, k.work_size)))
+                       for m, k in zip(members, models, strict=True)),
+            **{name: tuple(first_class(getattr(k, name), signature) for k in kernel_sets)
+               for name, signature in SIGNATURES._asdict().items()},
+        )  # fmt: skip
+
+    # -- sizes ----------------------------------------------------------------------------
 
     @property
     def n_appendages(self) -> int:
-        return int(self.panel_mass.shape[0])
+        return len(self.models)
 
     @property
     def n_dof(self) -> int:
-        return 6 + 6 * self.n_appendages
+        return self.layout.n_dof
 
     @property
-    def inertia_args(self) -> tuple:
-        """Arguments of the kernels that need the inertia only."""
-        return (
-            self.hub_mass, self.hub_J, self.mount_point, self.R_BM, self.com_offset,
-            self.panel_mass, self.panel_J,
-        )  # fmt: skip
+    def stiffness(self) -> np.ndarray:
+        """Diagonal of K_sys over the appendage coordinates, shape (n_dof - 6,)."""
+        return np.concatenate([m.stiffness(p) for m, p in self._rows()])
 
     @property
-    def dynamics_args(self) -> tuple:
-        """Arguments of :func:`flexsat.dynamics.kernels.accelerations` after (q, qd, Q)."""
-        return (
-            self.hub_mass, self.hub_J, self.hub_J_inv, self.mount_point, self.R_BM,
-            self.com_offset, self.panel_mass, self.panel_J, self.panel_J_inv,
-            self.stiffness, self.damping,
-        )  # fmt: skip
+    def damping(self) -> np.ndarray:
+        """Diagonal of C_damp over the appendage coordinates, shape (n_dof - 6,)."""
+        return np.concatenate([m.damping(p) for m, p in self._rows()])
+
+    def _rows(self) -> zip:
+        return zip(self.models, self.params, strict=True)
 
     def dof_names(self) -> list[str]:
-        """Names of the generalized coordinates: hub DOFs, then ``<appendage>.<joint DOF>``."""
-        names = list(HUB_DOFS)
-        for app in self.config.appendages:
-            names += [f"{app.name}.{dof}" for dof in JOINT_DOFS]
-        return names
+        """Names of the generalized coordinates: hub DOFs, then ``<appendage>.<coordinate>``."""
+        return self.layout.dof_names()
 
     def zeros(self) -> np.ndarray:
         """A zero generalized vector, shape (n_dof,)."""
@@ -152,32 +185,32 @@ class Plant:
     def mass_matrix(self, q: np.ndarray | None = None) -> np.ndarray:
         """M(q), shape (n_dof, n_dof) (eq. 2.39); ``q=None`` gives M(0)."""
         out = np.empty((self.n_dof, self.n_dof))
-        kernels.mass_matrix(self._state(q), *self.inertia_args, out)
+        kernels.mass_matrix(self._state(q), self._views["mass_matrix"], out)
         return out
 
     def bias_forces(self, q: np.ndarray, qd: np.ndarray) -> np.ndarray:
         """Coriolis and centrifugal vector h(q, q_dot), shape (n_dof,) (eq. 2.43)."""
         out = np.empty(self.n_dof)
-        kernels.bias_forces(self._state(q), self._state(qd), *self.inertia_args, out)
+        kernels.bias_forces(self._state(q), self._state(qd), self._views["bias_forces"], out)
         return out
 
     def stiffness_matrix(self) -> np.ndarray:
-        """K_sys = diag(0_6, K_flex,1, ..., K_flex,n), shape (n_dof, n_dof) (eq. 3.4)."""
-        return np.diag(np.concatenate([np.zeros(6), self.stiffness.ravel()]))
+        """K_sys = diag(0_6, K_1, ..., K_n), shape (n_dof, n_dof) (eq. 3.4)."""
+        return np.diag(np.concatenate([np.zeros(6), self.stiffness]))
 
     def damping_matrix(self) -> np.ndarray:
-        """C_damp = diag(0_6, C_flex,1, ..., C_flex,n), shape (n_dof, n_dof) (eq. 2.47)."""
-        return np.diag(np.concatenate([np.zeros(6), self.damping.ravel()]))
+        """C_damp = diag(0_6, C_1, ..., C_n), shape (n_dof, n_dof) (eq. 2.47)."""
+        return np.diag(np.concatenate([np.zeros(6), self.damping]))
 
     def elastic_forces(self, q: np.ndarray) -> np.ndarray:
         """k_el(q) = K_sys q, shape (n_dof,) (eq. 2.46)."""
         q = self._state(q)
-        return np.concatenate([np.zeros(6), self.stiffness.ravel() * q[6:]])
+        return np.concatenate([np.zeros(6), self.stiffness * q[6:]])
 
     def damping_forces(self, qd: np.ndarray) -> np.ndarray:
         """C_damp q_dot, shape (n_dof,) (eq. 2.47)."""
         qd = self._state(qd)
-        return np.concatenate([np.zeros(6), self.damping.ravel() * qd[6:]])
+        return np.concatenate([np.zeros(6), self.damping * qd[6:]])
 
     def generalized_forces(
         self, q: np.ndarray, torque_B: np.ndarray, force_N: np.ndarray | None = None
@@ -217,44 +250,38 @@ class Plant:
         """
         out = np.empty(self.n_dof)
         status = kernels.accelerations(
-            self._state(q), self._state(qd), self._state(Q), *self.dynamics_args, out
+            self._state(q), self._state(qd), self._state(Q), self._views["accelerations"], out
         )
-        if status != kernels.STATUS_OK:
-            raise SimulationError(_STATUS_MESSAGES[status])
+        if status != STATUS_OK:
+            raise SimulationError(status_message(status))
         return out
 
     # -- energies, momentum, loads, displacements -----------------------------------------
 
+    def _observe(self, q: np.ndarray, qd: np.ndarray | None = None) -> np.ndarray:
+        out = np.empty(OBS_SIZE)
+        kernels.observe(self._state(q), self._state(qd), self._views["observe"], out)
+        return out
+
     def kinetic_energy(self, q: np.ndarray, qd: np.ndarray) -> float:
         """T = 1/2 q_dot^T M q_dot, from the bodies' velocities [J] (eq. 2.32)."""
-        return float(kernels.kinetic_energy(self._state(q), self._state(qd), *self.inertia_args))
+        return float(self._observe(q, qd)[OBS_KINETIC])
 
     def elastic_energy(self, q: np.ndarray) -> float:
         """U = 1/2 sum_i q_i^T K_i q_i [J] (eq. 2.35)."""
-        flex = self._state(q)[6:]
-        return float(0.5 * np.dot(self.stiffness.ravel() * flex, flex))
+        return float(self._observe(q)[OBS_ELASTIC])
 
     def dissipation_power(self, qd: np.ndarray) -> float:
         """Power dissipated by the joint dampers, q_dot^T C q_dot = 2 D [W] (eq. 2.36)."""
-        flex = self._state(qd)[6:]
-        return float(np.dot(self.damping.ravel() * flex, flex))
+        return float(self._observe(None, qd)[OBS_DISSIPATION])
 
     def angular_momentum(self, q: np.ndarray, qd: np.ndarray) -> np.ndarray:
         """Total angular momentum about the inertial origin, frame N, shape (3,) [N m s]."""
-        out = np.empty(3)
-        kernels.system_angular_momentum(
-            self._state(q), self._state(qd), *self.inertia_args, out
-        )
-        return out
+        return self._observe(q, qd)[OBS_MOMENTUM : OBS_MOMENTUM + 3].copy()
 
     def locked_inertia(self, q: np.ndarray) -> np.ndarray:
         """Inertia of the satellite frozen in shape q about the hub centre of mass, B, (3, 3)."""
-        out = np.empty((3, 3))
-        kernels.locked_inertia(
-            self._state(q), self.hub_J, self.mount_point, self.R_BM, self.com_offset,
-            self.panel_mass, self.panel_J, out,
-        )  # fmt: skip
-        return out
+        return self._observe(q)[OBS_LOCKED_INERTIA : OBS_LOCKED_INERTIA + 9].reshape(3, 3)
 
     def joint_wrench_on_hub(
         self, q: np.ndarray, qd: np.ndarray, Q: np.ndarray | None = None
@@ -268,15 +295,15 @@ class Plant:
         """
         out = np.empty(6)
         status = kernels.hub_joint_wrench(
-            self._state(q), self._state(qd), self._state(Q), self.mount_point, self.R_BM,
-            self.com_offset, self.stiffness, self.damping, out,
-        )  # fmt: skip
-        if status != kernels.STATUS_OK:
-            raise SimulationError(_STATUS_MESSAGES[status])
+            self._state(q), self._state(qd), self._state(Q), self._views["joint_wrench"], out
+        )
+        if status != STATUS_OK:
+            raise SimulationError(status_message(status))
         return out[:3].copy(), out[3:].copy()
 
     def tip_displacement(self, q: np.ndarray) -> np.ndarray:
-        """Tip displacement of each panel from its undeformed place, mount frames, (n, 3) [m]."""
-        out = np.empty((self.n_appendages, 3))
-        kernels.tip_displacement(self._state(q), self.tip_point, out)
+        """Tip displacement of each appendage from its undeformed place, mount frames,
+        (n, 3) [m]."""
+        out = np.zeros((self.n_appendages, 3))
+        kernels.tip_displacement(self._state(q), self._views["tips"], out)
         return out

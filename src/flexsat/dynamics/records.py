@@ -9,13 +9,17 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from flexsat.dynamics.appendages.contract import (
+    OBS_ELASTIC,
+    OBS_KINETIC,
+    OBS_LOCKED_INERTIA,
+    OBS_MOMENTUM,
+    OBS_SIZE,
+)
 from flexsat.dynamics.kernels import (
-    STATUS_OK,
     accelerations,
     hub_joint_wrench,
-    kinetic_energy,
-    locked_inertia,
-    system_angular_momentum,
+    observe,
     tip_displacement,
 )
 from flexsat.dynamics.linalg3 import (
@@ -26,13 +30,14 @@ from flexsat.dynamics.linalg3 import (
     mv,
     rot_zyx,
 )
+from flexsat.dynamics.status import STATUS_OK
 
 __all__ = ["derive_records"]
 
 
 @njit(cache=True)
 def derive_records(
-    q, qd, tau_B, args, tip_point,
+    q, qd, tau_B, packed,
     omega, omega_dot, tau_flex, H, H_rigid, kinetic, elastic, tips,
 ):  # fmt: skip
     """Fill the derived arrays, row by row, from recorded states.
@@ -42,9 +47,8 @@ def derive_records(
     q, qd : ndarray, shape (m, n_dof)
     tau_B : ndarray, shape (m, 3)
         Applied body torque at each record [N m].
-    args : tuple
-        ``Plant.dynamics_args``.
-    tip_point : ndarray, shape (n, 3)
+    packed : PackedPlant
+        ``Plant.packed``.
     omega, omega_dot, tau_flex, H, H_rigid : ndarray, shape (m, 3)
         Outputs: body rate [rad/s], angular acceleration [rad/s^2], joint torque on
         the hub [N m] (frame B), total and rigid-part angular momentum [N m s]
@@ -59,24 +63,21 @@ def derive_records(
     A row whose state is singular (the last state of a failed run) gets NaN
     accelerations and joint torque.
     """
-    hub_mass, hub_J, hub_J_inv, mount_point, R_BM, com_offset = args[:6]
-    panel_mass, panel_J, panel_J_inv, stiffness, damping = args[6:]
     m, n = q.shape
     Q = np.zeros(n)
     no_external = np.zeros(n)  # tau_flex: elastic and damping wrench only
     qdd = np.empty(n)
     wrench = np.empty(6)
-    J_locked = np.empty((3, 3))
-    H_row = np.empty(3)
+    obs = np.empty(OBS_SIZE)
+    L = OBS_LOCKED_INERTIA
     for k in range(m):
         qk, qdk = q[k], qd[k]
         S = euler_rate_matrix(qk[3], qk[4])
         w = mv(S, load_seg(qdk, 3))
         omega[k, 0], omega[k, 1], omega[k, 2] = w
         Q[3], Q[4], Q[5] = mtv(S, load_seg(tau_B[k], 0))
-        status = accelerations(qk, qdk, Q, *args, qdd)
-        status |= hub_joint_wrench(qk, qdk, no_external, mount_point, R_BM, com_offset,
-                                   stiffness, damping, wrench)  # fmt: skip
+        status = accelerations(qk, qdk, Q, packed, qdd)
+        status |= hub_joint_wrench(qk, qdk, no_external, packed, wrench)
         if status == STATUS_OK:
             bias = euler_rate_bias(qk[3], qk[4], qdk[3], qdk[4], qdk[5])
             w_dot = mv(S, load_seg(qdd, 3))
@@ -86,22 +87,16 @@ def derive_records(
         else:
             omega_dot[k, :] = np.nan
             tau_flex[k, :] = np.nan
-        system_angular_momentum(qk, qdk, hub_mass, hub_J, mount_point, R_BM, com_offset,
-                                panel_mass, panel_J, H_row)  # fmt: skip
-        H[k, :] = H_row
-        locked_inertia(qk, hub_J, mount_point, R_BM, com_offset, panel_mass, panel_J, J_locked)
+        observe(qk, qdk, packed, obs)
+        for a in range(3):
+            H[k, a] = obs[OBS_MOMENTUM + a]
         R_NB = rot_zyx(qk[3], qk[4], qk[5])
         Jw = (
-            J_locked[0, 0] * w[0] + J_locked[0, 1] * w[1] + J_locked[0, 2] * w[2],
-            J_locked[1, 0] * w[0] + J_locked[1, 1] * w[1] + J_locked[1, 2] * w[2],
-            J_locked[2, 0] * w[0] + J_locked[2, 1] * w[1] + J_locked[2, 2] * w[2],
+            obs[L + 0] * w[0] + obs[L + 1] * w[1] + obs[L + 2] * w[2],
+            obs[L + 3] * w[0] + obs[L + 4] * w[1] + obs[L + 5] * w[2],
+            obs[L + 6] * w[0] + obs[L + 7] * w[1] + obs[L + 8] * w[2],
         )
         H_rigid[k, 0], H_rigid[k, 1], H_rigid[k, 2] = mv(R_NB, Jw)
-        kinetic[k] = kinetic_energy(qk, qdk, hub_mass, hub_J, mount_point, R_BM, com_offset,
-                                    panel_mass, panel_J)  # fmt: skip
-        u = 0.0
-        for i in range(stiffness.shape[0]):
-            for j in range(6):
-                u += 0.5 * stiffness[i, j] * qk[6 + 6 * i + j] ** 2
-        elastic[k] = u
-        tip_displacement(qk, tip_point, tips[k])
+        kinetic[k] = obs[OBS_KINETIC]
+        elastic[k] = obs[OBS_ELASTIC]
+        tip_displacement(qk, packed, tips[k])

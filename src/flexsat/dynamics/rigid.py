@@ -17,9 +17,10 @@ __all__ = ["gyroscopic_torque", "rigid_inertia"]
 def rigid_inertia(plant: Plant) -> np.ndarray:
     """Total inertia of the rigidized satellite about the hub centre of mass, frame B.
 
-    Each panel's centroidal inertia is rotated into B (R_BM J_p R_BM^T) and carried to
-    the hub centre of mass by the parallel-axis theorem in matrix form,
-    m (|r|^2 I - r r^T), with r the undeformed panel centre of mass.
+    Each appendage, frozen undeformed (its model's ``rigid_body``: for a plate, the
+    centroidal inertia rotated into B, R_BM J_p R_BM^T), is carried to the hub centre of
+    mass by the parallel-axis theorem in matrix form, m (|r|^2 I - r r^T), with r its
+    undeformed centre of mass.
 
     Returns
     -------
@@ -27,11 +28,11 @@ def rigid_inertia(plant: Plant) -> np.ndarray:
         J_tot [kg m^2]; diag(189.99, 44.16, 177.90) for the nominal case.
     """
     j_tot = plant.hub_J.copy()
-    for i in range(plant.n_appendages):
-        r = plant.mount_point[i] + plant.R_BM[i] @ plant.com_offset[i]
-        R = plant.R_BM[i]
-        j_tot += R @ plant.panel_J[i] @ R.T
-        j_tot += plant.panel_mass[i] * (np.dot(r, r) * np.eye(3) - np.outer(r, r))
+    for model, params in zip(plant.models, plant.params, strict=True):
+        body = model.rigid_body(params)
+        r = body.r_B
+        j_tot += body.J_B
+        j_tot += body.mass * (np.dot(r, r) * np.eye(3) - np.outer(r, r))
     return j_tot
 
 

@@ -48,40 +48,26 @@ def mirror_operator(plant: Plant, plane: str = "xz", rtol: float = 1e-9) -> np.n
     # Euler angles: R -> F R F with F the reflection; for ZYX angles this is the
     # axial-vector rule applied component-wise (exact, see module docstring).
     paired = set()
+    blocks = plant.layout.blocks
     for i in range(n):
-        j = _partner(plant, i, reflect, rtol)
-        if j is None:
+        found = _partner(plant, i, reflect, rtol)
+        if found is None:
             return None
+        j, T = found
         paired.add(j)
-        T_eta = plant.R_BM[j].T @ reflect @ plant.R_BM[i]
-        T_rho = -T_eta  # axial vectors: det(T_eta) = -1
-        if not _is_signed_identity(T_eta, rtol):
-            return None
-        oi, oj = 6 + 6 * i, 6 + 6 * j
-        P[oj : oj + 3, oi : oi + 3] = T_eta
-        P[oj + 3 : oj + 6, oi + 3 : oi + 6] = T_rho
+        P[blocks[j].slice, blocks[i].slice] = T
     return P if len(paired) == n else None
 
 
-def _partner(plant: Plant, i: int, reflect: np.ndarray, rtol: float) -> int | None:
-    """Index of the appendage that is the mirror image of appendage i, if any."""
-    scale = max(1.0, float(np.max(np.abs(plant.mount_point))))
-    target_root = reflect @ plant.mount_point[i]
-    target_com = reflect @ (plant.R_BM[i] @ plant.com_offset[i])
+def _partner(plant: Plant, i: int, reflect: np.ndarray, rtol: float
+             ) -> tuple[int, np.ndarray] | None:  # fmt: skip
+    """The appendage that is the mirror image of appendage i and the map of its
+    coordinates, asked of the model (same model only)."""
+    model = plant.models[i]
     for j in range(plant.n_appendages):
-        same = (
-            np.allclose(plant.mount_point[j], target_root, atol=rtol * scale)
-            and np.allclose(plant.R_BM[j] @ plant.com_offset[j], target_com, atol=rtol * scale)
-            and np.isclose(plant.panel_mass[j], plant.panel_mass[i], rtol=rtol)
-            and np.allclose(plant.panel_J[j], plant.panel_J[i], rtol=rtol)
-            and np.allclose(plant.stiffness[j], plant.stiffness[i], rtol=rtol)
-            and np.allclose(plant.damping[j], plant.damping[i], rtol=rtol)
-        )
-        if same:
-            return j
+        if plant.models[j] is not model:
+            continue
+        T = model.mirror_block(plant.params[i], plant.params[j], reflect, rtol)
+        if T is not None:
+            return j, T
     return None
-
-
-def _is_signed_identity(T: np.ndarray, rtol: float) -> bool:
-    """True when T is diagonal with entries +-1 (joint axes map onto joint axes)."""
-    return bool(np.allclose(np.abs(T), np.eye(3), atol=rtol))

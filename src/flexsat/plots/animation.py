@@ -154,7 +154,8 @@ def _peak_tip(result: Result, plant: Plant) -> tuple[float, float]:
     """Peak tip displacement over the run [m] of the panel where it is largest relative
     to the panel length, and that panel's length [m]."""
     ds = result.dataset
-    lengths = np.array([a.length_m for a in plant.config.appendages])
+    lengths = np.array([m.extent(a) for a, m in zip(plant.config.appendages, plant.models,
+                                                    strict=True)])  # fmt: skip
     if "tip_displacement" in ds.variables:
         tips = np.asarray(ds["tip_displacement"].values, dtype=float)
     else:
@@ -165,8 +166,8 @@ def _peak_tip(result: Result, plant: Plant) -> tuple[float, float]:
     norms = np.where(np.isfinite(norms), norms, 0.0)
     if norms.size == 0:
         return 0.0, float(lengths[0])
-    peaks = norms.max(axis=0)
-    worst = int(np.argmax(peaks / lengths))
+    peaks = np.where(lengths > 0.0, norms.max(axis=0), 0.0)  # a rigid body has no tip motion
+    worst = int(np.argmax(peaks / np.where(lengths > 0.0, lengths, 1.0)))
     return float(peaks[worst]), float(lengths[worst])
 
 

@@ -211,18 +211,19 @@ class SatelliteGeometry:
 
 
 def panel_corners_local(plant: Plant) -> np.ndarray:
-    """Panel corners in each panel frame P_i, shape (n, 4, 3) [m].
+    """Outline corners of each appendage, undeformed, hub frame B, shape (n, 4, 3) [m].
 
-    The panel spans 0..L along +Y_P or -Y_P from its root and -W/2..W/2 along X_P
-    (its mid-plane, Z_P = 0); corner order as in :class:`SatelliteGeometry`.
+    Each model draws itself (``shape_points``); for the thesis plate the corners span
+    0..L along +Y_P or -Y_P from its root and -W/2..W/2 along X_P (its mid-plane).
     """
-    apps = plant.config.appendages
-    out = np.zeros((len(apps), 4, 3))
-    for i, app in enumerate(apps):
-        w2, span = 0.5 * app.width_m, app.span_sign() * app.length_m
-        out[i, :, 0] = (-w2, w2, w2, -w2)
-        out[i, :, 1] = (0.0, 0.0, span, span)
-    return out
+    return _shape_points(plant, np.zeros(plant.n_dof))[:, 0:4, :]
+
+
+def _shape_points(plant: Plant, q: np.ndarray) -> np.ndarray:
+    """Each appendage's drawable points at q, hub frame B, shape (n, 6, 3) [m]."""
+    rows = zip(plant.config.appendages, plant.models, plant.params, plant.layout.blocks,
+               strict=True)  # fmt: skip
+    return np.stack([m.shape_points(app, p, q[b.slice]) for app, m, p, b in rows])
 
 
 def satellite_geometry(plant: Plant, q: np.ndarray | None = None) -> SatelliteGeometry:
@@ -247,22 +248,14 @@ def satellite_geometry(plant: Plant, q: np.ndarray | None = None) -> SatelliteGe
     n = plant.n_appendages
     centre = q[0:3].copy()
     R_NB = rot_zyx(q[3:6])
-    joints = q[6:].reshape(n, 6)
-    eta, R_MP = joints[:, 0:3], rot_zyx(joints[:, 3:6])
 
     def to_n(points_b: np.ndarray) -> np.ndarray:  # (..., 3) in B -> N
         return centre + points_b @ R_NB.T
 
-    # x_B = r_m + R_BM (eta + R_MP x_P), for the corners, the root and the tip.
-    local = np.concatenate(
-        [panel_corners_local(plant), np.zeros((n, 1, 3)), plant.tip_point[:, None, :]], axis=1
-    )
-    in_mount = eta[:, None, :] + np.einsum("nij,nkj->nki", R_MP, local)
-    in_hub = plant.mount_point[:, None, :] + np.einsum("nij,nkj->nki", plant.R_BM, in_mount)
-    pts = to_n(in_hub)
-
+    pts = to_n(_shape_points(plant, q))  # corners, root, tip of each appendage
     outline = hub_outline(plant)
-    anchors = np.array([outline.clip_ray(p) for p in plant.mount_point]).reshape(n, 3)
+    rest_roots = _shape_points(plant, np.zeros(plant.n_dof))[:, 4, :]
+    anchors = np.array([outline.clip_ray(p) for p in rest_roots]).reshape(n, 3)
     arms = np.stack([to_n(anchors), pts[:, 4, :]], axis=1)
     return SatelliteGeometry(
         centre=centre,

@@ -256,7 +256,8 @@ def _cantilever_targets(plant: Plant) -> dict[float, list[str]]:
 
 
 def _panel_lengths(plant: Plant) -> np.ndarray:
-    return np.array([a.length_m for a in plant.config.appendages])
+    return np.array([m.extent(a) for a, m in zip(plant.config.appendages, plant.models,
+                                                 strict=True)])  # fmt: skip
 
 
 def _panel_displacement(plant: Plant, q: np.ndarray, rest: SatelliteGeometry) -> np.ndarray:

@@ -16,11 +16,11 @@ from flexsat.control.stages import ACTUATORS, SENSORS
 from flexsat.dynamics.integrators import rk4_hold
 from flexsat.dynamics.plant import Plant
 from flexsat.dynamics.rigid import rigid_inertia
+from flexsat.dynamics.status import STATUS_CONTROL_FAILED
 from flexsat.errors import SimulationError
 from flexsat.simulate.common import PROGRESS_MIN_STEPS, chunk_steps, progress_bar, run_attributes
 from flexsat.simulate.layout import LoopLayout
 from flexsat.simulate.loops import (
-    STATUS_CONTROL_FAILED,
     LoopClock,
     LoopData,
     LoopRecords,
@@ -211,7 +211,7 @@ def _compiled_loop(plant, scenario, x, stages, data, rec_t, rec_x, rec_ctrl, bar
         final = done + n_chunk == steps
         clock = LoopClock(done * scenario.dt_s, scenario.dt_s, n_chunk, final, control, every)
         status, ran, written = run_closed_loop(
-            x, clock, stages, data, LoopRecords(rec_t, rec_x, rec_ctrl, rows), plant.dynamics_args
+            x, clock, stages, data, LoopRecords(rec_t, rec_x, rec_ctrl, rows), plant.packed
         )
         done += ran
         rows += written
@@ -253,7 +253,7 @@ def _python_loop(plant, scenario, x, stages, d, rec_t, rec_x, rec_ctrl, bar, tas
         if k == steps:
             return 0, k, rows
         torque = (d.tau_applied[0], d.tau_applied[1], d.tau_applied[2])
-        status, ran = rk4_hold(x, scenario.dt_s, block, torque, plant.dynamics_args)
+        status, ran = rk4_hold(x, scenario.dt_s, block, torque, plant.packed)
         k += ran
         if status:
             return status, k, rows

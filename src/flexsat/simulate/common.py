@@ -11,10 +11,8 @@ from dataclasses import dataclass
 from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
 
 from flexsat import __version__
-from flexsat.dynamics import kernels
-from flexsat.dynamics.integrators import STATUS_NOT_FINITE
+from flexsat.dynamics.status import status_message
 from flexsat.errors import ConfigError
-from flexsat.simulate.loops import STATUS_CONTROL_FAILED
 
 __all__ = [
     "PROGRESS_MIN_STEPS",
@@ -28,12 +26,6 @@ __all__ = [
 
 PROGRESS_MIN_STEPS = 200_000  # runs shorter than this (~1 s of wall time) show no bar
 _CHUNK_STEPS = 10_000  # compiled steps between progress updates
-FAILURES = {
-    kernels.STATUS_HUB_GIMBAL_LOCK: "hub pitch reached +-90 deg (ZYX Euler-angle singularity)",
-    kernels.STATUS_JOINT_GIMBAL_LOCK: "a joint root rotation rho_y reached +-90 deg",
-    STATUS_NOT_FINITE: "the state became non-finite (the integration diverged)",
-    STATUS_CONTROL_FAILED: "the control law or a loop stage returned a failure status",
-}
 
 
 def chunk_steps(*multiples: int) -> int:
@@ -47,7 +39,7 @@ def run_attributes(plant, scenario, kind: str, status: int, t_fail: float, wall:
     """Dataset attributes of a run: configs as JSON, version, status and timing."""
     message = ""
     if status:
-        message = f"simulation stopped at t = {t_fail:.6g} s: {FAILURES[status]}"
+        message = f"simulation stopped at t = {t_fail:.6g} s: {status_message(status)}"
     return {
         "title": f"flexsat {kind} run '{scenario.name}' of '{plant.config.name}'",
         "flexsat_version": __version__,

@@ -17,10 +17,9 @@ from numba import njit
 from numba.core.errors import NumbaExperimentalFeatureWarning
 
 from flexsat.dynamics.integrators import rk4_step
-from flexsat.dynamics.kernels import STATUS_OK
+from flexsat.dynamics.status import STATUS_CONTROL_FAILED, STATUS_OK
 
 __all__ = [
-    "STATUS_CONTROL_FAILED",
     "LoopClock",
     "LoopData",
     "LoopRecords",
@@ -29,8 +28,6 @@ __all__ = [
     "run_closed_loop",
 ]
 
-STATUS_CONTROL_FAILED = 100
-"""A law or a stage returned a non-zero status."""
 
 
 class LoopClock(NamedTuple):

@@ -46,19 +46,17 @@ def initial_state(plant: Plant, scenario: OpenLoopScenario) -> tuple[np.ndarray,
     q[3:6] = np.radians(init.attitude_deg)
     omega_B = np.radians(init.rate_deg_s)
     qd[3:6] = np.array(euler_rate_matrix_inv(q[3], q[4])) @ omega_B  # Theta_dot = S^-1 omega
-    names = [a.name for a in plant.config.appendages]
-    for app in init.appendages:
-        if app.name not in names:
-            raise ConfigError(
-                f"initial.appendages: unknown appendage {app.name!r} (the satellite has "
-                f"{', '.join(names)})"
-            )
-        o = 6 + 6 * names.index(app.name)
-        q[o : o + 3] = app.eta_m
-        q[o + 3 : o + 6] = np.radians(app.rho_deg)
-        qd[o : o + 3] = app.eta_rate_m_s
-        # Relative rate given as ZYX angle rates [deg/s].
-        qd[o + 3 : o + 6] = np.radians(app.rho_rate_deg_s)
+    configs = {a.name: (a, m) for a, m in zip(plant.config.appendages, plant.models, strict=True)}
+    for entry in init.appendages:
+        try:
+            block = plant.layout.block(entry.name)
+        except KeyError as exc:
+            raise ConfigError(f"initial.appendages: {exc.args[0]}") from None
+        config, model = configs[entry.name]
+        try:
+            q[block.slice], qd[block.slice] = model.initial_state(config, entry)
+        except ValueError as exc:
+            raise ConfigError(str(exc)) from None
     return q, qd
 
 
@@ -106,7 +104,7 @@ def run_openloop(
     else:
         t, X, tau, status, t_fail, steps = _run_dop853(plant, scenario, q0, qd0, profile)
     wall = time.perf_counter() - start
-    n = plant.n_dof
+    lay = plant.layout
     seg_start, seg_end, seg_torque, _ = profile
     tau_cmd = np.array(
         [applied_torque(tk, seg_start, seg_end, seg_torque, np.zeros(3)) for tk in t]
@@ -114,17 +112,17 @@ def run_openloop(
     attrs = run_attributes(plant, scenario, "open-loop", status, t_fail, wall, steps)
     attrs["solver"] = scenario.solver
     dataset = build_dataset(
-        plant, t, X[:, :n], X[:, n : 2 * n], X[:, 2 * n], X[:, 2 * n + 1], tau_cmd, tau, attrs
-    )
+        plant, t, X[:, lay.q], X[:, lay.qd], X[:, lay.work_in], X[:, lay.dissipated], tau_cmd,
+        tau, attrs,
+    )  # fmt: skip
     return Result(dataset)
 
 
 def _run_rk4(plant, scenario, q0, qd0, profile, progress):
-    n = plant.n_dof
     n_steps, every, dt = scenario.n_steps, scenario.record_every, scenario.dt_s
     n_records = n_steps // every + 1
     rec_t = np.empty(n_records)
-    rec_x = np.empty((n_records, 2 * n + 2))
+    rec_x = np.empty((n_records, plant.layout.size))
     rec_tau = np.empty((n_records, 3))
     x = np.concatenate([q0, qd0, [0.0, 0.0]])
     rec_t[0], rec_x[0] = 0.0, x
@@ -136,7 +134,7 @@ def _run_rk4(plant, scenario, q0, qd0, profile, progress):
         while done < n_steps and status == 0:
             steps = min(chunk, n_steps - done)
             status, ran = rk4_open_loop(
-                x, done * dt, dt, steps, every, *profile, plant.dynamics_args,
+                x, done * dt, dt, steps, every, *profile, plant.packed,
                 rec_t, rec_x, rec_tau, done // every + 1,
             )  # fmt: skip
             done += ran
@@ -191,7 +189,7 @@ def _run_dop853(plant, scenario, q0, qd0, profile):
             nonlocal evaluations, kernel_status
             evaluations += 1
             dy = np.empty_like(y)
-            code = augmented_derivative(y, torque, n, Q, dy, plant.dynamics_args)
+            code = augmented_derivative(y, torque, n, Q, dy, plant.packed)
             if code != STATUS_OK:  # a joint's singularity: make the step fail here
                 kernel_status = code
                 dy[:] = np.nan

@@ -98,20 +98,21 @@ def build_dataset(
     H_rigid = np.empty((m, 3))
     kinetic = np.empty(m)
     elastic = np.empty(m)
-    tips = np.empty((m, n_app, 3))
+    tips = np.zeros((m, n_app, 3))
     rotations = Rotation.from_euler("ZYX", q[:, 5:2:-1])  # R_NB = Rz(psi) Ry(theta) Rx(phi)
     # A diverged run keeps its last finite state, whose derived values may overflow.
     with np.errstate(over="ignore", invalid="ignore"):
         derive_records(
             np.ascontiguousarray(q), np.ascontiguousarray(qd), np.ascontiguousarray(tau_applied),
-            plant.dynamics_args, plant.tip_point,
-            omega, omega_dot, tau_flex, H, H_rigid, kinetic, elastic, tips,
+            plant.packed, omega, omega_dot, tau_flex, H, H_rigid, kinetic, elastic, tips,
         )  # fmt: skip
     total = kinetic + elastic
     quat_scalar_last = rotations.as_quat()
     quaternion = np.column_stack([quat_scalar_last[:, 3], quat_scalar_last[:, :3]])
-    flex = q[:, 6:].reshape(m, n_app, 6)
-    flex_rate = qd[:, 6:].reshape(m, n_app, 6)
+    # Root motion per appendage, as its model defines it.
+    blocks = list(zip(plant.models, plant.layout.blocks, strict=True))
+    root = [model.root_motion(q[:, b.slice]) for model, b in blocks]
+    root_rate = [model.root_motion(qd[:, b.slice]) for model, b in blocks]
 
     def var(dims, data, units, description):
         return (dims, data, {"units": units, "description": description})
@@ -126,10 +127,10 @@ def build_dataset(
         ),
         "omega": var(ta, omega, "rad/s", "hub body rate, frame B"),
         "omega_dot": var(ta, omega_dot, "rad/s^2", "hub angular acceleration, frame B"),
-        "eta": var(tpa, flex[:, :, :3], "m", "root translation, mount frame"),
-        "rho": var(tpa, flex[:, :, 3:], "rad", "root rotation (ZYX angles), mount frame"),
-        "eta_rate": var(tpa, flex_rate[:, :, :3], "m/s", "root translation rate"),
-        "rho_rate": var(tpa, flex_rate[:, :, 3:], "rad/s", "root rotation angle rates"),
+        "eta": var(tpa, _stack(root, 0, m), "m", "root translation, mount frame"),
+        "rho": var(tpa, _stack(root, 1, m), "rad", "root rotation (ZYX angles), mount frame"),
+        "eta_rate": var(tpa, _stack(root_rate, 0, m), "m/s", "root translation rate"),
+        "rho_rate": var(tpa, _stack(root_rate, 1, m), "rad/s", "root rotation angle rates"),
         "tip_displacement": var(tpa, tips, "m", "panel tip displacement, mount frame"),
         "tau_cmd": var(ta, tau_cmd, "N m", "commanded body torque, frame B"),
         "tau_applied": var(ta, tau_applied, "N m", "applied body torque, frame B"),
@@ -160,4 +161,9 @@ def build_dataset(
         "dof": plant.dof_names(),
     }
     return xr.Dataset(data_vars, coords=coords, attrs=attrs)
+
+
+def _stack(per_appendage: list[tuple[np.ndarray, np.ndarray]], k: int, m: int) -> np.ndarray:
+    """Part k of each appendage's (eta, rho) pair as one (m, n, 3) array."""
+    return np.stack([pair[k] for pair in per_appendage], axis=1).reshape(m, -1, 3)
 

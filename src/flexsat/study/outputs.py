@@ -67,22 +67,18 @@ def derived_properties(plant: Plant) -> dict:
     Returns
     -------
     dict
-        ``hub_inertia_kg_m2`` (3x3), and per appendage ``mass_kg``,
-        ``centroidal_inertia_kg_m2`` (3x3), ``stiffness`` and ``damping`` (6 joint
-        DOFs in the order of :meth:`Plant.dof_names`; N m/rad, N m s/rad for
-        rotations, N/m, N s/m for translations).
+        ``hub_inertia_kg_m2`` (3x3), and per appendage its name, model and what its
+        model describes (a plate: ``mass_kg``, ``centroidal_inertia_kg_m2`` (3x3),
+        ``stiffness`` and ``damping`` (6 joint DOFs in the order of
+        :meth:`Plant.dof_names`; N m/rad, N m s/rad for rotations, N/m, N s/m for
+        translations)).
     """
     return {
         "hub_inertia_kg_m2": plant.hub_J.tolist(),
         "appendages": [
-            {
-                "name": app_cfg.name,
-                "mass_kg": float(plant.panel_mass[i]),
-                "centroidal_inertia_kg_m2": plant.panel_J[i].tolist(),
-                "stiffness": plant.stiffness[i].tolist(),
-                "damping": plant.damping[i].tolist(),
-            }
-            for i, app_cfg in enumerate(plant.config.appendages)
+            {"name": app.name, "model": model.name, **model.describe(app, params)}
+            for app, model, params in zip(plant.config.appendages, plant.models, plant.params,
+                                          strict=True)
         ],
     }
 

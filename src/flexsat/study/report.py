@@ -186,14 +186,16 @@ def _matrix(src: _Source, rows: range, cols: range, caption: str) -> str:
 def _model(root: Path, outputs: dict, context: dict) -> str:
     src = _Source(root, outputs["json"])
     M = np.asarray(src.get("mass_matrix"))
-    n_app = (M.shape[0] - 6) // 6
+    # Each appendage's coordinates are the DOFs named "<appendage>.<coordinate>".
+    blocks: dict[str, list[int]] = {}
+    for j, name in enumerate(src.get("dof_names")[6:], start=6):
+        blocks.setdefault(name.split(".", 1)[0], []).append(j)
     parts = [
         "<p>The mass matrix M(q) at q = 0 (thesis appendix B), in the DOF order "
         f"{_esc(', '.join(src.get('dof_names')))}; and the rigid design inertia.</p>"
     ]
     parts.append(_matrix(src, range(6), range(6), "M(0) hub block, eq. B.2"))
-    for k in range(n_app):
-        cols = range(6 + 6 * k, 12 + 6 * k)
+    for k, cols in enumerate(blocks.values()):
         parts.append(_matrix(src, range(6), cols, f"M(0) hub–appendage {k + 1} coupling"))
         parts.append(_matrix(src, cols, cols, f"M(0) appendage {k + 1} block"))
     if context["nominal"]:

@@ -1,0 +1,31 @@
+"""Appendage models: the contract, the registry and the built-in models.
+
+The thesis's plate on its 6-DOF root joint (:mod:`.plate`) is registered here; a
+user's model is registered the same way, from the user's own file.
+"""
+
+from flexsat.dynamics.appendages.contract import (
+    AppendageKernels,
+    AppendageModel,
+    Coordinate,
+    RigidBody,
+)
+from flexsat.dynamics.appendages.plate import PlateModel
+from flexsat.dynamics.appendages.registry import (
+    appendage_model,
+    appendage_model_names,
+    register_appendage_model,
+)
+
+register_appendage_model(PlateModel())
+
+__all__ = [
+    "AppendageKernels",
+    "AppendageModel",
+    "Coordinate",
+    "PlateModel",
+    "RigidBody",
+    "appendage_model",
+    "appendage_model_names",
+    "register_appendage_model",
+]

@@ -1,0 +1,546 @@
+"""The thesis's appendage: a rigid thin plate on a 6-DOF elastic root joint.
+
+Coordinates (six per plate, thesis eq. 2.1)::
+
+    eta (3)   root translation, mount frame M_i [m]
+    rho (3)   root rotation, ZYX angles (eta_r) [rad]
+
+Kinematics are exact: the panel rotation relative to its mount is
+R_MP = Rz(rho_z) Ry(rho_y) Rx(rho_x) with relative body rate S(rho) rho_dot (the
+thesis writes rho_dot, the small-angle form of eq. 2.31; see docs/model.md).
+
+Because the plate hangs on a full 6-DOF joint, its joint wrench does not depend on
+the hub's acceleration: it transmits no articulated inertia, and each plate's
+absolute accelerations follow from its own Newton-Euler equations under the joint
+wrench (pass 1), the hub's from its own equations (the engine), and q_ddot from the
+relative kinematics (pass 2). Cost is linear in the number of plates.
+
+Compiled with ``error_model="numpy"`` (see :mod:`flexsat.dynamics.kernels`): no
+divisor can be zero, masses are validated positive and ``cos(rho_y)`` is checked
+against ``MIN_COS`` before any ``euler_rate_matrix_inv``.
+"""
+
+from __future__ import annotations
+
+from math import cos
+from typing import ClassVar
+
+import numpy as np
+from numba import njit
+from scipy.spatial.transform import Rotation
+
+from flexsat.config.models import AppendageConfig
+from flexsat.dynamics.appendages.contract import (
+    BIAS_SIGNATURE,
+    HUB_ACC,
+    HUB_ALPHA,
+    HUB_DISSIPATION,
+    HUB_FORCE,
+    HUB_OMEGA,
+    HUB_SBIAS,
+    HUB_TORQUE,
+    MASS_SIGNATURE,
+    OBS_DISSIPATION,
+    OBS_ELASTIC,
+    OBS_KINETIC,
+    OBS_LOCKED_INERTIA,
+    OBS_MOMENTUM,
+    OBSERVE_SIGNATURE,
+    PASS1_SIGNATURE,
+    PASS2_SIGNATURE,
+    TIPS_SIGNATURE,
+    WRENCH_SIGNATURE,
+    AppendageKernels,
+    AppendageModel,
+    Coordinate,
+    RigidBody,
+)
+from flexsat.dynamics.linalg3 import (
+    add,
+    add_block,
+    cross,
+    dot,
+    euler_rate_bias,
+    euler_rate_matrix,
+    euler_rate_matrix_inv,
+    load_m33_at,
+    load_seg,
+    mm,
+    mtm,
+    mtv,
+    mv,
+    rot_zyx,
+    scale,
+    scale_m,
+    skew,
+    sub,
+    transpose,
+)
+from flexsat.dynamics.status import STATUS_JOINT_GIMBAL_LOCK, STATUS_OK
+from flexsat.dynamics.tuning import tune_joints
+
+__all__ = ["JOINT_DOFS", "PlateModel"]
+
+JOINT_DOFS = ("eta_x", "eta_y", "eta_z", "eta_rx", "eta_ry", "eta_rz")
+_UNITS = ("m", "m", "m", "rad", "rad", "rad")
+
+# Packed parameter row of one plate.
+P_MOUNT = 0  # (3) r_m, root position in B [m]
+P_R_BM = 3  # (9) R_BM, mount frame M_i -> hub frame B (includes the SADM angle), row-major
+P_COM = 12  # (3) d_Gp, root -> panel centre of mass, panel frame P_i [m]
+P_MASS = 15  # (1) panel mass M_p [kg]
+P_J = 16  # (9) panel inertia about G_p in P_i [kg m^2]
+P_J_INV = 25  # (9) its inverse
+P_K = 34  # (6) joint stiffness per DOF [N/m, N m/rad] (eq. 2.14)
+P_C = 40  # (6) joint damping per DOF [N s/m, N m s/rad] (eq. 2.15)
+P_TIP = 46  # (3) panel tip (mid-chord of the free edge), panel frame [m]
+N_PARAMS = 49
+
+MIN_COS = 1e-9  # |cos(rho_y)| below this is treated as gimbal lock
+
+
+@njit(cache=True, error_model="numpy")
+def _pose(q, o, p):
+    """Pose of the plate whose coordinates start at q[o], relative to the hub, in B.
+
+    Returns R_BM, R_MP (panel -> mount), R_BP (panel -> hub), S(rho), r_P (root
+    position) and r_G (panel centre of mass), both from the hub centre of mass [m].
+    """
+    rho = load_seg(q, o + 3)
+    R_BM = load_m33_at(p, P_R_BM)
+    R_MP = rot_zyx(rho[0], rho[1], rho[2])
+    R_BP = mm(R_BM, R_MP)
+    S_rho = euler_rate_matrix(rho[0], rho[1])
+    r_P = add(load_seg(p, P_MOUNT), mv(R_BM, load_seg(q, o)))
+    r_G = add(r_P, mv(R_BP, load_seg(p, P_COM)))
+    return R_BM, R_MP, R_BP, S_rho, r_P, r_G
+
+
+@njit(cache=True, error_model="numpy")
+def _rates(qd, o, p, R_BM, R_BP, S_rho):
+    """Relative rates: omega_rel_P (panel frame) and the B-frame rate of r_G."""
+    omega_rel_P = mv(S_rho, load_seg(qd, o + 3))
+    rdot_G_rel = add(
+        mv(R_BM, load_seg(qd, o)),
+        mv(R_BP, cross(omega_rel_P, load_seg(p, P_COM))),
+    )
+    return omega_rel_P, rdot_G_rel
+
+
+@njit(cache=True, error_model="numpy")
+def _joint_wrench(q, qd, Q, o, p):
+    """Joint wrench on the plate from its elastic, damping and external generalized forces.
+
+    By virtual work the 6 generalized forces on (eta, rho) are a force F_M at the
+    root (mount frame) and a torque N_P (panel frame) on the panel, with the
+    opposite pair on the hub: F_M = Q_eta, N_P = S(rho)^-T Q_rho.
+    Returns F_M, N_P, S(rho)^-1 and a status flag (S(rho)^-1 is undefined on a
+    gimbal lock).
+    """
+    k, c = P_K, P_C
+    Q_eta = (
+        Q[o] - p[k] * q[o] - p[c] * qd[o],
+        Q[o + 1] - p[k + 1] * q[o + 1] - p[c + 1] * qd[o + 1],
+        Q[o + 2] - p[k + 2] * q[o + 2] - p[c + 2] * qd[o + 2],
+    )
+    Q_rho = (
+        Q[o + 3] - p[k + 3] * q[o + 3] - p[c + 3] * qd[o + 3],
+        Q[o + 4] - p[k + 4] * q[o + 4] - p[c + 4] * qd[o + 4],
+        Q[o + 5] - p[k + 5] * q[o + 5] - p[c + 5] * qd[o + 5],
+    )
+    if abs(cos(q[o + 4])) < MIN_COS:
+        undefined = ((0.0, 0.0, 0.0), (0.0, 0.0, 0.0), (0.0, 0.0, 0.0))
+        return Q_eta, Q_rho, undefined, STATUS_JOINT_GIMBAL_LOCK
+    S_inv = euler_rate_matrix_inv(q[o + 3], q[o + 4])
+    return Q_eta, mtv(S_inv, Q_rho), S_inv, STATUS_OK
+
+
+@njit(cache=True, error_model="numpy")
+def _add_hub_wrench(out, f, r_P, R_BM, R_BP, F_M, N_P):
+    """Subtract the joint's reaction from the hub wrench at out[f:f+6]; returns F_B.
+
+    out[f:f+3] -= F_B and out[f+3:f+6] -= r_P x F_B + R_BP N_P (in that order).
+    """
+    F_B = mv(R_BM, F_M)
+    arm = cross(r_P, F_B)
+    turn = mv(R_BP, N_P)
+    for a in range(3):
+        out[f + a] = out[f + a] - F_B[a]
+        out[f + 3 + a] = (out[f + 3 + a] - arm[a]) - turn[a]
+    return F_B
+
+
+# Scratch row that pass 1 leaves for pass 2 (terms that depend on q and q_dot only).
+W_R_BP = 0  # (9) R_BP, row-major
+W_R_G = 9  # (3) r_G [m], frame B
+W_OMEGA_REL = 12  # (3) omega_rel_P [rad/s]
+W_RDOT_G = 15  # (3) B-frame rate of r_G [m/s]
+W_S_INV = 18  # (9) S(rho)^-1, row-major
+W_RHO_BIAS = 27  # (3) S_dot(rho) rho_dot
+WORK_SIZE = 30
+
+
+@njit(cache=True, error_model="numpy")
+def _store(w, k, v):
+    w[k], w[k + 1], w[k + 2] = v
+
+
+@njit(cache=True, error_model="numpy")
+def _store_m33(w, k, m):
+    for a in range(3):
+        w[k + 3 * a], w[k + 3 * a + 1], w[k + 3 * a + 2] = m[a]
+
+
+@njit(PASS1_SIGNATURE, cache=True, error_model="numpy")
+def pass1(q, qd, Q, members, params, work, hub, qdd):
+    """Joint wrenches -> panel absolute accelerations and the reaction on the hub.
+
+    Writes the panel's absolute accelerations a_G (B) and alpha_P (P) into its rows
+    of ``qdd`` and its pose and rate terms into its ``work`` row for :func:`pass2`.
+    """
+    omega_B = load_seg(hub, HUB_OMEGA)
+    force_B = load_seg(hub, HUB_FORCE)
+    torque_B = load_seg(hub, HUB_TORQUE)
+    dissipated = hub[HUB_DISSIPATION]
+    for j in range(members.shape[0]):
+        o = members[j, 1]
+        p = params[j]
+        w = work[j]
+        R_BM, R_MP, R_BP, S_rho, r_P, r_G = _pose(q, o, p)
+        omega_rel_P, rdot_G_rel = _rates(qd, o, p, R_BM, R_BP, S_rho)
+        F_M, N_P, S_inv, status = _joint_wrench(q, qd, Q, o, p)
+        if status != STATUS_OK:
+            return status
+        F_B = mv(R_BM, F_M)
+        force_B = sub(force_B, F_B)
+        torque_B = sub(sub(torque_B, cross(r_P, F_B)), mv(R_BP, N_P))
+        # Panel Newton-Euler about its centre of mass G (the root force acts at -d from G).
+        d = load_seg(p, P_COM)
+        J_p = load_m33_at(p, P_J)
+        omega_P = add(mtv(R_BP, omega_B), omega_rel_P)
+        moment_P = add(N_P, cross(scale(-1.0, d), mtv(R_MP, F_M)))
+        alpha_P = mv(load_m33_at(p, P_J_INV), sub(moment_P, cross(omega_P, mv(J_p, omega_P))))
+        a_G = scale(1.0 / p[P_MASS], F_B)
+        qdd[o], qdd[o + 1], qdd[o + 2] = a_G
+        qdd[o + 3], qdd[o + 4], qdd[o + 5] = alpha_P
+        for k in range(6):
+            v = qd[o + k]
+            dissipated += p[P_C + k] * v * v  # q_dot^T C q_dot (eq. 2.36)
+        _store_m33(w, W_R_BP, R_BP)
+        _store(w, W_R_G, r_G)
+        _store(w, W_OMEGA_REL, omega_rel_P)
+        _store(w, W_RDOT_G, rdot_G_rel)
+        _store_m33(w, W_S_INV, S_inv)
+        _store(w, W_RHO_BIAS, euler_rate_bias(q[o + 3], q[o + 4], qd[o + 3], qd[o + 4], qd[o + 5]))
+    hub[HUB_FORCE], hub[HUB_FORCE + 1], hub[HUB_FORCE + 2] = force_B
+    hub[HUB_TORQUE], hub[HUB_TORQUE + 1], hub[HUB_TORQUE + 2] = torque_B
+    hub[HUB_DISSIPATION] = dissipated
+    return STATUS_OK
+
+
+@njit(PASS2_SIGNATURE, cache=True, error_model="numpy")
+def pass2(q, qd, members, params, work, hub, qdd):
+    """Relative accelerations of each joint from the absolute ones left by :func:`pass1`."""
+    omega_B = load_seg(hub, HUB_OMEGA)
+    a_hub_B = load_seg(hub, HUB_ACC)
+    omega_dot_B = load_seg(hub, HUB_ALPHA)
+    for j in range(members.shape[0]):
+        o = members[j, 1]
+        p = params[j]
+        w = work[j]
+        R_BM = load_m33_at(p, P_R_BM)
+        R_BP = load_m33_at(w, W_R_BP)
+        r_G = load_seg(w, W_R_G)
+        omega_rel_P = load_seg(w, W_OMEGA_REL)
+        rdot_G_rel = load_seg(w, W_RDOT_G)
+        a_G = load_seg(qdd, o)
+        alpha_P = load_seg(qdd, o + 3)
+        omega_dot_rel = add(
+            sub(alpha_P, mtv(R_BP, omega_dot_B)), cross(omega_rel_P, mtv(R_BP, omega_B))
+        )
+        rho_bias = load_seg(w, W_RHO_BIAS)
+        rho_dd = mv(load_m33_at(w, W_S_INV), sub(omega_dot_rel, rho_bias))
+        d = load_seg(p, P_COM)
+        a_rel_rot = mv(
+            R_BP, add(cross(omega_dot_rel, d), cross(omega_rel_P, cross(omega_rel_P, d)))
+        )
+        transport = add(
+            add(a_hub_B, cross(omega_dot_B, r_G)),
+            add(cross(omega_B, cross(omega_B, r_G)), scale(2.0, cross(omega_B, rdot_G_rel))),
+        )
+        eta_dd = mtv(R_BM, sub(sub(a_G, transport), a_rel_rot))
+        qdd[o], qdd[o + 1], qdd[o + 2] = eta_dd
+        qdd[o + 3], qdd[o + 4], qdd[o + 5] = rho_dd
+    return STATUS_OK
+
+
+@njit(MASS_SIGNATURE, cache=True, error_model="numpy")
+def mass_matrix(q, members, params, M):
+    """The plates' share of M(q) (eq. 2.39), from their velocity Jacobians::
+
+        v_G = R_BN r_dot - [r_G]x S Theta_dot + R_BM eta_dot - R_BP [d]x S(rho) rho_dot
+        w_P = R_BP^T S Theta_dot + S(rho) rho_dot
+    """
+    R_NB = rot_zyx(q[3], q[4], q[5])
+    S = euler_rate_matrix(q[3], q[4])
+    identity = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
+    for j in range(members.shape[0]):
+        o = members[j, 1]
+        p = params[j]
+        m = p[P_MASS]
+        J_p = load_m33_at(p, P_J)
+        R_BM, R_MP, R_BP, S_rho, r_P, r_G = _pose(q, o, p)
+        A_theta = scale_m(-1.0, mm(skew(r_G), S))
+        A_rho = scale_m(-1.0, mm(R_BP, mm(skew(load_seg(p, P_COM)), S_rho)))
+        B_theta = mtm(R_BP, S)
+        add_block(M, 0, 0, identity, m)
+        add_block(M, 0, 3, mm(R_NB, A_theta), m)
+        add_block(M, 0, o, mm(R_NB, R_BM), m)
+        add_block(M, 0, o + 3, mm(R_NB, A_rho), m)
+        add_block(M, 3, 3, mtm(A_theta, A_theta), m)
+        add_block(M, 3, 3, mtm(B_theta, mm(J_p, B_theta)), 1.0)
+        add_block(M, 3, o, mtm(A_theta, R_BM), m)
+        add_block(M, 3, o + 3, mtm(A_theta, A_rho), m)
+        add_block(M, 3, o + 3, mtm(B_theta, mm(J_p, S_rho)), 1.0)
+        add_block(M, o, o, identity, m)
+        add_block(M, o, o + 3, mtm(R_BM, A_rho), m)
+        add_block(M, o + 3, o + 3, mtm(A_rho, A_rho), m)
+        add_block(M, o + 3, o + 3, mtm(S_rho, mm(J_p, S_rho)), 1.0)
+
+
+@njit(BIAS_SIGNATURE, cache=True, error_model="numpy")
+def bias_forces(q, qd, members, params, hub, h):
+    """The plates' share of h(q, q_dot) (eq. 2.43): Kane's inertia forces at q_ddot = 0."""
+    R_NB = rot_zyx(q[3], q[4], q[5])
+    omega_B = load_seg(hub, HUB_OMEGA)
+    s_bias = load_seg(hub, HUB_SBIAS)
+    for j in range(members.shape[0]):
+        o = members[j, 1]
+        p = params[j]
+        R_BM, R_MP, R_BP, S_rho, r_P, r_G = _pose(q, o, p)
+        omega_rel_P, rdot_G_rel = _rates(qd, o, p, R_BM, R_BP, S_rho)
+        d = load_seg(p, P_COM)
+        J_p = load_m33_at(p, P_J)
+        rho_bias = euler_rate_bias(q[o + 3], q[o + 4], qd[o + 3], qd[o + 4], qd[o + 5])
+        a0 = add(
+            add(cross(s_bias, r_G), cross(omega_B, cross(omega_B, r_G))),
+            add(
+                scale(2.0, cross(omega_B, rdot_G_rel)),
+                mv(R_BP, add(cross(rho_bias, d), cross(omega_rel_P, cross(omega_rel_P, d)))),
+            ),
+        )
+        omega_B_P = mtv(R_BP, omega_B)
+        alpha0 = sub(add(mtv(R_BP, s_bias), rho_bias), cross(omega_rel_P, omega_B_P))
+        omega_P = add(omega_B_P, omega_rel_P)
+        f_B = scale(p[P_MASS], a0)
+        g_P = add(mv(J_p, alpha0), cross(omega_P, mv(J_p, omega_P)))
+        f_N = mv(R_NB, f_B)
+        t_B = add(cross(r_G, f_B), mv(R_BP, g_P))
+        for a in range(3):
+            hub[HUB_FORCE + a] += f_N[a]
+            hub[HUB_TORQUE + a] += t_B[a]
+        h[o], h[o + 1], h[o + 2] = mtv(R_BM, f_B)
+        h[o + 3], h[o + 4], h[o + 5] = mtv(S_rho, add(cross(d, mtv(R_BP, f_B)), g_P))
+
+
+@njit(OBSERVE_SIGNATURE, cache=True, error_model="numpy")
+def observe(q, qd, members, params, out):
+    """Add the plates' kinetic energy, momentum, locked inertia, elastic energy, damper power."""
+    R_NB = rot_zyx(q[3], q[4], q[5])
+    r_hub = load_seg(q, 0)
+    omega_B = mv(euler_rate_matrix(q[3], q[4]), load_seg(qd, 3))
+    v_hub_B = mtv(R_NB, load_seg(qd, 0))
+    for j in range(members.shape[0]):
+        o = members[j, 1]
+        p = params[j]
+        m = p[P_MASS]
+        J_p = load_m33_at(p, P_J)
+        R_BM, R_MP, R_BP, S_rho, r_P, r_G = _pose(q, o, p)
+        omega_rel_P, rdot_G_rel = _rates(qd, o, p, R_BM, R_BP, S_rho)
+        v_G = add(add(v_hub_B, cross(omega_B, r_G)), rdot_G_rel)
+        omega_P = add(mtv(R_BP, omega_B), omega_rel_P)
+        out[OBS_KINETIC] += 0.5 * m * dot(v_G, v_G)  # eqs. 2.32-2.34
+        out[OBS_KINETIC] += 0.5 * dot(omega_P, mv(J_p, omega_P))
+        p_G = add(r_hub, mv(R_NB, r_G))
+        linear = cross(p_G, scale(m, mv(R_NB, v_G)))
+        spin = mv(R_NB, mv(R_BP, mv(J_p, omega_P)))
+        for a in range(3):
+            out[OBS_MOMENTUM + a] += linear[a]
+        for a in range(3):
+            out[OBS_MOMENTUM + a] += spin[a]
+        J_B = mm(R_BP, mm(J_p, transpose(R_BP)))
+        r2 = dot(r_G, r_G)
+        for a in range(3):
+            for b in range(3):
+                out[OBS_LOCKED_INERTIA + 3 * a + b] += J_B[a][b] - m * r_G[a] * r_G[b]
+            out[OBS_LOCKED_INERTIA + 4 * a] += m * r2
+        for k in range(6):
+            out[OBS_ELASTIC] += 0.5 * p[P_K + k] * q[o + k] ** 2  # eq. 2.35
+            out[OBS_DISSIPATION] += p[P_C + k] * qd[o + k] ** 2  # eq. 2.36
+
+
+@njit(WRENCH_SIGNATURE, cache=True, error_model="numpy")
+def joint_wrench(q, qd, Q, members, params, out):
+    """Add the wrench the plates' joints exert on the hub (tau_flex in out[3:6])."""
+    for j in range(members.shape[0]):
+        o = members[j, 1]
+        p = params[j]
+        R_BM, R_MP, R_BP, S_rho, r_P, r_G = _pose(q, o, p)
+        F_M, N_P, S_inv, status = _joint_wrench(q, qd, Q, o, p)
+        if status != STATUS_OK:
+            return status
+        _add_hub_wrench(out, 0, r_P, R_BM, R_BP, F_M, N_P)
+    return STATUS_OK
+
+
+@njit(TIPS_SIGNATURE, cache=True, error_model="numpy")
+def tips(q, members, params, out):
+    """Tip displacement eta + (R_MP - I) tip of each plate, mount frame [m]."""
+    for j in range(members.shape[0]):
+        o = members[j, 1]
+        tip = load_seg(params[j], P_TIP)
+        R_MP = rot_zyx(q[o + 3], q[o + 4], q[o + 5])
+        moved = add(load_seg(q, o), sub(mv(R_MP, tip), tip))
+        i = members[j, 0]
+        out[i, 0], out[i, 1], out[i, 2] = moved
+
+
+def _scale_mass(table: dict, factor: float) -> None:
+    """Campaign path ``appendages[*].inertia``: scale the panel mass and so its inertia
+    (the joints are re-tuned to keep their target frequencies, as the thesis does)."""
+    field = "mass_kg" if table.get("mass_kg") is not None else "surface_density_kg_m2"
+    table[field] = table[field] * factor
+
+
+class PlateModel(AppendageModel):
+    """The thesis plate (:class:`flexsat.config.models.AppendageConfig`) on its 6-DOF root joint."""
+
+    name = "plate"
+    config_class = AppendageConfig
+    kernels = AppendageKernels(pass1, pass2, mass_matrix, bias_forces, observe, joint_wrench, tips)
+    transmits_inertia = False
+    modifiers: ClassVar[dict] = {"inertia": _scale_mass}
+    work_size = WORK_SIZE
+
+    def coordinates(self, config: AppendageConfig) -> tuple[Coordinate, ...]:
+        return tuple(Coordinate(n, u) for n, u in zip(JOINT_DOFS, _UNITS, strict=True))
+
+    def pack(self, config: AppendageConfig) -> np.ndarray:
+        sign = config.span_sign()
+        J = config.centroidal_inertia()
+        # R_BM = Rz(yaw) Ry(alpha_sadm): intrinsic Z then Y.
+        angles = np.radians([config.mount_yaw_deg, config.sadm_angle_deg])
+        row = np.zeros(N_PARAMS)
+        row[P_MOUNT : P_MOUNT + 3] = config.mount_point_m
+        row[P_R_BM : P_R_BM + 9] = Rotation.from_euler("ZY", angles).as_matrix().ravel()
+        row[P_COM : P_COM + 3] = (0.0, 0.5 * sign * config.length_m, 0.0)
+        row[P_MASS] = config.mass
+        row[P_J : P_J + 9] = J.ravel()
+        row[P_J_INV : P_J_INV + 9] = np.linalg.inv(J).ravel()
+        row[P_TIP : P_TIP + 3] = (0.0, sign * config.length_m, 0.0)
+        return row
+
+    def tune(self, config: AppendageConfig, params: np.ndarray, inertia_diag: np.ndarray
+             ) -> np.ndarray:  # fmt: skip
+        stiffness, damping = tune_joints(
+            inertia_diag, config.target_frequencies_hz.per_dof(), config.damping_ratio
+        )  # eqs. 2.14-2.15
+        return self.with_joints(params, stiffness, damping)
+
+    def stiffness(self, params: np.ndarray) -> np.ndarray:
+        return params[P_K : P_K + 6].copy()
+
+    def damping(self, params: np.ndarray) -> np.ndarray:
+        return params[P_C : P_C + 6].copy()
+
+    def with_joints(self, params: np.ndarray, stiffness: np.ndarray, damping: np.ndarray
+                    ) -> np.ndarray:  # fmt: skip
+        row = params.copy()
+        row[P_K : P_K + 6] = stiffness
+        row[P_C : P_C + 6] = damping
+        return row
+
+    def rigid_body(self, params: np.ndarray) -> RigidBody:
+        R_BM = self.mount_rotation(params)
+        r = params[P_MOUNT : P_MOUNT + 3] + R_BM @ params[P_COM : P_COM + 3]
+        J = params[P_J : P_J + 9].reshape(3, 3)
+        return RigidBody(float(params[P_MASS]), r, R_BM @ J @ R_BM.T)
+
+    def initial_state(self, config: AppendageConfig, entry) -> tuple[np.ndarray, np.ndarray]:
+        q = np.concatenate([entry.eta_m, np.radians(entry.rho_deg)])
+        # Relative rate given as ZYX angle rates [deg/s].
+        qd = np.concatenate([entry.eta_rate_m_s, np.radians(entry.rho_rate_deg_s)])
+        return q, qd
+
+    def describe(self, config: AppendageConfig, params: np.ndarray) -> dict:
+        return {
+            "mass_kg": float(params[P_MASS]),
+            "centroidal_inertia_kg_m2": params[P_J : P_J + 9].reshape(3, 3).tolist(),
+            "stiffness": self.stiffness(params).tolist(),
+            "damping": self.damping(params).tolist(),
+        }
+
+    def shape_points(self, config: AppendageConfig, params: np.ndarray, q_block: np.ndarray
+                     ) -> np.ndarray:  # fmt: skip
+        # x_B = r_m + R_BM (eta + R_MP x_P) for the corners, the root and the tip, with
+        # the corners spanning 0..L along +-Y_P and -W/2..W/2 along X_P (mid-plane).
+        w2, span = 0.5 * config.width_m, config.span_sign() * config.length_m
+        local = np.zeros((6, 3))
+        local[0:4, 0] = (-w2, w2, w2, -w2)
+        local[0:4, 1] = (0.0, 0.0, span, span)
+        local[5] = self.tip_point(params)
+        R_MP = Rotation.from_euler("ZYX", q_block[5:2:-1]).as_matrix()
+        in_mount = q_block[:3] + local @ R_MP.T
+        return params[P_MOUNT : P_MOUNT + 3] + in_mount @ self.mount_rotation(params).T
+
+    def extent(self, config: AppendageConfig) -> float:
+        return float(config.length_m)
+
+    def mode_kinds(self, config: AppendageConfig) -> tuple[str, ...]:
+        return ("translation", "translation", "translation", "flapping", "torsion", "in_plane")
+
+    def root_motion(self, q_block: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        return q_block[:, :3], q_block[:, 3:]
+
+    def mirror_block(self, params_i: np.ndarray, params_j: np.ndarray, reflect: np.ndarray,
+                     rtol: float) -> np.ndarray | None:  # fmt: skip
+        R_i, R_j = self.mount_rotation(params_i), self.mount_rotation(params_j)
+        mount_i, mount_j = params_i[P_MOUNT : P_MOUNT + 3], params_j[P_MOUNT : P_MOUNT + 3]
+        scale_ = max(1.0, float(np.max(np.abs(mount_i))), float(np.max(np.abs(mount_j))))
+        com_i = R_i @ params_i[P_COM : P_COM + 3]
+        com_j = R_j @ params_j[P_COM : P_COM + 3]
+        same = (
+            np.allclose(mount_j, reflect @ mount_i, atol=rtol * scale_)
+            and np.allclose(com_j, reflect @ com_i, atol=rtol * scale_)
+            and np.allclose(params_j[P_MASS : P_J + 9], params_i[P_MASS : P_J + 9], rtol=rtol)
+            and np.allclose(params_j[P_K : P_C + 6], params_i[P_K : P_C + 6], rtol=rtol)
+        )
+        if not same:
+            return None
+        T_eta = R_j.T @ reflect @ R_i
+        if not np.allclose(np.abs(T_eta), np.eye(3), atol=rtol):
+            return None  # joint axes must map onto joint axes
+        block = np.zeros((6, 6))
+        block[:3, :3] = T_eta
+        block[3:, 3:] = -T_eta  # axial vectors: det(T_eta) = -1
+        return block
+
+    @staticmethod
+    def mount_rotation(params: np.ndarray) -> np.ndarray:
+        """R_BM of a packed row, shape (3, 3)."""
+        return params[P_R_BM : P_R_BM + 9].reshape(3, 3)
+
+    @staticmethod
+    def mount_point(params: np.ndarray) -> np.ndarray:
+        """r_m, the root position in B of a packed row, shape (3,) [m]."""
+        return params[P_MOUNT : P_MOUNT + 3]
+
+    @staticmethod
+    def tip_point(params: np.ndarray) -> np.ndarray:
+        """The panel tip in panel frame, shape (3,) [m]."""
+        return params[P_TIP : P_TIP + 3]
+
+    @staticmethod
+    def com_offset(params: np.ndarray) -> np.ndarray:
+        """d_Gp, root -> panel centre of mass, panel frame, shape (3,) [m]."""
+        return params[P_COM : P_COM + 3]
