@@ -156,7 +156,9 @@ def body_frame_derivative(
     ])  # fmt: skip
 
 
-def output_map(plant: Plant, groups: Sequence[str]) -> Callable[[np.ndarray, np.ndarray], np.ndarray]:
+def output_map(
+    plant: Plant, groups: Sequence[str]
+) -> Callable[[np.ndarray, np.ndarray], np.ndarray]:
     """y(x, u) of the named output groups (see :data:`OUTPUT_GROUPS`), concatenated.
 
     Raises
@@ -166,7 +168,9 @@ def output_map(plant: Plant, groups: Sequence[str]) -> Callable[[np.ndarray, np.
     """
     for g in groups:
         if g not in OUTPUT_GROUPS:
-            raise ConfigError(f"outputs: unknown output {g!r} (allowed: {', '.join(OUTPUT_GROUPS)})")
+            raise ConfigError(
+                f"outputs: unknown output {g!r} (allowed: {', '.join(OUTPUT_GROUPS)})"
+            )
 
     def y(x: np.ndarray, torque_B: np.ndarray) -> np.ndarray:
         _, dTheta, eta, _, omega, _ = _split(plant, x)

@@ -162,7 +162,5 @@ def _indices(names: list[str] | None, allowed: tuple[str, ...], what: str) -> li
         raise ConfigError(f"{what}: give at least one name (allowed: {', '.join(allowed)})")
     unknown = [n for n in names if n not in allowed]
     if unknown:
-        raise ConfigError(
-            f"{what}: unknown name {unknown[0]!r} (allowed: {', '.join(allowed)})"
-        )
+        raise ConfigError(f"{what}: unknown name {unknown[0]!r} (allowed: {', '.join(allowed)})")
     return [allowed.index(n) for n in names]
