@@ -31,6 +31,8 @@ from flexsat.errors import ConfigError
 
 __all__ = ["MAT_VARIABLES", "LinearModel"]
 
+_BATCH = 256  # frequencies solved at once (stacked LAPACK calls)
+
 MAT_VARIABLES = (
     "A", "B", "C", "D", "x0", "u0", "spin",
     "state_names", "input_names", "output_names",
@@ -111,8 +113,12 @@ class LinearModel:
         f = np.atleast_1d(np.asarray(frequencies_hz, dtype=float))
         eye = np.eye(self.n_states)
         out = np.empty((f.size, self.C.shape[0], self.B.shape[1]), dtype=complex)
-        for k, fk in enumerate(f):
-            out[k] = self.C @ np.linalg.solve(2j * np.pi * fk * eye - self.A, self.B) + self.D
+        for k in range(0, f.size, _BATCH):
+            s = 2j * np.pi * f[k : k + _BATCH, None, None]
+            X = np.linalg.solve(
+                s * eye - self.A, np.broadcast_to(self.B, (s.shape[0], *self.B.shape))
+            )
+            out[k : k + _BATCH] = self.C @ X + self.D
         return out
 
     def to_statespace(self):
