@@ -191,6 +191,10 @@ def margins(
         Path | None,
         typer.Option(help="Slew scenario (TOML) with a PD controller. Default: PD defaults."),
     ] = None,
+    campaign: Annotated[
+        str | None,
+        typer.Option(help="Also the margins over a campaign's cases (preset name or TOML)."),
+    ] = None,
     json_output: JsonOption = False,
     out: Annotated[
         Path | None, typer.Option(help="Write margins.json and the loop figures here.")
@@ -200,12 +204,16 @@ def margins(
     from flexsat.config import load_config
     from flexsat.dynamics.plant import Plant
     from flexsat.simulate.scenario import load_slew
-    from flexsat.study.linear import write_margins
+    from flexsat.study.linear import family_margins, write_margins
 
     slew_scenario = None if scenario is None else load_slew(scenario)
     _announce_compilation()
     plant = Plant.from_config(load_config(config))
     summary = write_margins(plant, slew_scenario, out)
+    if campaign is not None:
+        family = family_margins(plant, campaign, slew_scenario, out)
+        summary["family"] = family["cases"]
+        summary["files"] = summary.get("files", []) + family.get("files", [])
     if json_output:
         typer.echo(json.dumps(jsonable(summary)))
         return
@@ -219,6 +227,13 @@ def margins(
             f"{m['delay_margin_s']:.3g}", f"{m['delay_crossover_hz']:.3g}",
         )  # fmt: skip
     _console.print(table)
+    if "family" in summary:
+        family = Table(title=f"Delay margin per case [s] — {campaign}")
+        for column in ("case", "x", "y", "z"):
+            family.add_column(column)
+        for case, axes in summary["family"].items():
+            family.add_row(case, *(f"{axes[a]['delay_margin_s']:.3g}" for a in "xyz"))
+        _console.print(family)
     for path in summary.get("files", []):
         _console.print(f"wrote {path}")
 

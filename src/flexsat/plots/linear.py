@@ -9,6 +9,7 @@ Drawn with the shared style (:mod:`flexsat.plots.style`), no pyplot.
 - :func:`plot_effective_inertia`: modal effective inertia per mode and axis.
 - :func:`plot_loops`: PD loop gain per axis with its margins, the flexible peaks
   marked; :func:`plot_nichols`: the same loops in the Nichols plane.
+- :func:`plot_loop_family`: the loop gains of a campaign's cases, one curve per case.
 - :func:`write_linear_figures`: all of them into a folder.
 """
 
@@ -28,6 +29,7 @@ __all__ = [
     "frequency_grid_hz",
     "plot_bode",
     "plot_effective_inertia",
+    "plot_loop_family",
     "plot_loops",
     "plot_nichols",
     "plot_pole_zero",
@@ -179,6 +181,29 @@ def plot_nichols(loops: dict[str, LinearModel]) -> Figure:
     ax.grid(True, color="0.88", linewidth=0.5)
     ax.legend(fontsize=8)
     fig.suptitle("Nichols plot of the PD loop gains (critical point at -180 deg, 0 dB)")
+    return fig
+
+
+def plot_loop_family(
+    loops: dict[str, dict[str, LinearModel]], margins: dict[str, dict[str, dict]]
+) -> Figure:
+    """Loop-gain magnitude per axis, one curve per case; the legend gives its delay margin."""
+    f = frequency_grid_hz()
+    fig, axes = style.figure(1, 3, size=(15.0, 5.5))
+    for a, axis in enumerate(style.AXES):
+        ax = axes[0, a]
+        for case, case_loops in loops.items():
+            L = case_loops[axis].frequency_response(f)[:, 0, 0]
+            dm = margins[case][axis]["delay_margin_s"]
+            ax.loglog(f, np.abs(L), linewidth=0.8, label=f"{case}: DM {dm:.3g} s")
+        ax.axhline(1.0, color="0.3", linewidth=0.8)
+        ax.set_title(f"axis {axis}")
+        ax.set_xlabel("frequency [Hz]")
+        ax.set_ylabel("|L| [-]")
+        ax.grid(True, which="both", color="0.88", linewidth=0.5)
+        if len(loops) <= 12:
+            ax.legend(fontsize=6)
+    fig.suptitle("PD loop gain over the campaign's cases (one curve per case)")
     return fig
 
 

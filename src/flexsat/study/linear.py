@@ -19,7 +19,13 @@ from flexsat.study.outputs import write_json
 if TYPE_CHECKING:
     from flexsat.dynamics.plant import Plant
 
-__all__ = ["parse_about", "parse_reduction", "write_linearize", "write_margins"]
+__all__ = [
+    "family_margins",
+    "parse_about",
+    "parse_reduction",
+    "write_linearize",
+    "write_margins",
+]
 
 _REDUCTIONS = ("modal", "balanced")
 
@@ -148,7 +154,6 @@ def write_margins(plant: Plant, scenario=None, out: Path | None = None) -> dict:
     ConfigError
         If the scenario's law is not PD (only PD is linearized so far).
     """
-    from flexsat.control.config import PDConfig
     from flexsat.linear import linearize
     from flexsat.linear.frequency import (
         effective_inertia,
@@ -158,11 +163,7 @@ def write_margins(plant: Plant, scenario=None, out: Path | None = None) -> dict:
         rigid_model,
     )
 
-    pd = PDConfig() if scenario is None else scenario.controller
-    if pd.kind != "pd":
-        raise ConfigError(
-            f"controller.kind: margins need the linearizable 'pd' law, the scenario has {pd.kind!r}"
-        )
+    pd = _pd_law(scenario)
     model = linearize(plant, outputs=["attitude", "rate"])
     K = pd_gains(plant, pd)
     loops = {axis: pd_loop(model, K, axis) for axis in "xyz"}
@@ -182,3 +183,57 @@ def write_margins(plant: Plant, scenario=None, out: Path | None = None) -> dict:
         files = write_linear_figures(out, model, rigid_model(plant), effective, loops, margins)
         summary["files"] = [str(p) for p in [write_json(out / "margins.json", summary), *files]]
     return summary
+
+
+def family_margins(
+    plant: Plant, campaign: str | Path, scenario=None, out: Path | None = None
+) -> dict:
+    """PD loop margins over every case of a campaign (sensitivity, Monte Carlo...).
+
+    Each case perturbs the truth plant; the controller keeps the design model of
+    ``plant`` (the campaign's base configuration), as in the campaigns. With ``out``,
+    ``margins_family.json`` and ``loop_family.png`` (one curve per case and axis).
+
+    Returns
+    -------
+    dict
+        ``cases``: one entry per case id with its margins per axis.
+    """
+    from flexsat.campaigns.definition import load_campaign, resolve_cases
+    from flexsat.config.models import SatelliteConfig
+    from flexsat.dynamics.plant import Plant
+    from flexsat.linear import linearize
+    from flexsat.linear.frequency import loop_margins, pd_gains, pd_loop
+
+    K = pd_gains(plant, _pd_law(scenario))
+    cases = resolve_cases(load_campaign(campaign), plant.config)
+    loops: dict[str, dict] = {}
+    table: dict[str, dict] = {}
+    for case in cases:
+        truth = Plant.from_config(SatelliteConfig.model_validate(case.plant))
+        model = linearize(truth, outputs=["attitude", "rate"])
+        loops[case.case_id] = {axis: pd_loop(model, K, axis) for axis in "xyz"}
+        table[case.case_id] = {
+            axis: loop_margins(loop).to_dict() for axis, loop in loops[case.case_id].items()
+        }
+    summary = {"config_name": plant.config.name, "campaign": str(campaign), "cases": table}
+    if out is not None:
+        from flexsat.plots.linear import plot_loop_family
+        from flexsat.plots.style import save_figure
+
+        out = Path(out)
+        figure = save_figure(plot_loop_family(loops, table), out / "loop_family.png", dpi=110)
+        json_path = write_json(out / "margins_family.json", summary)
+        summary["files"] = [str(json_path), str(figure)]
+    return summary
+
+
+def _pd_law(scenario):
+    from flexsat.control.config import PDConfig
+
+    pd = PDConfig() if scenario is None else scenario.controller
+    if pd.kind != "pd":
+        raise ConfigError(
+            f"controller.kind: margins need the linearizable 'pd' law, the scenario has {pd.kind!r}"
+        )
+    return pd
