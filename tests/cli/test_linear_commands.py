@@ -70,9 +70,10 @@ def test_bad_requests_exit_2_with_one_message(args, fragment):
     assert "Traceback" not in result.stderr
 
 
-def test_margins_refuses_a_law_it_cannot_linearize(tmp_path):
+def test_margins_of_a_sliding_mode_law_inside_its_boundary_layer(tmp_path):
     scenario = tmp_path / "slew.toml"
     scenario.write_text('[controller]\nkind = "smc"\n')
-    result = run("margins", "--scenario", str(scenario))
-    assert result.returncode == 2
-    assert "controller.kind" in result.stderr and "'smc'" in result.stderr
+    result = run("margins", "--scenario", str(scenario), "--json")
+    assert result.returncode == 0, result.stderr
+    summary = json.loads(result.stdout)
+    assert summary["law"] == "smc" and summary["gains"]["lambda"] == 1.0

@@ -1,11 +1,13 @@
-"""Effective inertia, the rigid reference model and the PD loop margins."""
+"""Effective inertia, the rigid reference model and the loop margins of the laws."""
 
 import numpy as np
 import pytest
 
+from flexsat.control.config import ASMCConfig, SMCConfig
 from flexsat.errors import ConfigError
 from flexsat.linear.frequency import (
     effective_inertia,
+    law_gains,
     loop_margins,
     pd_gains,
     pd_loop,
@@ -88,6 +90,30 @@ def test_pd_loop_rigid_crossover_and_flexible_delay_limit(loops):
         assert margins.delay_margin_s < 0.5
     rigid_delay = np.radians(pm) / w
     assert loop_margins(loops["y"]).delay_margin_s == pytest.approx(rigid_delay, rel=0.05)
+
+
+@pytest.mark.parametrize(
+    ("law", "lam", "jk", "shift"),
+    # defaults (thesis section 5.1); the allowed crossover shift by the flexible modes
+    # (see below): SMC crosses at 0.40 Hz, half the 0.82 Hz coupled torsion mode;
+    # the ASMC (Lambda = 5) at 0.66 Hz, close under it, and is pulled 11 % down.
+    [(SMCConfig(), 1.0, 0.8925, 0.05), (ASMCConfig(), 5.0, 0.8925, 0.15)],
+)
+def test_sliding_mode_loops_inside_the_boundary_layer(plant, rest_model, law, lam, jk, shift):
+    K = law_gains(plant, law)
+    phi = 0.01  # [rad/s] boundary layer
+    J = plant.locked_inertia(plant.zeros())  # = J_tot at rest
+    # tau = -Lambda J w/2 - (JK/Phi)(w + Lambda theta/2): rigid loop about Y, the
+    # axis with the least flexible coupling (J_eff 1.3 of 44 kg m^2):
+    # L = (k_t + k_w s) / (J_yy s^2) with k_t = JK Lambda / (2 Phi), k_w = Lambda J_yy/2 + JK/Phi.
+    k_t, k_w = jk * lam / (2 * phi), lam * J[1, 1] / 2 + jk / phi
+    np.testing.assert_allclose(K[1, [1, 4]], [k_t, k_w], rtol=1e-12)
+    # |L| = 1 at w^4 J^2 = k_t^2 + k_w^2 w^2
+    a = J[1, 1] ** 2
+    w2 = (k_w**2 + np.sqrt(k_w**4 + 4 * a * k_t**2)) / (2 * a)
+    margins = loop_margins(pd_loop(rest_model, K, "y"))
+    # The torsion modes (0.8 Hz) sit above the crossover and pull it down by `shift`.
+    assert margins.gain_crossover_hz == pytest.approx(np.sqrt(w2) / (2 * np.pi), rel=shift)
 
 
 def test_loop_of_an_unknown_axis_is_refused(plant, rest_model):

@@ -189,7 +189,7 @@ def margins(
     config: ConfigOption = None,
     scenario: Annotated[
         Path | None,
-        typer.Option(help="Slew scenario (TOML) with a PD controller. Default: PD defaults."),
+        typer.Option(help="Slew scenario (TOML): its law (pd, smc, asmc). Default: PD defaults."),
     ] = None,
     campaign: Annotated[
         str | None,
@@ -200,7 +200,7 @@ def margins(
         Path | None, typer.Option(help="Write margins.json and the loop figures here.")
     ] = None,
 ) -> None:
-    """Gain, phase and delay margins of the PD loop per axis, flexible modes included."""
+    """Gain, phase and delay margins of the control loop per axis, flexible modes included."""
     from flexsat.config import load_config
     from flexsat.dynamics.plant import Plant
     from flexsat.simulate.scenario import load_slew
@@ -217,7 +217,7 @@ def margins(
     if json_output:
         typer.echo(json.dumps(jsonable(summary)))
         return
-    table = Table(title=f"PD loop margins — {summary['config_name']}")
+    table = Table(title=f"{summary['law'].upper()} loop margins — {summary['config_name']}")
     for column in ("axis", "PM [deg]", "at [Hz]", "GM", "delay margin [s]", "at [Hz]"):
         table.add_column(column)
     for axis, m in summary["axes"].items():

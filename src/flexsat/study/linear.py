@@ -146,33 +146,28 @@ def write_margins(plant: Plant, scenario=None, out: Path | None = None) -> dict:
     ----------
     plant : Plant
     scenario : SlewScenario, optional
-        Its controller must be the PD law (the gains are taken from it); default:
-        the PD law's default gains.
-
-    Raises
-    ------
-    ConfigError
-        If the scenario's law is not PD (only PD is linearized so far).
+        Its controller (PD, SMC or ASMC) is linearized about rest, the sliding-mode
+        laws inside their boundary layer with Lambda and JK at their steady-state
+        values; default: the PD law's default gains.
     """
     from flexsat.linear import linearize
     from flexsat.linear.frequency import (
         effective_inertia,
+        law_gains,
         loop_margins,
-        pd_gains,
         pd_loop,
         rigid_model,
     )
 
-    pd = _pd_law(scenario)
+    law = _law(scenario)
     model = linearize(plant, outputs=["attitude", "rate"])
-    K = pd_gains(plant, pd)
+    K = law_gains(plant, law)
     loops = {axis: pd_loop(model, K, axis) for axis in "xyz"}
     margins = {axis: loop_margins(loop) for axis, loop in loops.items()}
     summary = {
         "config_name": plant.config.name,
-        "law": "pd",
-        "natural_frequency_rad_s": pd.natural_frequency_rad_s,
-        "damping_ratio": pd.damping_ratio,
+        "law": law.kind,
+        "gains": law.model_dump(mode="json", by_alias=True),
         "axes": {axis: m.to_dict() for axis, m in margins.items()},
     }
     if out is not None:
@@ -203,9 +198,9 @@ def family_margins(
     from flexsat.config.models import SatelliteConfig
     from flexsat.dynamics.plant import Plant
     from flexsat.linear import linearize
-    from flexsat.linear.frequency import loop_margins, pd_gains, pd_loop
+    from flexsat.linear.frequency import law_gains, loop_margins, pd_loop
 
-    K = pd_gains(plant, _pd_law(scenario))
+    K = law_gains(plant, _law(scenario))
     cases = resolve_cases(load_campaign(campaign), plant.config)
     loops: dict[str, dict] = {}
     table: dict[str, dict] = {}
@@ -228,12 +223,7 @@ def family_margins(
     return summary
 
 
-def _pd_law(scenario):
+def _law(scenario):
     from flexsat.control.config import PDConfig
 
-    pd = PDConfig() if scenario is None else scenario.controller
-    if pd.kind != "pd":
-        raise ConfigError(
-            f"controller.kind: margins need the linearizable 'pd' law, the scenario has {pd.kind!r}"
-        )
-    return pd
+    return PDConfig() if scenario is None else scenario.controller
