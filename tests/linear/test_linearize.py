@@ -39,7 +39,7 @@ def test_undamped_eigenvalues_are_the_modal_frequencies(plant):
     modal = modal_analysis(undamped).frequencies_hz[6:]  # thesis table 3.3 (coupled)
     linear = _flexible_frequencies_hz(model)
     # Same M(0), K; eig of the 36 x 36 first-order form vs eigh of the pencil: both
-    # backward stable, relative agreement ~1e-13; 1e-9 is the acceptance figure.
+    # backward stable; measured 1.2e-11 relative; 1e-9 is the acceptance figure.
     np.testing.assert_allclose(linear, modal, rtol=1e-9)
 
 
@@ -53,8 +53,9 @@ def test_damped_poles_match_modal_damping_to_first_order(plant, rest_model):
     lam = lam[np.argsort(np.abs(lam))]
     zeta_max = zeta.max()
     # |lambda_k| = omega_k and -Re/|lambda| = zeta_k up to the second order in zeta
-    # (non-proportional damping couples modes at O(zeta^2)); zeta ~ 0.005 gives a
-    # bound of 10 zeta^2 = 2.5e-4 relative. Measured: ~1e-5.
+    # (non-proportional damping couples modes at O(zeta^2)); the modal zeta reach
+    # 0.012 here, a bound of 10 zeta^2 = 1.5e-3. Measured: 8e-9 on |lambda| and 1e-10
+    # on zeta (the joint dampers are tuned per mode, nearly proportional).
     np.testing.assert_allclose(np.abs(lam), omega, rtol=10 * zeta_max**2)
     np.testing.assert_allclose(-lam.real / np.abs(lam), zeta, rtol=0.0, atol=10 * zeta_max**2)
 
