@@ -136,6 +136,111 @@ def _print_modal(summary: dict) -> None:
 
 
 @app.command()
+def linearize(
+    config: ConfigOption = None,
+    about: Annotated[
+        str, typer.Option(help="'rest' or 'spin:wx,wy,wz', a steady body rate [rad/s].")
+    ] = "rest",
+    outputs: Annotated[
+        str | None,
+        typer.Option(help="Output groups, comma-separated: attitude,rate,tip,joint,tau_flex."),
+    ] = None,
+    reduce: Annotated[
+        str | None, typer.Option(help="Also a reduced model: 'balanced:N' or 'modal:N'.")
+    ] = None,
+    json_output: JsonOption = False,
+    out: Annotated[
+        Path | None,
+        typer.Option(help="Write model.npz, model.mat, linear.json and the figures here."),
+    ] = None,
+) -> None:
+    """State-space model of the satellite about rest or a steady spin (A, B, C, D)."""
+    from flexsat.config import load_config
+    from flexsat.dynamics.plant import Plant
+    from flexsat.study.linear import parse_about, parse_reduction, write_linearize
+
+    spin = parse_about(about)
+    reduction = parse_reduction(reduce)
+    groups = None if outputs is None else [g.strip() for g in outputs.split(",")]
+    _announce_compilation()
+    plant = Plant.from_config(load_config(config))
+    _, summary = write_linearize(plant, spin, groups, reduction, out)
+    if json_output:
+        typer.echo(json.dumps(jsonable(summary)))
+        return
+    table = Table(title=f"Linear model about {summary['about']} — {summary['config_name']}")
+    for column in ("mode", "f [Hz]", "damping ratio"):
+        table.add_column(column)
+    for k, mode in enumerate(summary["modes"], 1):
+        table.add_row(str(k), f"{mode['frequency_hz']:.5g}", f"{mode['damping_ratio']:.3g}")
+    _console.print(table)
+    _console.print(
+        f"{summary['n_states']} states, {len(summary['input_names'])} inputs, "
+        f"{len(summary['output_names'])} outputs; Jacobian: {summary['jacobian']}"
+    )
+    if "reduction" in summary:
+        red = summary["reduction"]
+        _console.print(f"{red['method']} truncation to {red['order']} states: error bound "
+                       f"{red['error_bound']:.3g}")  # fmt: skip
+    for path in summary.get("files", []):
+        _console.print(f"wrote {path}")
+
+
+@app.command()
+def margins(
+    config: ConfigOption = None,
+    scenario: Annotated[
+        Path | None,
+        typer.Option(help="Slew scenario (TOML): its law (pd, smc, asmc). Default: PD defaults."),
+    ] = None,
+    campaign: Annotated[
+        str | None,
+        typer.Option(help="Also the margins over a campaign's cases (preset name or TOML)."),
+    ] = None,
+    json_output: JsonOption = False,
+    out: Annotated[
+        Path | None, typer.Option(help="Write margins.json and the loop figures here.")
+    ] = None,
+) -> None:
+    """Gain, phase and delay margins of the control loop per axis, flexible modes included."""
+    from flexsat.config import load_config
+    from flexsat.dynamics.plant import Plant
+    from flexsat.simulate.scenario import load_slew
+    from flexsat.study.linear import family_margins, write_margins
+
+    slew_scenario = None if scenario is None else load_slew(scenario)
+    _announce_compilation()
+    plant = Plant.from_config(load_config(config))
+    summary = write_margins(plant, slew_scenario, out)
+    if campaign is not None:
+        family = family_margins(plant, campaign, slew_scenario, out)
+        summary["family"] = family["cases"]
+        summary["files"] = summary.get("files", []) + family.get("files", [])
+    if json_output:
+        typer.echo(json.dumps(jsonable(summary)))
+        return
+    table = Table(title=f"{summary['law'].upper()} loop margins — {summary['config_name']}")
+    for column in ("axis", "PM [deg]", "at [Hz]", "GM", "delay margin [s]", "at [Hz]"):
+        table.add_column(column)
+    for axis, m in summary["axes"].items():
+        gm = "inf" if math.isinf(m["gain_margin"]) else f"{m['gain_margin']:.3g}"
+        table.add_row(
+            axis, f"{m['phase_margin_deg']:.1f}", f"{m['gain_crossover_hz']:.3g}", gm,
+            f"{m['delay_margin_s']:.3g}", f"{m['delay_crossover_hz']:.3g}",
+        )  # fmt: skip
+    _console.print(table)
+    if "family" in summary:
+        family = Table(title=f"Delay margin per case [s] — {campaign}")
+        for column in ("case", "x", "y", "z"):
+            family.add_column(column)
+        for case, axes in summary["family"].items():
+            family.add_row(case, *(f"{axes[a]['delay_margin_s']:.3g}" for a in "xyz"))
+        _console.print(family)
+    for path in summary.get("files", []):
+        _console.print(f"wrote {path}")
+
+
+@app.command()
 def openloop(
     config: ConfigOption = None,
     scenario: Annotated[

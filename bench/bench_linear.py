@@ -1,0 +1,69 @@
+"""Benchmark: time to linearize the thesis model, analytic against finite differences.
+
+Rows (nominal two-panel satellite, 18 DOF, 36 states; best of ``REPEATS`` after one
+warm-up call that loads the compiled kernels):
+
+* about rest, analytic A, B (M(0), K, C) plus the output matrices by differences;
+* about rest with Richardson central differences for A, B as well;
+* about a steady spin (1 rad/s about body X): the relative equilibrium (Gauss-Newton)
+  and Richardson differences;
+* balanced truncation of the torque -> rate model to 16 states; the PD loop margins
+  of the three axes.
+
+The agreement of the two rest Jacobians (max |A_fd - A_exact| / max |A|) is printed
+with them. Run with ``python bench/bench_linear.py``.
+"""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+from rich.console import Console
+from rich.table import Table
+
+from flexsat.config import nominal
+from flexsat.dynamics.plant import Plant
+from flexsat.linear import linearize
+from flexsat.linear.frequency import loop_margins, pd_gains, pd_loop
+from flexsat.linear.reduce import balanced_truncation
+
+REPEATS = 5
+
+
+def _best(fn) -> tuple[float, object]:
+    fn()
+    times, out = [], None
+    for _ in range(REPEATS):
+        start = time.perf_counter()
+        out = fn()
+        times.append(time.perf_counter() - start)
+    return min(times), out
+
+
+def main() -> None:
+    plant = Plant.from_config(nominal())
+    rows = []
+    t_exact, exact = _best(lambda: linearize(plant))
+    rows.append(("rest, analytic A, B", t_exact, ""))
+    t_fd, fd = _best(lambda: linearize(plant, jacobian="richardson"))
+    err = np.max(np.abs(fd.A - exact.A)) / np.max(np.abs(exact.A))
+    rows.append(("rest, Richardson A, B", t_fd, f"max rel. diff. to analytic {err:.1e}"))
+    t_spin, _ = _best(lambda: linearize(plant, about=[1.0, 0.0, 0.0]))
+    rows.append(("spin 1 rad/s about X (equilibrium + Richardson)", t_spin, ""))
+    rate = exact.select(outputs=["omega_x", "omega_y", "omega_z"])
+    t_bt, red = _best(lambda: balanced_truncation(rate, 16))
+    rows.append(("balanced truncation to 16 states", t_bt, f"bound {red.error_bound:.3g}"))
+    K = pd_gains(plant)
+    t_m, _ = _best(lambda: [loop_margins(pd_loop(exact, K, a)) for a in "xyz"])
+    rows.append(("PD loop margins, 3 axes", t_m, ""))
+    table = Table(title=f"Linear analysis, nominal satellite ({exact.n_states} states)")
+    for column in ("what", "time [ms]", "note"):
+        table.add_column(column)
+    for what, t, note in rows:
+        table.add_row(what, f"{1e3 * t:.2f}", note)
+    Console().print(table)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,246 @@
+"""Frequency-domain views: rigid reference model, modal effective inertia, PD loop margins.
+
+- :func:`rigid_model`: the rigidized satellite (J_tot of the design model) from body
+  torque to attitude and rate, to draw beside the flexible model.
+- :func:`effective_inertia`: modal effective inertia per flexible mode and body axis,
+  the CSI ranking of the modes.
+- :func:`pd_loop` and :func:`loop_margins`: the loop gain of the quaternion PD law
+  linearized about rest, one axis at a time (that axis's loop broken at the torque
+  input, the other two closed), with gain, phase and delay margins.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.linalg import eigh
+from scipy.optimize import brentq
+
+from flexsat.control.config import ASMCConfig, PDConfig, SMCConfig
+from flexsat.dynamics.plant import Plant
+from flexsat.dynamics.rigid import rigid_inertia
+from flexsat.errors import ConfigError
+from flexsat.linear.model import LinearModel
+
+__all__ = [
+    "LoopMargins",
+    "effective_inertia",
+    "law_gains",
+    "loop_margins",
+    "pd_gains",
+    "pd_loop",
+    "rigid_model",
+]
+
+_AXES = ("x", "y", "z")
+_BESIDE_POLE = 1e-7  # relative offset of the grid points beside each pole frequency
+
+
+def rigid_model(plant: Plant) -> LinearModel:
+    """The rigidized satellite about rest: attitude and body rate from body torque.
+
+    ``J_tot theta_ddot = tau`` with J_tot of :func:`flexsat.dynamics.rigid.rigid_inertia`;
+    states and outputs ``phi, theta, psi, omega_x, omega_y, omega_z``.
+    """
+    J_inv = np.linalg.inv(rigid_inertia(plant))
+    A = np.zeros((6, 6))
+    A[:3, 3:] = np.eye(3)
+    B = np.vstack([np.zeros((3, 3)), J_inv])
+    names = ("phi", "theta", "psi", "omega_x", "omega_y", "omega_z")
+    units = ("rad",) * 3 + ("rad/s",) * 3
+    return LinearModel(
+        A=A, B=B, C=np.eye(6), D=np.zeros((6, 3)), x0=np.zeros(6), u0=np.zeros(3),
+        spin=np.zeros(3), state_names=names, input_names=("tau_x", "tau_y", "tau_z"),
+        output_names=names, state_units=units, input_units=("N m",) * 3, output_units=units,
+        jacobian="analytic",
+    )  # fmt: skip
+
+
+def effective_inertia(plant: Plant) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Modal effective inertia of the appendage modes about each body axis.
+
+    The appendages' modes with the hub held fixed (hybrid coordinates):
+    ``K_ff phi = omega^2 M_ff phi`` with ``phi^T M_ff phi = 1`` on the joint
+    coordinates f of M(0) (eq. 3.3 restricted to f). Their participation factors
+    on the hub coordinates h are ``L = phi^T M_fh`` and the effective inertia of
+    mode k about body axis a is ``J_eff,ka = L_k,a^2`` [kg m^2]. Together with the
+    residual inertia ``J_res = M_hh - M_hf M_ff^-1 M_fh`` (the inertia the hub
+    shows above every appendage mode) they add up to the locked inertia M(0)_hh.
+    A large J_eff at a low frequency means strong control-structure interaction.
+
+    Returns
+    -------
+    frequencies_hz : ndarray, shape (n_flex,)
+        Frequencies of the hub-fixed appendage modes, ascending [Hz].
+    J_eff : ndarray, shape (n_flex, 3)
+        Effective inertia about body X, Y, Z [kg m^2].
+    J_residual : ndarray, shape (3,)
+        Residual inertia about X, Y, Z [kg m^2].
+    """
+    M0 = plant.mass_matrix()
+    K = plant.stiffness_matrix()
+    M_ff, M_fh, K_ff = M0[6:, 6:], M0[6:, :6], K[6:, 6:]
+    omega2, phi = eigh(K_ff, M_ff)
+    L = phi.T @ M_fh[:, 3:6]
+    residual = M0[3:6, 3:6] - M_fh[:, 3:6].T @ np.linalg.solve(M_ff, M_fh[:, 3:6])
+    return np.sqrt(omega2) / (2 * np.pi), L**2, np.diag(residual).copy()
+
+
+def pd_gains(plant: Plant, pd: PDConfig | None = None) -> np.ndarray:
+    """Static gain K, shape (3, 6), of the PD law about rest: tau = -K [theta; omega].
+
+    The law ``tau = w x Jw - J (kp q_v,e + kd w)`` with ``q_v,e ~ theta / 2`` and
+    J the rigid design inertia linearizes to ``tau = -J (wn^2 theta + 2 zeta wn w)``
+    (the gyroscopic term is quadratic in the rate).
+    """
+    pd = pd or PDConfig()
+    wn, zeta = pd.natural_frequency_rad_s, pd.damping_ratio
+    J = rigid_inertia(plant)
+    return np.hstack([J * wn**2, J * 2.0 * zeta * wn])
+
+
+def _sliding_gains(J: np.ndarray, lam: float, jk: float, phi: float) -> np.ndarray:
+    """Inside the boundary layer |s| < Phi, about rest (q_v,e ~ theta/2, q_v,e_dot ~ w/2):
+    tau = -Lambda J q_v,e_dot - JK s / Phi with s = w + Lambda q_v,e (eqs. 4.13-4.14)."""
+    k = jk / phi
+    return np.hstack([0.5 * k * lam * np.eye(3), 0.5 * lam * J + k * np.eye(3)])
+
+
+def _smc_gains(plant: Plant, law: SMCConfig) -> np.ndarray:
+    return _sliding_gains(rigid_inertia(plant), law.lambda_, law.jk_nm, law.phi)
+
+
+def _asmc_gains(plant: Plant, law: ASMCConfig) -> np.ndarray:
+    # At the target: Lambda_target = lambda_max (eq. 4.27 at theta = 0), never cut by
+    # the budget (J q_v,e_dot -> 0, eq. 4.28), and JK = JK_min at s = 0 (eq. 4.30).
+    return _sliding_gains(rigid_inertia(plant), law.lambda_max, law.jk_min_nm, law.phi)
+
+
+_LINEARIZED_LAWS = {"pd": pd_gains, "smc": _smc_gains, "asmc": _asmc_gains}
+
+
+def law_gains(plant: Plant, law=None) -> np.ndarray:
+    """Static gain K, shape (3, 6), of a law linearized about rest: tau = -K [theta; omega].
+
+    Parameters
+    ----------
+    plant : Plant
+        Its rigidized inertia is the law's design model.
+    law : PDConfig, SMCConfig or ASMCConfig, optional
+        Default: the PD law with its default gains. The sliding-mode laws are
+        linearized inside their boundary layer, the SMC with its constant Lambda and
+        JK, the ASMC with its steady-state values at the target (Lambda = lambda_max,
+        JK = JK_min); see :func:`_sliding_gains`.
+    """
+    law = law or PDConfig()
+    return _LINEARIZED_LAWS[law.kind](plant, law)
+
+
+def pd_loop(model: LinearModel, K: np.ndarray, axis: str) -> LinearModel:
+    """Loop gain L(s) at the torque input of ``axis`` with the other two loops closed.
+
+    Parameters
+    ----------
+    model : LinearModel
+        Must have the outputs ``phi, theta, psi, omega_x, omega_y, omega_z`` and the
+        three torque inputs.
+    K : ndarray, shape (3, 6)
+        Static feedback ``tau = -K [theta; omega]``.
+    axis : {"x", "y", "z"}
+
+    Returns
+    -------
+    LinearModel
+        SISO, input ``tau_<axis>``, output ``loop_<axis>``: the negative-feedback
+        loop gain (closing the loop is ``u = -y``).
+    """
+    if axis not in _AXES:
+        raise ConfigError(f"axis: unknown axis {axis!r} (allowed: x, y, z)")
+    sub = model.select(
+        outputs=["phi", "theta", "psi", "omega_x", "omega_y", "omega_z"],
+        inputs=["tau_x", "tau_y", "tau_z"],
+    )
+    a = _AXES.index(axis)
+    P = np.eye(3)
+    P[a, a] = 0.0  # the other axes stay closed
+    A = sub.A - sub.B @ P @ K @ sub.C
+    return LinearModel(
+        A=A, B=sub.B[:, [a]], C=K[[a]] @ sub.C, D=np.zeros((1, 1)), x0=sub.x0, u0=sub.u0[[a]],
+        spin=sub.spin, state_names=sub.state_names, input_names=(f"tau_{axis}",),
+        output_names=(f"loop_{axis}",), state_units=sub.state_units, input_units=("N m",),
+        output_units=("N m",), jacobian=sub.jacobian,
+    )  # fmt: skip
+
+
+@dataclass(frozen=True)
+class LoopMargins:
+    """Stability margins of a SISO loop gain (negative feedback).
+
+    ``gain_margin`` [-] (inf when the phase never crosses -180 deg above the lowest
+    frequency); ``phase_margin_deg`` and ``delay_margin_s`` are the smallest over all
+    gain crossovers (a flexible peak above 0 dB adds crossovers); the frequencies
+    are those of the limiting crossing [Hz]; ``crossovers_hz`` lists them all.
+    """
+
+    gain_margin: float
+    phase_crossover_hz: float
+    phase_margin_deg: float
+    gain_crossover_hz: float
+    delay_margin_s: float
+    delay_crossover_hz: float
+    crossovers_hz: tuple[float, ...]
+
+    def to_dict(self) -> dict:
+        return {k: getattr(self, k) for k in self.__dataclass_fields__}
+
+
+def loop_margins(loop: LinearModel, f_min_hz: float = 1e-4, f_max_hz: float = 200.0) -> LoopMargins:
+    """Gain, phase and delay margins of a SISO loop gain, from its exact response.
+
+    Crossings are bracketed on a log grid of 5000 points, to which the frequency of
+    every pole of the loop is added with a point just below and just above it (so
+    the two crossings beside a sharp or undamped peak are always bracketed), and are
+    refined with Brent's method on the exact response (no fitting); phase crossings
+    likewise.
+    """
+    if loop.B.shape[1] != 1 or loop.C.shape[0] != 1:
+        raise ConfigError("loop_margins needs a single-input single-output loop gain")
+
+    def L(f):
+        return loop.frequency_response(f)[0, 0, 0]
+
+    lam = np.linalg.eigvals(loop.A)
+    f_poles = np.abs(lam[lam.imag > 0]) / (2 * np.pi)
+    f_poles = f_poles[(f_poles > f_min_hz) & (f_poles < f_max_hz)]
+    f = np.unique(
+        np.concatenate([
+            np.geomspace(f_min_hz, f_max_hz, 5000),
+            f_poles * (1 - _BESIDE_POLE), f_poles * (1 + _BESIDE_POLE),
+        ])
+    )  # fmt: skip
+    G = loop.frequency_response(f)[:, 0, 0]
+    log_mag = np.log(np.abs(G))
+    cross = [
+        brentq(lambda x: np.log(abs(L(x))), f[k], f[k + 1], xtol=1e-14)
+        for k in np.nonzero(np.sign(log_mag[:-1]) != np.sign(log_mag[1:]))[0]
+    ]
+    pm, dm, f_pm, f_dm = np.inf, np.inf, np.nan, np.nan
+    for fc in cross:
+        margin = np.angle(-L(fc))  # phase above -180 deg, in (-pi, pi]
+        delay = (margin % (2 * np.pi)) / (2 * np.pi * fc)  # phase a delay can eat first
+        if abs(np.degrees(margin)) < abs(pm):
+            pm, f_pm = float(np.degrees(margin)), fc
+        if delay < dm:
+            dm, f_dm = float(delay), fc
+    imag = G.imag
+    gm, f_gm = np.inf, np.nan
+    for k in np.nonzero((np.sign(imag[:-1]) != np.sign(imag[1:])) & (G.real[:-1] < 0))[0]:
+        fp = brentq(lambda x: L(x).imag, f[k], f[k + 1], xtol=1e-14)
+        mag = abs(L(fp))
+        if mag == 0.0:  # a phase jump at an undamped zero, not a crossing of -180 deg
+            continue
+        g = 1.0 / mag
+        if abs(np.log(g)) < abs(np.log(gm)):
+            gm, f_gm = float(g), fp
+    return LoopMargins(gm, f_gm, pm, f_pm, dm, f_dm, tuple(float(c) for c in cross))

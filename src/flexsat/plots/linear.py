@@ -1,0 +1,236 @@
+"""Figures of the linear analysis: Bode, singular values, poles and zeros, loop gains.
+
+Drawn with the shared style (:mod:`flexsat.plots.style`), no pyplot.
+
+- :func:`plot_bode`: body torque to body rate (or attitude) per axis, the flexible
+  model beside the rigidized one.
+- :func:`plot_singular_values`: singular values of torque to rate, flexible and rigid.
+- :func:`plot_pole_zero`: poles of the model and zeros of each axis's torque to rate.
+- :func:`plot_effective_inertia`: modal effective inertia per mode and axis.
+- :func:`plot_loops`: PD loop gain per axis with its margins, the flexible peaks
+  marked; :func:`plot_nichols`: the same loops in the Nichols plane.
+- :func:`plot_loop_family`: the loop gains of a campaign's cases, one curve per case.
+- :func:`write_linear_figures`: all of them into a folder.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+from matplotlib.figure import Figure
+
+from flexsat.linear.frequency import LoopMargins
+from flexsat.linear.model import LinearModel
+from flexsat.plots import style
+
+__all__ = [
+    "FIGURES",
+    "frequency_grid_hz",
+    "plot_bode",
+    "plot_effective_inertia",
+    "plot_loop_family",
+    "plot_loops",
+    "plot_nichols",
+    "plot_pole_zero",
+    "plot_singular_values",
+    "write_linear_figures",
+]
+
+FIGURES = (
+    "bode_rate", "bode_attitude", "singular_values", "pole_zero", "effective_inertia",
+    "loop_gain", "nichols",
+)  # fmt: skip
+
+
+def frequency_grid_hz(n: int = 3000) -> np.ndarray:
+    """The frequency grid of every figure: 1 mHz to 200 Hz, log-spaced [Hz]."""
+    return np.geomspace(1e-3, 200.0, n)
+
+
+def _siso(model: LinearModel, out: str, inp: str, f: np.ndarray) -> np.ndarray:
+    return model.select(outputs=[out], inputs=[inp]).frequency_response(f)[:, 0, 0]
+
+
+def plot_bode(flexible: LinearModel, rigid: LinearModel, output: str = "rate") -> Figure:
+    """Bode diagrams tau_a -> omega_a (``output="rate"``) or -> attitude, a = x, y, z."""
+    outs = {"rate": ("omega_x", "omega_y", "omega_z"), "attitude": ("phi", "theta", "psi")}
+    unit = {"rate": "rad/s / N m", "attitude": "rad / N m"}[output]
+    f = frequency_grid_hz()
+    fig, axes = style.figure(2, 3, size=(14.0, 7.0), height_ratios=(2, 1))
+    for a, (axis, out) in enumerate(zip(style.AXES, outs[output], strict=True)):
+        for model, label, ls in ((flexible, "flexible", "-"), (rigid, "rigid", "--")):
+            G = _siso(model, out, f"tau_{axis}", f)
+            colour = style.AXIS_COLOURS[a] if ls == "-" else "0.4"
+            axes[0, a].loglog(f, np.abs(G), ls, color=colour, label=label)
+            axes[1, a].semilogx(f, np.degrees(np.unwrap(np.angle(G))), ls, color=colour)
+        axes[0, a].set_title(f"tau_{axis} -> {out}")
+        axes[0, a].set_ylabel(f"|G| [{unit}]")
+        axes[1, a].set_ylabel("phase [deg]")
+        axes[1, a].set_xlabel("frequency [Hz]")
+        axes[0, a].legend(loc="lower left", fontsize=8)
+    for ax in axes.ravel():
+        ax.grid(True, which="both", color="0.88", linewidth=0.5)
+    fig.suptitle(f"Body torque to body {output}: flexible model and rigidized satellite")
+    return fig
+
+
+def plot_singular_values(flexible: LinearModel, rigid: LinearModel) -> Figure:
+    """Singular values of the 3 x 3 torque -> rate response, flexible and rigid."""
+    f = frequency_grid_hz()
+    rate = ["omega_x", "omega_y", "omega_z"]
+    fig, axes = style.figure(1, 1, size=(9.0, 5.5))
+    ax = axes[0, 0]
+    for model, label, ls in ((flexible, "flexible", "-"), (rigid, "rigid", "--")):
+        sv = np.linalg.svd(model.select(outputs=rate).frequency_response(f), compute_uv=False)
+        for k in range(sv.shape[1]):
+            ax.loglog(f, sv[:, k], ls, color=style.AXIS_COLOURS[k], label=f"{label} σ{k + 1}")
+    ax.set_xlabel("frequency [Hz]")
+    ax.set_ylabel("singular value [rad/s / N m]")
+    ax.grid(True, which="both", color="0.88", linewidth=0.5)
+    ax.legend(fontsize=8, ncol=2)
+    fig.suptitle("Singular values, body torque to body rate")
+    return fig
+
+
+def plot_pole_zero(flexible: LinearModel) -> Figure:
+    """Poles of the model and the zeros of tau_a -> omega_a per axis (s-plane, [rad/s])."""
+    fig, axes = style.figure(1, 1, size=(9.0, 6.0))
+    ax = axes[0, 0]
+    poles = flexible.poles()
+    ax.plot(poles.real, poles.imag, "x", color="k", label="poles")
+    for a, axis in enumerate(style.AXES):
+        siso = flexible.select(outputs=[f"omega_{axis}"], inputs=[f"tau_{axis}"])
+        z = np.asarray(siso.to_statespace().zeros())
+        z = z[np.isfinite(z) & (np.abs(z) < 10 * np.abs(poles).max())]
+        ax.plot(z.real, z.imag, "o", mfc="none", color=style.AXIS_COLOURS[a],
+                label=f"zeros tau_{axis} -> omega_{axis}")  # fmt: skip
+    ax.set_yscale("symlog", linthresh=1.0)
+    ax.set_xscale("symlog", linthresh=1e-3)
+    ax.set_xlabel("Re s [1/s]")
+    ax.set_ylabel("Im s [rad/s]")
+    ax.grid(True, color="0.88", linewidth=0.5)
+    ax.legend(fontsize=8)
+    fig.suptitle("Pole-zero map: alternating poles and zeros of each collocated axis")
+    return fig
+
+
+def plot_effective_inertia(frequencies_hz: np.ndarray, J_eff: np.ndarray) -> Figure:
+    """Bars of the modal effective inertia per appendage mode and body axis [kg m^2]."""
+    fig, axes = style.figure(1, 1, size=(10.0, 5.5))
+    ax = axes[0, 0]
+    keep = J_eff.max(axis=1) > 1e-6 * J_eff.max()
+    k = np.arange(int(keep.sum()))
+    for a, axis in enumerate(style.AXES):
+        ax.bar(k + (a - 1) * 0.27, J_eff[keep, a], width=0.27, color=style.AXIS_COLOURS[a],
+               label=f"about {axis}")  # fmt: skip
+    ax.set_xticks(k, [f"{fk:.3g} Hz" for fk in frequencies_hz[keep]], rotation=45)
+    ax.set_yscale("log")
+    ax.set_ylabel("effective inertia J_eff [kg m²]")
+    ax.grid(True, axis="y", color="0.88", linewidth=0.5)
+    ax.legend(fontsize=8)
+    fig.suptitle("Modal effective inertia of the hub-fixed appendage modes (CSI ranking)")
+    return fig
+
+
+def plot_loops(
+    loops: dict[str, LinearModel], margins: dict[str, LoopMargins], modes_hz: np.ndarray
+) -> Figure:
+    """Loop gain per axis: Bode with 0 dB, -180 deg, crossovers and flexible modes marked."""
+    f = frequency_grid_hz()
+    fig, axes = style.figure(2, 3, size=(14.0, 7.0), height_ratios=(2, 1))
+    for a, axis in enumerate(style.AXES):
+        L = loops[axis].frequency_response(f)[:, 0, 0]
+        m = margins[axis]
+        colour = style.AXIS_COLOURS[a]
+        axes[0, a].loglog(f, np.abs(L), color=colour)
+        axes[1, a].semilogx(f, np.degrees(np.unwrap(np.angle(L))), color=colour)
+        axes[0, a].axhline(1.0, color="0.3", linewidth=0.8)
+        axes[1, a].axhline(-180.0, color="0.3", linewidth=0.8)
+        for fm in modes_hz:
+            for ax in axes[:, a]:
+                ax.axvline(fm, color="0.75", linewidth=0.6, linestyle=":")
+        for fc in m.crossovers_hz:
+            axes[0, a].plot(fc, 1.0, "o", color="k", ms=4)
+        axes[0, a].set_title(
+            f"axis {axis}: PM {m.phase_margin_deg:.1f} deg, GM {_db(m.gain_margin)}, "
+            f"DM {m.delay_margin_s:.3g} s",
+            fontsize=9,
+        )
+        axes[0, a].set_ylabel("|L| [-]")
+        axes[1, a].set_ylabel("phase [deg]")
+        axes[1, a].set_xlabel("frequency [Hz] (dotted: flexible modes)")
+    for ax in axes.ravel():
+        ax.grid(True, which="both", color="0.88", linewidth=0.5)
+    fig.suptitle("PD loop gain per axis (loop broken at that torque, others closed)")
+    return fig
+
+
+def plot_nichols(loops: dict[str, LinearModel]) -> Figure:
+    """Nichols plot of the loop gains: open-loop phase [deg] against gain [dB]."""
+    f = frequency_grid_hz()
+    fig, axes = style.figure(1, 1, size=(9.0, 6.5))
+    ax = axes[0, 0]
+    for a, axis in enumerate(style.AXES):
+        L = loops[axis].frequency_response(f)[:, 0, 0]
+        ax.plot(np.degrees(np.unwrap(np.angle(L))), 20 * np.log10(np.abs(L)),
+                color=style.AXIS_COLOURS[a], label=f"axis {axis}")  # fmt: skip
+    ax.plot(-180.0, 0.0, "+", color="k", ms=12, mew=2)
+    ax.set_xlabel("open-loop phase [deg]")
+    ax.set_ylabel("open-loop gain [dB]")
+    ax.grid(True, color="0.88", linewidth=0.5)
+    ax.legend(fontsize=8)
+    fig.suptitle("Nichols plot of the PD loop gains (critical point at -180 deg, 0 dB)")
+    return fig
+
+
+def plot_loop_family(
+    loops: dict[str, dict[str, LinearModel]], margins: dict[str, dict[str, dict]]
+) -> Figure:
+    """Loop-gain magnitude per axis, one curve per case; the legend gives its delay margin."""
+    f = frequency_grid_hz()
+    fig, axes = style.figure(1, 3, size=(15.0, 5.5))
+    for a, axis in enumerate(style.AXES):
+        ax = axes[0, a]
+        for case, case_loops in loops.items():
+            L = case_loops[axis].frequency_response(f)[:, 0, 0]
+            dm = margins[case][axis]["delay_margin_s"]
+            ax.loglog(f, np.abs(L), linewidth=0.8, label=f"{case}: DM {dm:.3g} s")
+        ax.axhline(1.0, color="0.3", linewidth=0.8)
+        ax.set_title(f"axis {axis}")
+        ax.set_xlabel("frequency [Hz]")
+        ax.set_ylabel("|L| [-]")
+        ax.grid(True, which="both", color="0.88", linewidth=0.5)
+        if len(loops) <= 12:
+            ax.legend(fontsize=6)
+    fig.suptitle("PD loop gain over the campaign's cases (one curve per case)")
+    return fig
+
+
+def _db(gain: float) -> str:
+    return "inf" if np.isinf(gain) else f"{20 * np.log10(gain):.1f} dB"
+
+
+def write_linear_figures(
+    out_dir: str | Path,
+    flexible: LinearModel,
+    rigid: LinearModel,
+    effective: tuple[np.ndarray, np.ndarray],
+    loops: dict[str, LinearModel] | None = None,
+    margins: dict[str, LoopMargins] | None = None,
+    *,
+    dpi: int = 110,
+) -> list[Path]:
+    """Write the figures of :data:`FIGURES` (the loop figures only with ``loops``)."""
+    modes_hz = effective[0]
+    draw = {
+        "bode_rate": lambda: plot_bode(flexible, rigid, "rate"),
+        "bode_attitude": lambda: plot_bode(flexible, rigid, "attitude"),
+        "singular_values": lambda: plot_singular_values(flexible, rigid),
+        "pole_zero": lambda: plot_pole_zero(flexible),
+        "effective_inertia": lambda: plot_effective_inertia(*effective),
+        "loop_gain": lambda: plot_loops(loops, margins, modes_hz),
+        "nichols": lambda: plot_nichols(loops),
+    }
+    names = [n for n in FIGURES if loops is not None or n not in ("loop_gain", "nichols")]
+    return style.write_figures(out_dir, names, lambda n: draw[n](), dpi=dpi)

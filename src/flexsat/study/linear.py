@@ -1,0 +1,229 @@
+"""Linear analysis and loop margins, written to files: what ``flexsat linearize`` and
+``flexsat margins`` share.
+
+Each function returns a JSON-ready summary (SI units, keys ending in their unit)
+and, given a folder, writes the model files, ``linear.json`` / ``margins.json``
+and the figures there.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from flexsat.errors import ConfigError
+from flexsat.study.outputs import write_json
+
+if TYPE_CHECKING:
+    from flexsat.dynamics.plant import Plant
+
+__all__ = [
+    "family_margins",
+    "parse_about",
+    "parse_reduction",
+    "write_linearize",
+    "write_margins",
+]
+
+_REDUCTIONS = ("modal", "balanced")
+
+
+def parse_about(text: str) -> str | np.ndarray:
+    """``"rest"`` or ``"spin:wx,wy,wz"`` (body rate [rad/s]) -> ``"rest"`` or the vector."""
+    if text == "rest":
+        return "rest"
+    head, _, tail = text.partition(":")
+    try:
+        values = [float(v) for v in tail.split(",")]
+    except ValueError:
+        values = []
+    if head != "spin" or len(values) != 3:
+        raise ConfigError(f"--about: expected 'rest' or 'spin:wx,wy,wz' [rad/s], got {text!r}")
+    return np.array(values)
+
+
+def parse_reduction(text: str | None) -> tuple[str, int] | None:
+    """``"balanced:16"`` or ``"modal:16"`` -> (method, order); ``None`` -> no reduction."""
+    if text is None:
+        return None
+    method, _, order = text.partition(":")
+    if method not in _REDUCTIONS or not order.isdigit():
+        raise ConfigError(
+            f"--reduce: expected 'balanced:N' or 'modal:N' (N states in all), got {text!r}"
+        )
+    return method, int(order)
+
+
+def _mode_table(model) -> list[dict]:
+    lam = model.poles()
+    lam = lam[lam.imag > 1e-9 * max(1.0, float(np.abs(lam).max()))]
+    return [
+        {
+            "frequency_hz": float(abs(v) / (2 * np.pi)),
+            "damped_frequency_hz": float(v.imag / (2 * np.pi)),
+            "damping_ratio": float(-v.real / abs(v)),
+        }
+        for v in lam[np.argsort(np.abs(lam))]
+    ]
+
+
+def write_linearize(
+    plant: Plant,
+    about: str | np.ndarray = "rest",
+    outputs: list[str] | None = None,
+    reduction: tuple[str, int] | None = None,
+    out: Path | None = None,
+) -> tuple[object, dict]:
+    """Linearize; with ``out``, ``model.npz``, ``model.mat``, ``linear.json``, figures.
+
+    Returns
+    -------
+    model : flexsat.linear.LinearModel
+        The full model (outputs as requested).
+    summary : dict
+        Sizes, names, equilibrium, modes (frequency, damping ratio), the reduction's
+        error bound, and ``files`` when ``out`` is given.
+    """
+    from flexsat.linear import OUTPUT_GROUPS, linearize
+    from flexsat.linear.frequency import effective_inertia, rigid_model
+    from flexsat.linear.reduce import balanced_truncation, modal_truncation
+
+    model = linearize(plant, about, outputs=outputs or OUTPUT_GROUPS)
+    f_eff, J_eff, J_res = effective_inertia(plant)
+    summary = {
+        "config_name": plant.config.name,
+        "about": "rest" if isinstance(about, str) else "spin",
+        "spin_rad_s": model.spin.tolist(),
+        "equilibrium_torque_nm": model.u0.tolist(),
+        "jacobian": model.jacobian,
+        "n_states": model.n_states,
+        "state_names": list(model.state_names),
+        "input_names": list(model.input_names),
+        "output_names": list(model.output_names),
+        "modes": _mode_table(model),
+        "effective_inertia": {
+            "frequencies_hz": f_eff.tolist(),
+            "J_eff_kg_m2": J_eff.tolist(),
+            "J_residual_kg_m2": J_res.tolist(),
+        },
+    }
+    reduced = None
+    if reduction is not None:
+        method, order = reduction
+        reduce = balanced_truncation if method == "balanced" else modal_truncation
+        reduced = reduce(model, order)
+        summary["reduction"] = {
+            "method": method,
+            "order": order,
+            "n_marginal": reduced.n_marginal,
+            "error_bound": reduced.error_bound,
+            "hankel_singular_values": (
+                None if reduced.hankel_singular_values is None
+                else reduced.hankel_singular_values.tolist()
+            ),
+        }  # fmt: skip
+    if out is not None:
+        from flexsat.plots.linear import write_linear_figures
+
+        out = Path(out)
+        out.mkdir(parents=True, exist_ok=True)
+        files = [model.save_npz(out / "model.npz"), model.save_mat(out / "model.mat")]
+        if reduced is not None:
+            files += [reduced.model.save_npz(out / "reduced.npz")]
+            files += [reduced.model.save_mat(out / "reduced.mat")]
+        if isinstance(about, str) and {"attitude", "rate"} <= set(outputs or OUTPUT_GROUPS):
+            files += write_linear_figures(out, model, rigid_model(plant), (f_eff, J_eff))
+        summary["files"] = [str(p) for p in [write_json(out / "linear.json", summary), *files]]
+    return model, summary
+
+
+def write_margins(plant: Plant, scenario=None, out: Path | None = None) -> dict:
+    """PD loop gain per axis about rest and its margins; with ``out``, figures and JSON.
+
+    Parameters
+    ----------
+    plant : Plant
+    scenario : SlewScenario, optional
+        Its controller (PD, SMC or ASMC) is linearized about rest, the sliding-mode
+        laws inside their boundary layer with Lambda and JK at their steady-state
+        values; default: the PD law's default gains.
+    """
+    from flexsat.linear import linearize
+    from flexsat.linear.frequency import (
+        effective_inertia,
+        law_gains,
+        loop_margins,
+        pd_loop,
+        rigid_model,
+    )
+
+    law = _law(scenario)
+    model = linearize(plant, outputs=["attitude", "rate"])
+    K = law_gains(plant, law)
+    loops = {axis: pd_loop(model, K, axis) for axis in "xyz"}
+    margins = {axis: loop_margins(loop) for axis, loop in loops.items()}
+    summary = {
+        "config_name": plant.config.name,
+        "law": law.kind,
+        "gains": law.model_dump(mode="json", by_alias=True),
+        "axes": {axis: m.to_dict() for axis, m in margins.items()},
+    }
+    if out is not None:
+        from flexsat.plots.linear import write_linear_figures
+
+        out = Path(out)
+        effective = effective_inertia(plant)[:2]
+        files = write_linear_figures(out, model, rigid_model(plant), effective, loops, margins)
+        summary["files"] = [str(p) for p in [write_json(out / "margins.json", summary), *files]]
+    return summary
+
+
+def family_margins(
+    plant: Plant, campaign: str | Path, scenario=None, out: Path | None = None
+) -> dict:
+    """PD loop margins over every case of a campaign (sensitivity, Monte Carlo...).
+
+    Each case perturbs the truth plant; the controller keeps the design model of
+    ``plant`` (the campaign's base configuration), as in the campaigns. With ``out``,
+    ``margins_family.json`` and ``loop_family.png`` (one curve per case and axis).
+
+    Returns
+    -------
+    dict
+        ``cases``: one entry per case id with its margins per axis.
+    """
+    from flexsat.campaigns.definition import load_campaign, resolve_cases
+    from flexsat.config.models import SatelliteConfig
+    from flexsat.dynamics.plant import Plant
+    from flexsat.linear import linearize
+    from flexsat.linear.frequency import law_gains, loop_margins, pd_loop
+
+    K = law_gains(plant, _law(scenario))
+    cases = resolve_cases(load_campaign(campaign), plant.config)
+    loops: dict[str, dict] = {}
+    table: dict[str, dict] = {}
+    for case in cases:
+        truth = Plant.from_config(SatelliteConfig.model_validate(case.plant))
+        model = linearize(truth, outputs=["attitude", "rate"])
+        loops[case.case_id] = {axis: pd_loop(model, K, axis) for axis in "xyz"}
+        table[case.case_id] = {
+            axis: loop_margins(loop).to_dict() for axis, loop in loops[case.case_id].items()
+        }
+    summary = {"config_name": plant.config.name, "campaign": str(campaign), "cases": table}
+    if out is not None:
+        from flexsat.plots.linear import plot_loop_family
+        from flexsat.plots.style import save_figure
+
+        out = Path(out)
+        figure = save_figure(plot_loop_family(loops, table), out / "loop_family.png", dpi=110)
+        json_path = write_json(out / "margins_family.json", summary)
+        summary["files"] = [str(json_path), str(figure)]
+    return summary
+
+
+def _law(scenario):
+    from flexsat.control.config import PDConfig
+
+    return PDConfig() if scenario is None else scenario.controller

@@ -1,0 +1,79 @@
+"""``flexsat linearize`` and ``flexsat margins``, run as a user runs them."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+FLEXSAT = [sys.executable, "-m", "flexsat"]
+
+
+def run(*args: str) -> subprocess.CompletedProcess:
+    return subprocess.run([*FLEXSAT, *args], capture_output=True, text=True, timeout=300)
+
+
+def test_linearize_writes_the_model_files_and_figures(tmp_path):
+    from scipy.io import loadmat
+
+    result = run("linearize", "--reduce", "balanced:16", "--json", "--out", str(tmp_path))
+    assert result.returncode == 0, result.stderr
+    summary = json.loads(result.stdout)
+    assert summary["n_states"] == 36 and summary["jacobian"] == "analytic"
+    # Thesis table 3.3: first coupled flexible mode 0.258 Hz, zeta = 0.005 (table 3.1).
+    first = summary["modes"][0]
+    assert first["frequency_hz"] == pytest.approx(0.2581, abs=1e-4)
+    assert first["damping_ratio"] == pytest.approx(0.005, rel=0.05)
+    assert summary["reduction"]["error_bound"] > 0.0
+    mat = loadmat(tmp_path / "model.mat")
+    assert mat["A"].shape == (36, 36)
+    assert np.load(tmp_path / "reduced.npz")["A"].shape == (16, 16)
+    for name in ("bode_rate", "bode_attitude", "singular_values", "pole_zero"):
+        assert (tmp_path / f"{name}.png").stat().st_size > 0
+
+
+def test_linearize_about_a_spin_reports_the_equilibrium():
+    result = run("linearize", "--about", "spin:0.5,0,0", "--outputs", "rate", "--json")
+    assert result.returncode == 0, result.stderr
+    summary = json.loads(result.stdout)
+    assert summary["about"] == "spin" and summary["jacobian"] == "richardson"
+    assert summary["spin_rad_s"] == [0.5, 0.0, 0.0]
+    assert summary["output_names"] == ["omega_x", "omega_y", "omega_z"]
+
+
+def test_margins_table_and_files(tmp_path):
+    result = run("margins", "--out", str(tmp_path))
+    assert result.returncode == 0, result.stderr
+    assert "delay margin" in result.stdout
+    summary = json.loads((tmp_path / "margins.json").read_text())
+    assert set(summary["axes"]) == {"x", "y", "z"}
+    assert (tmp_path / "loop_gain.png").exists() and (tmp_path / "nichols.png").exists()
+
+
+@pytest.mark.parametrize(
+    ("args", "fragment"),
+    [
+        (("linearize", "--about", "spin:0,0,0"), "zero length"),
+        (("linearize", "--about", "tumbling"), "--about: expected 'rest' or 'spin:wx,wy,wz'"),
+        (("linearize", "--outputs", "rate,tips"), "unknown output 'tips'"),
+        (("linearize", "--reduce", "balanced:99"), "order: must be between 12"),
+        (("linearize", "--reduce", "hankel:8"), "--reduce: expected"),
+    ],
+)
+def test_bad_requests_exit_2_with_one_message(args, fragment):
+    result = run(*args)
+    assert result.returncode == 2
+    assert fragment in result.stderr
+    assert "Traceback" not in result.stderr
+
+
+def test_margins_of_a_sliding_mode_law_inside_its_boundary_layer(tmp_path):
+    scenario = tmp_path / "slew.toml"
+    scenario.write_text('[controller]\nkind = "smc"\n')
+    result = run("margins", "--scenario", str(scenario), "--json")
+    assert result.returncode == 0, result.stderr
+    summary = json.loads(result.stdout)
+    assert summary["law"] == "smc" and summary["gains"]["lambda"] == 1.0
