@@ -10,17 +10,22 @@ import pytest
 from flexsat.control.laws import get_law
 from flexsat.control.registry import Channel
 from flexsat.control.stages import ACTUATORS, SENSORS
+from flexsat.dynamics.layout import StateLayout
 from flexsat.simulate.layout import LoopLayout
 
+# The nominal satellite's plant state: two plates of six joint coordinates each.
+_PLATE = (("eta_x", "eta_y", "eta_z", "eta_rx", "eta_ry", "eta_rz"), ("m",) * 3 + ("rad",) * 3)
+PLANT = StateLayout.build([("+Y", "plate", *_PLATE), ("-Y", "plate", *_PLATE)])
 
-def _layout(law: str = "asmc", n_dof: int = 18) -> LoopLayout:
-    return LoopLayout(n_dof, get_law(law), SENSORS.get("ideal"), ACTUATORS.get("static"))
+
+def _layout(law: str = "asmc") -> LoopLayout:
+    return LoopLayout(PLANT, get_law(law), SENSORS.get("ideal"), ACTUATORS.get("static"))
 
 
-def test_plant_state_offsets():
+def test_plant_state_offsets_are_the_plants():
     layout = _layout()
-    assert (layout.q, layout.qd) == (slice(0, 18), slice(18, 36))
-    assert (layout.work, layout.dissipated, layout.x_size) == (36, 37, 38)
+    assert (layout.plant.q, layout.plant.qd) == (slice(0, 18), slice(18, 36))
+    assert (layout.plant.work_in, layout.plant.dissipated, layout.plant.size) == (36, 37, 38)
 
 
 def test_record_columns_follow_each_other_without_gaps():
@@ -37,7 +42,7 @@ def test_stage_records_come_after_the_law_diagnostics():
     actuator = dataclasses.replace(
         ACTUATORS.get("static"), state_size=4, records=(Channel("extra", "N m", "", True),)
     )
-    layout = LoopLayout(18, get_law("pd"), SENSORS.get("ideal"), actuator)
+    layout = LoopLayout(PLANT, get_law("pd"), SENSORS.get("ideal"), actuator)
     assert layout.law_diag == slice(6, 12)  # the PD's tau_gyro and tau_guide
     assert layout.actuator_record == slice(12, 15)
     assert layout.actuator_state == slice(0, 4)  # the PD and the ideal sensor keep none
@@ -46,4 +51,4 @@ def test_stage_records_come_after_the_law_diagnostics():
 def test_a_channel_named_twice_is_refused():
     law = dataclasses.replace(get_law("pd"), diagnostics=(Channel("tau_cmd", "N m", ""),))
     with pytest.raises(ValueError, match="named twice: tau_cmd"):
-        LoopLayout(18, law, SENSORS.get("ideal"), ACTUATORS.get("static"))
+        LoopLayout(PLANT, law, SENSORS.get("ideal"), ACTUATORS.get("static"))

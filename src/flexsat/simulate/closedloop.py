@@ -108,13 +108,13 @@ def run_slew(
         slew_design_inertia(plant, scenario) if design_J is None else design_J, dtype=float
     )
     law = get_law(scenario.controller.kind)
-    layout = LoopLayout(plant.n_dof, law, SENSORS.get(scenario.sensor.kind),
+    layout = LoopLayout(plant.layout, law, SENSORS.get(scenario.sensor.kind),
                         ACTUATORS.get(scenario.actuator.kind))  # fmt: skip
     q0, qd0 = initial_state(plant, scenario)
     steps, every = scenario.n_steps, scenario.record_every
     n_records = steps // every + 2  # + the last good state of a failed run
     rec_t = np.full(n_records, np.nan)
-    rec_x = np.full((n_records, layout.x_size), np.nan)
+    rec_x = np.full((n_records, layout.plant.size), np.nan)
     rec_ctrl = np.full((n_records, layout.record_size), np.nan)
     x = np.concatenate([q0, qd0, [0.0, 0.0]])
     data = _loop_data(layout, scenario, J)
@@ -145,9 +145,10 @@ def run_slew(
     attrs["target_quaternion"] = data.q_d.tolist()
     # gain (3), environment (3), sloshing ratio and Hz, residual (3), T_max
     attrs["realised_disturbances"] = data.actuator_params.tolist()
+    at = layout.plant  # where each piece of the plant state lives
     ds = build_dataset(
-        plant, rec_t, rec_x[:, layout.q], rec_x[:, layout.qd], rec_x[:, layout.work],
-        rec_x[:, layout.dissipated], rec_ctrl[:, layout.tau_cmd], rec_ctrl[:, layout.tau_applied],
+        plant, rec_t, rec_x[:, at.q], rec_x[:, at.qd], rec_x[:, at.work_in],
+        rec_x[:, at.dissipated], rec_ctrl[:, layout.tau_cmd], rec_ctrl[:, layout.tau_applied],
         attrs,
     )  # fmt: skip
     ta = ("time", "axis")
@@ -156,7 +157,7 @@ def run_slew(
         attributes = {"units": channel.units, "description": channel.description}
         ds[channel.name] = (ta if channel.per_axis else "time", values, attributes)
     # of the true attitude, whatever the sensor measured
-    pointing = pointing_errors(data.q_d, np.ascontiguousarray(rec_x[:, layout.q][:, 3:6]))
+    pointing = pointing_errors(data.q_d, np.ascontiguousarray(rec_x[:, at.attitude]))
     ds["pointing_error_deg"] = (
         "time", np.degrees(pointing),
         {"units": "deg", "description": "2 asin |q_v,e| of the true attitude: absolute "

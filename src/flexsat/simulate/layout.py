@@ -10,6 +10,7 @@ from dataclasses import dataclass
 from flexsat.control.laws import LawSpec
 from flexsat.control.registry import Channel
 from flexsat.control.stages import StageSpec
+from flexsat.dynamics.layout import StateLayout
 
 __all__ = ["LoopLayout"]
 
@@ -20,8 +21,8 @@ _LOOP_COLUMNS = ("tau_cmd", "tau_applied")
 class LoopLayout:
     """Offsets of a closed loop's state and records.
 
-    Plant state ``x`` (``x_size``,): q ``[q]``, q_dot ``[qd]``, cumulative work of
-    the applied torque ``[work]`` and damper dissipation ``[dissipated]`` [J].
+    Plant state ``x``: the plant's own :class:`~flexsat.dynamics.layout.StateLayout`
+    (``plant``: q, q_dot, each appendage's block, work and dissipation).
 
     Control state (``state_size``,): the law's ``[law_state]``, the sensor's
     ``[sensor_state]`` and the actuator's ``[actuator_state]``, zero at t = 0.
@@ -31,30 +32,10 @@ class LoopLayout:
     ``[law_diag]``, the sensor's and the actuator's records.
     """
 
-    n_dof: int
+    plant: StateLayout
     law: LawSpec
     sensor: StageSpec
     actuator: StageSpec
-
-    @property
-    def q(self) -> slice:
-        return slice(0, self.n_dof)
-
-    @property
-    def qd(self) -> slice:
-        return slice(self.n_dof, 2 * self.n_dof)
-
-    @property
-    def work(self) -> int:
-        return 2 * self.n_dof
-
-    @property
-    def dissipated(self) -> int:
-        return 2 * self.n_dof + 1
-
-    @property
-    def x_size(self) -> int:
-        return 2 * self.n_dof + 2
 
     @property
     def law_state(self) -> slice:
