@@ -49,14 +49,14 @@ else:
     import flexsat.simulate.closedloop as closedloop
     if mode == "api":
         stamps["import flexsat.simulate"] = time.time()
-    compiled_loop = closedloop.run_closed_loop
+    compiled_loop = closedloop.rk4_closed_loop
 
     def first_chunk(*args):
         out = compiled_loop(*args)
         stamps.setdefault("simulating", time.time())
         return out
 
-    closedloop.run_closed_loop = first_chunk
+    closedloop.rk4_closed_loop = first_chunk
     if mode == "cli":
         from flexsat.cli.main import main
         sys.argv = ["flexsat", *sys.argv[2:]]

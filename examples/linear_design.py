@@ -14,7 +14,7 @@ from pathlib import Path
 import numpy as np
 
 from flexsat.config import nominal
-from flexsat.control.config import PDConfig
+from flexsat.control.laws.pd import PDConfig
 from flexsat.dynamics.plant import Plant
 from flexsat.linear import (
     balanced_truncation,

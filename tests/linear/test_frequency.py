@@ -3,7 +3,9 @@
 import numpy as np
 import pytest
 
-from flexsat.control.config import ASMCConfig, SMCConfig
+from flexsat.control.laws.asmc import ASMCConfig
+from flexsat.control.laws.smc import SMCConfig
+from flexsat.control.laws.stsmc import STSMCConfig
 from flexsat.errors import ConfigError
 from flexsat.linear.frequency import (
     effective_inertia,
@@ -114,6 +116,12 @@ def test_sliding_mode_loops_inside_the_boundary_layer(plant, rest_model, law, la
     margins = loop_margins(pd_loop(rest_model, K, "y"))
     # The torsion modes (0.8 Hz) sit above the crossover and pull it down by `shift`.
     assert margins.gain_crossover_hz == pytest.approx(np.sqrt(w2) / (2 * np.pi), rel=shift)
+
+
+def test_a_law_without_a_linear_form_is_refused_naming_the_ones_with_one(plant):
+    # The super-twisting term |s|^1/2 sgn(s) has no derivative at s = 0.
+    with pytest.raises(ConfigError, match=r"no linear form about rest.*asmc, smc, pd"):
+        law_gains(plant, STSMCConfig())
 
 
 def test_loop_of_an_unknown_axis_is_refused(plant, rest_model):

@@ -17,7 +17,8 @@ import numpy as np
 from scipy.linalg import eigh
 from scipy.optimize import brentq
 
-from flexsat.control.config import ASMCConfig, PDConfig, SMCConfig
+from flexsat.control.laws import LawConfig, get_law, law_names
+from flexsat.control.laws.pd import PDConfig
 from flexsat.dynamics.plant import Plant
 from flexsat.dynamics.rigid import rigid_inertia
 from flexsat.errors import ConfigError
@@ -94,47 +95,38 @@ def pd_gains(plant: Plant, pd: PDConfig | None = None) -> np.ndarray:
     J the rigid design inertia linearizes to ``tau = -J (wn^2 theta + 2 zeta wn w)``
     (the gyroscopic term is quadratic in the rate).
     """
-    pd = pd or PDConfig()
-    wn, zeta = pd.natural_frequency_rad_s, pd.damping_ratio
-    J = rigid_inertia(plant)
-    return np.hstack([J * wn**2, J * 2.0 * zeta * wn])
+    return law_gains(plant, pd or PDConfig())
 
 
-def _sliding_gains(J: np.ndarray, lam: float, jk: float, phi: float) -> np.ndarray:
-    """Inside the boundary layer |s| < Phi, about rest (q_v,e ~ theta/2, q_v,e_dot ~ w/2):
-    tau = -Lambda J q_v,e_dot - JK s / Phi with s = w + Lambda q_v,e (eqs. 4.13-4.14)."""
-    k = jk / phi
-    return np.hstack([0.5 * k * lam * np.eye(3), 0.5 * lam * J + k * np.eye(3)])
-
-
-def _smc_gains(plant: Plant, law: SMCConfig) -> np.ndarray:
-    return _sliding_gains(rigid_inertia(plant), law.lambda_, law.jk_nm, law.phi)
-
-
-def _asmc_gains(plant: Plant, law: ASMCConfig) -> np.ndarray:
-    # At the target: Lambda_target = lambda_max (eq. 4.27 at theta = 0), never cut by
-    # the budget (J q_v,e_dot -> 0, eq. 4.28), and JK = JK_min at s = 0 (eq. 4.30).
-    return _sliding_gains(rigid_inertia(plant), law.lambda_max, law.jk_min_nm, law.phi)
-
-
-_LINEARIZED_LAWS = {"pd": pd_gains, "smc": _smc_gains, "asmc": _asmc_gains}
-
-
-def law_gains(plant: Plant, law=None) -> np.ndarray:
+def law_gains(plant: Plant, law: LawConfig | None = None) -> np.ndarray:
     """Static gain K, shape (3, 6), of a law linearized about rest: tau = -K [theta; omega].
 
     Parameters
     ----------
     plant : Plant
         Its rigidized inertia is the law's design model.
-    law : PDConfig, SMCConfig or ASMCConfig, optional
-        Default: the PD law with its default gains. The sliding-mode laws are
-        linearized inside their boundary layer, the SMC with its constant Lambda and
-        JK, the ASMC with its steady-state values at the target (Lambda = lambda_max,
-        JK = JK_min); see :func:`_sliding_gains`.
+    law : LawConfig, optional
+        Any registered law's parameters; default: the PD law with its default gains.
+        Each law says how it linearizes (``LawConfig.linear_feedback``): the
+        sliding-mode laws inside their boundary layer, the SMC with its constant
+        Lambda and JK, the ASMC with its steady-state values at the target
+        (Lambda = lambda_max, JK = JK_min).
+
+    Raises
+    ------
+    ConfigError
+        For a law without a linear form about rest.
     """
     law = law or PDConfig()
-    return _LINEARIZED_LAWS[law.kind](plant, law)
+    K = law.linear_feedback(rigid_inertia(plant))
+    if K is None:
+        linear = [name for name in law_names()  # the laws that say how they linearize
+                  if get_law(name).config.linear_feedback is not LawConfig.linear_feedback]
+        raise ConfigError(
+            f"controller.kind: the {law.kind!r} law has no linear form about rest "
+            f"(laws with one: {', '.join(linear)})"
+        )
+    return np.asarray(K, dtype=float)
 
 
 def pd_loop(model: LinearModel, K: np.ndarray, axis: str) -> LinearModel:

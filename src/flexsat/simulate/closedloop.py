@@ -25,7 +25,7 @@ from flexsat.simulate.loops import (
     LoopData,
     LoopRecords,
     LoopStages,
-    run_closed_loop,
+    rk4_closed_loop,
 )
 from flexsat.simulate.openloop import initial_state
 from flexsat.simulate.result import Result, build_dataset
@@ -211,7 +211,7 @@ def _compiled_loop(plant, scenario, x, stages, data, rec_t, rec_x, rec_ctrl, bar
         n_chunk = min(chunk, steps - done)
         final = done + n_chunk == steps
         clock = LoopClock(done * scenario.dt_s, scenario.dt_s, n_chunk, final, control, every)
-        status, ran, written = run_closed_loop(
+        status, ran, written = rk4_closed_loop(
             x, clock, stages, data, LoopRecords(rec_t, rec_x, rec_ctrl, rows), plant.packed
         )
         done += ran

@@ -9,12 +9,10 @@ in between (zero-order hold). Nothing is allocated inside the loop.
 
 from __future__ import annotations
 
-import warnings
 from typing import NamedTuple
 
 import numpy as np
 from numba import njit
-from numba.core.errors import NumbaExperimentalFeatureWarning
 
 from flexsat.dynamics.integrators import rk4_step
 from flexsat.dynamics.status import STATUS_CONTROL_FAILED, STATUS_OK
@@ -25,7 +23,6 @@ __all__ = [
     "LoopRecords",
     "LoopStages",
     "rk4_closed_loop",
-    "run_closed_loop",
 ]
 
 
@@ -87,19 +84,19 @@ class LoopRecords(NamedTuple):
 
 
 @njit(cache=True)
-def rk4_closed_loop(x, clock, stages, d, records, plant_args):
+def rk4_closed_loop(x, clock, stages, d, records, plant):
     """Run ``clock.n_steps`` closed-loop steps from ``clock.t0``; ``x`` advanced in place.
 
     At each step k (time t0 + k dt): run sensor, law and actuator if k is a control
     instant, record if k is a record instant, then take one RK4 step. Chunk
     boundaries must be multiples of ``control_every`` and ``record_every``.
-    ``plant_args`` are the plant's packed arguments, passed to ``rk4_step`` as is.
+    ``plant`` is the plant's named structure (``Plant.packed``), passed to ``rk4_step``.
 
     Returns
     -------
     status, steps_done, records_written
     """
-    n = (x.shape[0] - 2) // 2
+    n = plant.n_dof
     scratch = np.empty((5, x.shape[0]))
     Q = np.empty(n)
     control_dt = clock.control_every * clock.dt
@@ -127,20 +124,7 @@ def rk4_closed_loop(x, clock, stages, d, records, plant_args):
         if k == clock.n_steps:
             break
         torque = (d.tau_applied[0], d.tau_applied[1], d.tau_applied[2])
-        status = rk4_step(x, clock.dt, torque, n, Q, scratch, plant_args)
+        status = rk4_step(x, clock.dt, torque, n, Q, scratch, plant)
         if status != STATUS_OK:
             return status, k, row - records.start
     return STATUS_OK, clock.n_steps, row - records.start
-
-
-def run_closed_loop(x, clock: LoopClock, stages: LoopStages, data: LoopData,
-                    records: LoopRecords, plant_args) -> tuple[int, int, int]:  # fmt: skip
-    """:func:`rk4_closed_loop`, with numba's notice on first-class functions silenced.
-
-    numba flags its first-class function type as experimental at every call that
-    passes one; the loop depends on it by design (measured: 26-54 ns per call),
-    so that one warning category is ignored here, and only here.
-    """
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", NumbaExperimentalFeatureWarning)
-        return rk4_closed_loop(x, clock, stages, data, records, plant_args)

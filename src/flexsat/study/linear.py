@@ -224,6 +224,6 @@ def family_margins(
 
 
 def _law(scenario):
-    from flexsat.control.config import PDConfig
+    from flexsat.control.laws.pd import PDConfig
 
     return PDConfig() if scenario is None else scenario.controller

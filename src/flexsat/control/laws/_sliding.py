@@ -5,13 +5,32 @@ from __future__ import annotations
 
 from math import asin, sqrt
 
+import numpy as np
 from numba import njit
 
 from flexsat.control.quaternion import quaternion_error
 from flexsat.control.registry import Channel
 from flexsat.dynamics.linalg3 import cross
 
-__all__ = ["SLIDING_DIAGNOSTICS", "clip_and_store", "errors", "inertia3", "sat"]
+__all__ = [
+    "SLIDING_DIAGNOSTICS",
+    "clip_and_store",
+    "errors",
+    "inertia3",
+    "linear_sliding_feedback",
+    "sat",
+]
+
+
+def linear_sliding_feedback(J: np.ndarray, lam: float, jk: float, phi: float) -> np.ndarray:
+    """Static gain K (3, 6) of a sliding-mode law inside its boundary layer, about rest.
+
+    With |s| < Phi, q_v,e ~ theta / 2 and q_v,e_dot ~ omega / 2, the law
+    tau = -Lambda J q_v,e_dot - JK s / Phi, s = omega + Lambda q_v,e (eqs. 4.13-4.14),
+    is tau = -K [theta; omega] (the gyroscopic term is quadratic in the rate).
+    """
+    k = jk / phi
+    return np.hstack([0.5 * k * lam * np.eye(3), 0.5 * lam * np.asarray(J) + k * np.eye(3)])
 
 
 @njit(cache=True)

@@ -19,6 +19,7 @@ from flexsat.control.laws._sliding import (
     clip_and_store,
     errors,
     inertia3,
+    linear_sliding_feedback,
     sat,
 )
 from flexsat.control.laws.registry import LAW_SIGNATURE, LawConfig, LawSpec
@@ -75,6 +76,11 @@ class ASMCConfig(LawConfig):
             "jk_floor_nm": self.jk_min_nm,
             "theta_threshold_deg": self.theta_threshold_deg,
         }
+
+    def linear_feedback(self, J: np.ndarray) -> np.ndarray:
+        # At the target: Lambda_target = lambda_max (eq. 4.27 at theta = 0), never cut
+        # by the budget (J q_v,e_dot -> 0, eq. 4.28), and JK = JK_min at s = 0 (eq. 4.30).
+        return linear_sliding_feedback(J, self.lambda_max, self.jk_min_nm, self.phi)
 
 
 @njit(cache=True)

@@ -47,6 +47,12 @@ class PDConfig(LawConfig):
             2.0 * self.damping_ratio * wn,
         ), dtype=float)  # fmt: skip
 
+    def linear_feedback(self, J: np.ndarray) -> np.ndarray:
+        # With q_v,e ~ theta / 2: tau = -J (wn^2 theta + 2 zeta wn omega); the
+        # gyroscopic term is quadratic in the rate.
+        wn, zeta = self.natural_frequency_rad_s, self.damping_ratio
+        return np.hstack([np.asarray(J) * wn**2, np.asarray(J) * 2.0 * zeta * wn])
+
 
 @njit(LAW_SIGNATURE, cache=True)
 def pd_step(q_d, omega_d, omega_dot_d, q, omega_B, J, gains, state, t, dt, tau_cmd, diag):

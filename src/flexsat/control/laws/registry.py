@@ -98,6 +98,23 @@ class LawConfig(_Frozen):
         """
         return {}
 
+    def linear_feedback(self, J: np.ndarray) -> np.ndarray | None:
+        """The law linearized about rest, for the frequency-domain analysis.
+
+        Parameters
+        ----------
+        J : ndarray, shape (3, 3)
+            Design inertia J_tot [kg m^2].
+
+        Returns
+        -------
+        ndarray, shape (3, 6), or None
+            Static gain K of tau = -K [theta; omega] (theta the small attitude error,
+            ZYX angles [rad]; omega the body rate [rad/s]); ``None`` (the default) for
+            a law without a linear form about rest.
+        """
+        return None
+
 
 @dataclass(frozen=True)
 class LawSpec:

@@ -19,6 +19,7 @@ from flexsat.control.laws._sliding import (
     clip_and_store,
     errors,
     inertia3,
+    linear_sliding_feedback,
     sat,
 )
 from flexsat.control.laws.registry import LAW_SIGNATURE, LawConfig, LawSpec
@@ -61,6 +62,9 @@ class SMCConfig(LawConfig):
             "boundary_layer_rad_s": self.phi,
             "jk_floor_nm": self.jk_nm,
         }
+
+    def linear_feedback(self, J: np.ndarray) -> np.ndarray:
+        return linear_sliding_feedback(J, self.lambda_, self.jk_nm, self.phi)
 
 
 @njit(LAW_SIGNATURE, cache=True)
