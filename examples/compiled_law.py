@@ -1,4 +1,8 @@
-"""Your own control law, compiled, flying inside flexsat's compiled loop.
+"""
+Your own compiled control law
+=============================
+
+Your own control law, compiled, flying inside flexsat's compiled loop.
 
 A quaternion PID with gyroscopic compensation and a 3-axis integral state. The
 law is this file: a parameter model, a compiled step of the law signature and one

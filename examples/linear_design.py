@@ -1,4 +1,8 @@
-"""Frequency-domain design with the linear model: PD loop, flexible modes, a reduced model.
+"""
+Frequency-domain design with the linear model
+=============================================
+
+Frequency-domain design with the linear model: PD loop, flexible modes, a reduced model.
 
 Linearizes the nominal satellite about rest, closes the PD law's loop one axis at a
 time and reports its margins, ranks the appendage modes by effective inertia, and

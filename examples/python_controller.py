@@ -1,4 +1,8 @@
-"""Fly the thesis slew with your own control law written in plain Python.
+"""
+A control law in plain Python
+=============================
+
+Fly the thesis slew with your own control law written in plain Python.
 
 A quaternion PID with gyroscopic compensation, using the same design model as the
 built-in laws (the rigid nominal satellite). Run it::

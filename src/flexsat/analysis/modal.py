@@ -71,7 +71,7 @@ class ModalAnalysis:
     shapes : ndarray, shape (n_dof, n_dof)
         Mass-normalized mode shapes in columns (phi^T M phi = 1).
     participation : ndarray, shape (n_dof, n_dof)
-        Mass-weighted amplitudes |phi_j| sqrt(M_jj), each column scaled to max 1:
+        Mass-weighted amplitudes ‖phi_j‖ sqrt(M_jj), each column scaled to max 1:
         the modal interaction map (thesis fig. 3.2).
     """
 

@@ -17,11 +17,11 @@ def openloop_metrics(ds: xr.Dataset) -> dict:
 
     Keys: ``final_angular_momentum_nms`` (3, inertial), ``final_rate_deg_s`` (3, body),
     ``total_energy_j`` (final), ``peak_elastic_energy_j``, ``dissipated_energy_j``
-    (final cumulative), ``peak_flex_torque_nm`` (3, max |tau_flex| per body axis),
+    (final cumulative), ``peak_flex_torque_nm`` (3, max ‖tau_flex‖ per body axis),
     ``peak_tip_displacement_m``, ``peak_root_rotation_deg``, ``dominant_frequency_hz``
     (of the yaw-acceleration ripple after the commanded torque ends; NaN if the
     torque never ends or too little time is left), ``energy_balance_error_j``
-    (max |E - E0 - W_in + W_diss|), ``wall_time_s``, ``steps``, ``status``, ``message``.
+    (max ‖E - E0 - W_in + W_diss‖), ``wall_time_s``, ``steps``, ``status``, ``message``.
 
     A diverged run's metrics are those of its finite part (:func:`finite_part`);
     ``finite_until_s`` says where that ends.

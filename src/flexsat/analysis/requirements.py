@@ -100,7 +100,7 @@ def error_rotation_vector(quaternion: np.ndarray, target: np.ndarray) -> np.ndar
     Returns
     -------
     ndarray, shape (n, 3)
-        theta_err * axis with theta_err = 2 atan2(|q_v,e|, q_e0) in [0, pi] (the
+        theta_err * axis with theta_err = 2 atan2(‖q_v,e‖, q_e0) in [0, pi] (the
         shorter rotation, eq. 4.1); its norm is the pointing error.
     """
     q = np.asarray(quaternion, dtype=float)
@@ -129,7 +129,7 @@ def absolute_performance_error(error: np.ndarray) -> float:
 
 
 def relative_performance_error(t: np.ndarray, error: np.ndarray, duration_s: float) -> float:
-    """RPE: the largest |e(t) - mean of e over its window| (ECSS-E-ST-60-10C).
+    """RPE: the largest ‖e(t) - mean of e over its window‖ (ECSS-E-ST-60-10C).
 
     The records are cut into consecutive windows of ``duration_s`` from the first
     one (a shorter last window counts too); in each window the error vector's mean
@@ -198,7 +198,7 @@ def slew_metrics(
         at every record of ``observation_window_s`` (start, end); R2: the residual
         rate stays below ``jitter_deg_s`` there; both fail when the records do not
         reach the window's end (a run shorter than the deadline, or stopped). R3:
-        |applied torque| <= T_max on every axis at every record. ``ape_deg`` and
+        ‖applied torque‖ <= T_max on every axis at every record. ``ape_deg`` and
         ``rpe_deg`` are the APE and RPE over the window (RPE over windows of
         ``rpe_window_s``), ``max_rate_error_deg_s`` the largest residual rate there.
         Settling times are when each quantity enters its band for good (NaN if not

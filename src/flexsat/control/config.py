@@ -17,8 +17,8 @@ class DisturbanceConfig(_Frozen):
     'Disturbances forced to maximum') or one random draw within the same bounds.
 
     In ``mode = "random"`` each run draws, from ``seed``: the actuator gain per axis
-    uniformly within 1 +- |1 - G_act|, the environment and residual torques per axis
-    within +-|value|, and the sloshing ratio within [0, ratio]. The realised values
+    uniformly within 1 +- ‖1 - G_act‖, the environment and residual torques per axis
+    within +-‖value‖, and the sloshing ratio within [0, ratio]. The realised values
     are stored in the result's attributes so the run can be replayed.
     """
 

@@ -57,7 +57,7 @@ def target_quaternion(euler_deg: tuple[float, float, float]) -> np.ndarray:
 
 @njit(cache=True)
 def pointing_error(q_d, q):
-    """Absolute pointing error 2 asin |q_v,e| [rad] of attitude ``q`` from ``q_d``."""
+    """Absolute pointing error 2 asin ‖q_v,e‖ [rad] of attitude ``q`` from ``q_d``."""
     e = quaternion_error(q_d, q)
     return 2.0 * asin(min(1.0, sqrt(e[1] ** 2 + e[2] ** 2 + e[3] ** 2)))
 

@@ -19,7 +19,7 @@ def rigid_inertia(plant: Plant) -> np.ndarray:
 
     Each appendage, frozen undeformed (its model's ``rigid_body``: for a plate, the
     centroidal inertia rotated into B, R_BM J_p R_BM^T), is carried to the hub centre of
-    mass by the parallel-axis theorem in matrix form, m (|r|^2 I - r r^T), with r its
+    mass by the parallel-axis theorem in matrix form, m (‖r‖^2 I - r r^T), with r its
     undeformed centre of mass.
 
     Returns

@@ -5,19 +5,19 @@ equilibrium, with a name (and unit) for every state, input and output. It conver
 to a ``control.StateSpace`` of python-control and writes plain arrays for users who
 continue elsewhere. The variable names in both files are the same:
 
-========== ===================================================================
-name       content
-========== ===================================================================
-``A``      (n_x, n_x) state matrix
-``B``      (n_x, n_u) input matrix
-``C``      (n_y, n_x) output matrix
-``D``      (n_y, n_u) feedthrough matrix
-``x0``     (n_x,) equilibrium state (body-frame variables, SI)
-``u0``     (n_u,) equilibrium input (the torque holding a spin, zero at rest) [N m]
-``spin``   (3,) body rate of the reference motion, hub frame B [rad/s]
-``state_names``, ``input_names``, ``output_names``  names, one string per row
-``state_units``, ``input_units``, ``output_units``  SI units of each
-========== ===================================================================
+=================== ===================================================================
+name                content
+=================== ===================================================================
+``A``               (n_x, n_x) state matrix
+``B``               (n_x, n_u) input matrix
+``C``               (n_y, n_x) output matrix
+``D``               (n_y, n_u) feedthrough matrix
+``x0``              (n_x,) equilibrium state (body-frame variables, SI)
+``u0``              (n_u,) equilibrium input (the torque holding a spin, zero at rest) [N m]
+``spin``            (3,) body rate of the reference motion, hub frame B [rad/s]
+``state_names``     names, one string per row (likewise ``input_names``, ``output_names``)
+``state_units``     SI units of each (likewise ``input_units``, ``output_units``)
+=================== ===================================================================
 """
 
 from __future__ import annotations

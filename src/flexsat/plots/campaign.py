@@ -196,7 +196,7 @@ def plot_envelope_pointing(store_dir: str | Path) -> Figure:
 
 
 def plot_envelope_rate(store_dir: str | Path) -> Figure:
-    """Residual rate |ω − ω_d| [deg/s] of every case (log) with the R2 band."""
+    """Residual rate ‖ω − ω_d‖ [deg/s] of every case (log) with the R2 band."""
     c = _load(store_dir)
     return _log_panel(
         c,

@@ -22,7 +22,7 @@ _COLOURS = ("black", "tab:orange", "tab:blue", "tab:green", "tab:purple", "tab:r
 
 
 def plot_controller_comparison(datasets: dict[str, xr.Dataset]) -> Figure:
-    """Pointing error [deg], residual rate [deg/s] and |applied torque| [N m] per law.
+    """Pointing error [deg], residual rate [deg/s] and ‖applied torque‖ [N m] per law.
 
     Parameters
     ----------

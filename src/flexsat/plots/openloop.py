@@ -528,7 +528,7 @@ def plot_energy(ds: xr.Dataset) -> Figure:
     Top: kinetic energy T, elastic energy U, total E = T + U, cumulative work of
     the applied torque W_in and cumulative damper dissipation W_diss; E tracks
     W_in - W_diss. Bottom, on a logarithmic scale: U, W_diss and the magnitude of
-    the balance error |E - E(0) - W_in + W_diss|, the integration's numerical error.
+    the balance error ‖E - E(0) - W_in + W_diss‖, the integration's numerical error.
 
     Parameters
     ----------

@@ -346,11 +346,11 @@ def _requirement_panel(ax: Axes, t: np.ndarray, values: np.ndarray, bound: float
 
 
 def plot_pointing(ds: xr.Dataset) -> Figure:
-    """Pointing error [deg] and residual rate |omega| [deg/s] on log scales.
+    """Pointing error [deg] and residual rate ‖omega‖ [deg/s] on log scales.
 
-    Top: the absolute pointing error 2 asin |q_v,e| with the R1 band (below the
+    Top: the absolute pointing error 2 asin ‖q_v,e‖ with the R1 band (below the
     scenario's ``requirements.pointing_deg``) shaded green; bottom: the residual
-    rate (jitter) |omega - omega_d| with the R2 band (``requirements.jitter_deg_s``).
+    rate (jitter) ‖omega - omega_d‖ with the R2 band (``requirements.jitter_deg_s``).
     Each panel marks the time its quantity enters its band for good
     (:func:`flexsat.analysis.requirements.settling_time`), shades the observation
     window and gives the verdict over it (:func:`flexsat.analysis.slew_metrics`).
@@ -452,7 +452,7 @@ def plot_phase_plane(ds: xr.Dataset) -> Figure:
     sliding surfaces s = omega_e + Lambda q_v,e = 0 are drawn as lines of slope
     -Lambda: the initial surface with Lambda_min and the final one with Lambda_max
     (a single one for the constant-slope SMC), each with its boundary layer
-    |s| <= Phi, the band of half-width Phi in omega, Phi/Lambda in q. Top row: the
+    ‖s‖ <= Phi, the band of half-width Phi in omega, Phi/Lambda in q. Top row: the
     whole slew; bottom row: close to the target, from the time the pointing error
     drops below the ASMC threshold theta_th (5 deg for the other laws) on.
 
@@ -512,7 +512,7 @@ def plot_phase_plane(ds: xr.Dataset) -> Figure:
 def plot_sliding_variables(ds: xr.Dataset) -> Figure:
     """Sliding variable s = omega_e + Lambda_act q_v,e per axis [rad/s], symlog scale.
 
-    The boundary layer |s| <= Phi is shaded with its edges +-Phi dashed; the
+    The boundary layer ‖s‖ <= Phi is shaded with its edges +-Phi dashed; the
     scale is linear within Phi/1000 of zero and logarithmic beyond, so both the
     reaching phase and the small residual inside the layer show. Each panel
     gives the time s enters the layer for good.
@@ -726,7 +726,7 @@ def plot_torque_limits(ds: xr.Dataset) -> Figure:
     """Commanded and applied torque per axis [N m] against the actuator limits.
 
     The software limit +-RF * T_max clips the command; the hardware saturation
-    +-T_max clips the applied torque (requirement R3: |tau_applied| <= T_max).
+    +-T_max clips the applied torque (requirement R3: ‖tau_applied‖ <= T_max).
 
     Parameters
     ----------

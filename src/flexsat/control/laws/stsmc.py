@@ -5,24 +5,24 @@ sliding mode control for attitude tracking and vibration suppression of a flexib
 spacecraft), on the surface s = omega_e + lambda q_v,e (eq. 4.6, lambda constant):
 
     tau = omega x J omega - J lambda q_v,e_dot + J u,
-    u   = -k1 |s|^(1/2) sgn(s) + v,     v_dot = -k2 sgn(s)     (per body axis)
+    u   = -k1 ‖s‖^(1/2) sgn(s) + v,     v_dot = -k2 sgn(s)     (per body axis)
 
 On the rigid design model (eq. 4.7) with a disturbance torque d this gives exactly
 s_dot = u + a, a = J^-1 d: the super-twisting algorithm in s, whose integral v
 learns -a. The gains come from the disturbance bound D_max and a disturbance
 frequency f_d: the torque rate is bounded by L = 2 pi f_d D_max [N m/s], on axis i
-the perturbation rate by L_i = L sum_j |J^-1_ij| [rad/s^3], and
+the perturbation rate by L_i = L sum_j ‖J^-1_ij‖ [rad/s^3], and
 
     k1_i = c1 sqrt(L_i),   k2_i = c2 L_i.
 
 With the quadratic Lyapunov function of Moreno and Osorio (2008),
-V = zeta^T P zeta, zeta = (|s|^(1/2) sgn(s), v + a), P = [[2 k2 + k1^2/2, -k1/2],
-[-k1/2, 1]], V_dot = -zeta^T Q zeta / |s|^(1/2) with Q positive definite for every
-|a_dot| <= L_i if and only if k1 > 0 and k2 > L_i + 2 L_i^2 / k1^2, that is
+V = zeta^T P zeta, zeta = (‖s‖^(1/2) sgn(s), v + a), P = [[2 k2 + k1^2/2, -k1/2],
+[-k1/2, 1]], V_dot = -zeta^T Q zeta / ‖s‖^(1/2) with Q positive definite for every
+‖a_dot‖ <= L_i if and only if k1 > 0 and k2 > L_i + 2 L_i^2 / k1^2, that is
 c2 > 1 + 2 / c1^2 (checked by the parameter model). Then s = s_dot = 0 in finite
 time, T <= 2 V(0)^(1/2) / gamma, gamma = lambda_min(Q) lambda_min(P)^(1/2) /
 lambda_max(P). The integral is held within the disturbance bound,
-|v_i| <= D_max sum_j |J^-1_ij| (anti-windup while the torque is clipped).
+‖v_i‖ <= D_max sum_j ‖J^-1_ij‖ (anti-windup while the torque is clipped).
 """
 
 from __future__ import annotations
@@ -104,7 +104,7 @@ class STSMCConfig(LawConfig):
 
 @njit(cache=True)
 def _inverse_row_sums(J):
-    """sum_j |J^-1_ij| for each row i of the (3, 3) inverse (adjugate / determinant)."""
+    """sum_j ‖J^-1_ij‖ for each row i of the (3, 3) inverse (adjugate / determinant)."""
     a, b, c = J[0, 0], J[0, 1], J[0, 2]
     d, e, f = J[1, 0], J[1, 1], J[1, 2]
     g, h, k = J[2, 0], J[2, 1], J[2, 2]
@@ -128,7 +128,7 @@ def axis_gains(gains: np.ndarray, J: np.ndarray) -> dict[str, np.ndarray]:
 
 
 def lyapunov_matrices(k1: float, k2: float, rho: float) -> tuple[np.ndarray, np.ndarray]:
-    """P and Q(rho) of V = zeta^T P zeta, |s|^(1/2) V_dot = -zeta^T Q zeta, rho = a_dot sgn(s)."""
+    """P and Q(rho) of V = zeta^T P zeta, ‖s‖^(1/2) V_dot = -zeta^T Q zeta, rho = a_dot sgn(s)."""
     P = np.array([[2.0 * k2 + 0.5 * k1**2, -0.5 * k1], [-0.5 * k1, 1.0]])
     Q = np.array([[k1 * k2 + 0.5 * k1**3 + rho * k1, -(0.5 * k1**2 + rho)],
                   [-(0.5 * k1**2 + rho), 0.5 * k1]])  # fmt: skip
@@ -142,7 +142,7 @@ def _sgn(x):
 
 @njit(cache=True)
 def _twist(k1, s):
-    """-k1 |s|^(1/2) sgn(s), the continuous term of the super-twisting algorithm."""
+    """-k1 ‖s‖^(1/2) sgn(s), the continuous term of the super-twisting algorithm."""
     return -k1 * sqrt(abs(s)) * _sgn(s)
 
 
