@@ -4,7 +4,7 @@ VENV   := .venv
 BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.installed
 
-.PHONY: demo test bench lint clean chromium
+.PHONY: demo test bench lint clean chromium docs
 
 $(STAMP): pyproject.toml
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
@@ -29,6 +29,7 @@ chromium:
 test: $(STAMP) chromium
 	$(BIN)/ruff check src tests bench examples
 	$(BIN)/python -m pytest -q
+	$(MAKE) docs
 
 # Every benchmark and the table of performance targets (docs/performance.md); the
 # optional `bench` extra adds Basilisk, the peer flexsat is compared with.
@@ -36,8 +37,19 @@ bench: $(STAMP)
 	$(BIN)/python -m pip install --quiet -e '.[dev,bench]'
 	$(BIN)/python bench/run_all.py
 
+# The documentation site (docs/documentation.md): Sphinx builds it, every example of the
+# gallery is executed, and a warning is an error.
+DOCS_STAMP := $(VENV)/.docs-installed
+$(DOCS_STAMP): pyproject.toml $(STAMP)
+	$(BIN)/python -m pip install --quiet -e '.[docs]'
+	touch $(DOCS_STAMP)
+
+docs: $(DOCS_STAMP)
+	MPLBACKEND=Agg $(BIN)/python -m sphinx -W --keep-going -q docs docs/_build/html
+	@echo "Documentation: $(CURDIR)/docs/_build/html/index.html"
+
 lint: $(STAMP)
 	$(BIN)/ruff check src tests bench examples
 
 clean:
-	rm -rf $(VENV) out build *.egg-info src/*.egg-info .pytest_cache .ruff_cache .hypothesis
+	rm -rf $(VENV) out build docs/_build docs/api docs/auto_examples *.egg-info src/*.egg-info .pytest_cache .ruff_cache .hypothesis

@@ -34,13 +34,40 @@ _HUB_COUPLING_MIN = 0.1
 
 
 def dof_names(plant: Plant) -> list[str]:
-    """Names of the generalized coordinates (see :meth:`Plant.dof_names`)."""
+    """Names of the generalized coordinates (see :meth:`Plant.dof_names`).
+
+    Parameters
+    ----------
+    plant : Plant
+        The satellite.
+
+    Returns
+    -------
+    list of str
+        One name per coordinate, in state order.
+    """
     return plant.dof_names()
 
 
 @dataclass(frozen=True)
 class Mode:
-    """One mode of the coupled system (1-based ``index``, ascending frequency)."""
+    """One mode of the coupled system (1-based ``index``, ascending frequency).
+
+    Attributes
+    ----------
+    index : int
+        1-based rank of the mode by frequency.
+    frequency_hz : float
+        Natural frequency [Hz] (0 for a rigid-body mode).
+    kind : str
+        ``"rigid"`` or the dominant joint motion (``"flapping"``, ``"torsion"``...).
+    symmetry : str
+        Mirror parity of the shape: ``"symmetric"``, ``"antisymmetric"`` or ``"none"``.
+    dominant_dofs : list of str
+        The coordinates with the largest mass-weighted amplitude.
+    hub_dof : str or None
+        The hub coordinate the mode drives most; None if it leaves the hub at rest.
+    """
 
     index: int
     frequency_hz: float
@@ -66,13 +93,23 @@ class ModalAnalysis:
 
     Attributes
     ----------
+    plant : Plant
+        The plant analysed.
+    mass_matrix : ndarray, shape (n_dof, n_dof)
+        M(0), the mass matrix at rest (eq. 3.2) [SI: kg, kg m, kg m^2].
+    stiffness_matrix : ndarray, shape (n_dof, n_dof)
+        K, the joint stiffness matrix (eq. 3.2) [SI: N/m, N m/rad].
     frequencies_hz : ndarray, shape (n_dof,)
-        Natural frequencies, ascending; the six rigid-body modes are exactly 0.
+        Natural frequencies, ascending; the six rigid-body modes are exactly 0 [Hz].
     shapes : ndarray, shape (n_dof, n_dof)
-        Mass-normalized mode shapes in columns (phi^T M phi = 1).
+        Mass-normalized mode shapes in columns (phi^T M phi = 1) [SI / sqrt(kg)].
     participation : ndarray, shape (n_dof, n_dof)
         Mass-weighted amplitudes ‖phi_j‖ sqrt(M_jj), each column scaled to max 1:
-        the modal interaction map (thesis fig. 3.2).
+        the modal interaction map (thesis fig. 3.2) [-].
+    modes : list of Mode
+        Classification of each mode, in the order of ``frequencies_hz``.
+    dof_names : list of str
+        Name of each generalized coordinate (rows of ``shapes``).
     """
 
     plant: Plant
@@ -128,6 +165,7 @@ def modal_analysis(plant: Plant) -> ModalAnalysis:
     Parameters
     ----------
     plant : Plant
+        The satellite.
 
     Returns
     -------

@@ -25,6 +25,16 @@ def openloop_metrics(ds: xr.Dataset) -> dict:
 
     A diverged run's metrics are those of its finite part (:func:`finite_part`);
     ``finite_until_s`` says where that ends.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        An open-loop result's dataset (:attr:`Result.dataset`).
+
+    Returns
+    -------
+    dict
+        The metrics above, each key naming its unit.
     """
     ds = finite_part(ds)
     t = ds["time"].values

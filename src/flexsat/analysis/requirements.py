@@ -68,7 +68,22 @@ class Requirements(_Frozen):
 
 
 def settling_time(t: np.ndarray, values: np.ndarray, bound: float) -> float:
-    """First time after which ``values`` stays below ``bound`` to the end [s]; NaN if never."""
+    """First time after which ``values`` stays below ``bound`` to the end [s]; NaN if never.
+
+    Parameters
+    ----------
+    t : ndarray, shape (n,)
+        Record times [s].
+    values : ndarray, shape (n,)
+        A non-negative signal, any unit ``u`` (a pointing error, a rate) [u].
+    bound : float
+        The band it must settle in, same unit [u].
+
+    Returns
+    -------
+    float
+        The settling time [s]; NaN if the last record is outside the band.
+    """
     above = np.nonzero(~(values < bound))[0]
     if above.size == 0:
         return float(t[0])
@@ -82,6 +97,18 @@ def observation_window(requirements: Requirements, planned_end_s: float) -> tupl
 
     From ``requirements.settling_deadline_s`` to ``requirements.window_end_s``, or to
     ``planned_end_s`` (the scenario's duration) when no end is given.
+
+    Parameters
+    ----------
+    requirements : Requirements
+        The scenario's requirements.
+    planned_end_s : float
+        End of the planned run, the scenario's duration [s].
+
+    Returns
+    -------
+    tuple of float
+        Start and end of the window [s].
     """
     end = requirements.window_end_s if requirements.window_end_s is not None else planned_end_s
     return float(requirements.settling_deadline_s), float(end)
@@ -93,9 +120,9 @@ def error_rotation_vector(quaternion: np.ndarray, target: np.ndarray) -> np.ndar
     Parameters
     ----------
     quaternion : ndarray, shape (n, 4)
-        Hub attitude q, scalar first.
+        Hub attitude q, scalar first [-].
     target : ndarray, shape (4,)
-        Target attitude q_d, scalar first.
+        Target attitude q_d, scalar first [-].
 
     Returns
     -------
@@ -119,7 +146,15 @@ def error_rotation_vector(quaternion: np.ndarray, target: np.ndarray) -> np.ndar
 def absolute_performance_error(error: np.ndarray) -> float:
     """APE over a window: the largest error magnitude at any record (ECSS-E-ST-60-10C).
 
-    ``error`` has shape (n,) (magnitudes) or (n, 3) (vectors); NaN if empty.
+    Parameters
+    ----------
+    error : ndarray, shape (n,) or (n, 3)
+        Error magnitudes or error vectors at each record (any unit ``u``) [u].
+
+    Returns
+    -------
+    float
+        The largest magnitude, in the unit of ``error`` [u]; NaN if ``error`` is empty.
     """
     error = np.asarray(error, dtype=float)
     if error.shape[0] == 0:
@@ -141,14 +176,14 @@ def relative_performance_error(t: np.ndarray, error: np.ndarray, duration_s: flo
     t : ndarray, shape (n,)
         Record times [s].
     error : ndarray, shape (n, 3)
-        Error vector at each record (any unit; the RPE has the same).
+        Error vector at each record, any unit ``u`` [u].
     duration_s : float
         Window duration [s].
 
     Returns
     -------
     float
-        NaN if there is no record.
+        The RPE, in the unit of ``error`` [u]; NaN if there is no record.
     """
     t = np.asarray(t, dtype=float)
     error = np.asarray(error, dtype=float)

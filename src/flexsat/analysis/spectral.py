@@ -18,6 +18,7 @@ def dominant_frequency(values: np.ndarray, dt: float, min_hz: float = 0.0) -> fl
     Parameters
     ----------
     values : ndarray, shape (m,)
+        The signal, any unit [u].
     dt : float
         Sample interval [s].
     min_hz : float

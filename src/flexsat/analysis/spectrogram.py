@@ -54,13 +54,13 @@ def spectrogram(
     Parameters
     ----------
     values : ndarray, shape (m,)
-        The signal, any unit ``u`` (e.g. rad/s^2).
+        The signal, any unit ``u`` (e.g. rad/s^2) [u].
     dt : float
         Sample interval [s].
     window_s : float
         Segment length [s].
     overlap : float
-        Overlap of consecutive segments, as a fraction of a segment, in [0, 1).
+        Overlap of consecutive segments, as a fraction of a segment, in [0, 1) [-].
 
     Returns
     -------
@@ -115,6 +115,7 @@ def coupled_frequencies(analysis: ModalAnalysis, hub_axis: str) -> np.ndarray:
     Parameters
     ----------
     analysis : ModalAnalysis
+        The modes (:func:`flexsat.analysis.modal_analysis`).
     hub_axis : {"x", "y", "z"}
         Body axis of the hub rotation; the coordinate names ``"phi"``, ``"theta"``,
         ``"psi"`` are accepted too.

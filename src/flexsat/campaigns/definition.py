@@ -81,12 +81,12 @@ class CampaignDefinition(_Frozen):
     name: Annotated[
         str, Field(min_length=1, max_length=80, pattern=r"^[A-Za-z0-9_][A-Za-z0-9_.+\-]*$")
     ] = Field(description="campaign name, also its store folder's (no path separators)")
-    description: str = ""
+    description: str = Field("", description="one line for listings")
     include_nominal: bool = Field(True, description="add the unmodified case 'nominal'")
     base: dict = Field(default_factory=dict, description="SlewScenario fields for every case")
-    cases: list[CaseSpec] = Field(default_factory=list)
-    grid: Grid | None = None
-    random: RandomCases | None = None
+    cases: list[CaseSpec] = Field(default_factory=list, description="cases listed one by one")
+    grid: Grid | None = Field(None, description="cases crossed from levels of several axes")
+    random: RandomCases | None = Field(None, description="cases drawn from distributions")
 
     @model_validator(mode="after")
     def _has_cases(self) -> CampaignDefinition:
@@ -103,7 +103,23 @@ class CampaignDefinition(_Frozen):
 
 @dataclass(frozen=True)
 class ResolvedCase:
-    """A case ready to run anywhere: validated plant config and scenario as plain dicts."""
+    """A case ready to run anywhere: validated plant config and scenario as plain dicts.
+
+    Attributes
+    ----------
+    case_id : str
+        The case's id, also its file name in the store.
+    root_seed : int
+        The campaign's root seed.
+    stream_index : int
+        Index of the case's random stream, ``SeedSequence(root_seed, spawn_key=(index,))``.
+    plant : dict
+        The case's satellite config, validated, as plain data (SI).
+    scenario : dict
+        The case's slew scenario, validated, as plain data.
+    parameters : dict
+        The realised value of each modifier, by config path (SI or the path's unit).
+    """
 
     case_id: str
     root_seed: int
@@ -142,7 +158,23 @@ def campaign_fingerprint(
 
 
 def load_campaign(name_or_path: str | Path) -> CampaignDefinition:
-    """A shipped preset by name, or a campaign TOML file."""
+    """A shipped preset by name, or a campaign TOML file.
+
+    Parameters
+    ----------
+    name_or_path : str or Path
+        A preset name (``sensitivity``, ``montecarlo-critical``, ``deployment-shock``,
+        ``montecarlo-random``) or the path of a campaign TOML file.
+
+    Returns
+    -------
+    CampaignDefinition
+
+    Raises
+    ------
+    ConfigError
+        If no preset has that name and no such file exists, or the file is invalid.
+    """
     if str(name_or_path) in CAMPAIGN_PRESETS:
         path = Path(str(resources.files("flexsat.campaigns") / "presets" / f"{name_or_path}.toml"))
     else:
@@ -159,6 +191,21 @@ def resolve_cases(
     definition: CampaignDefinition, satellite: SatelliteConfig, n_random: int | None = None
 ) -> list[ResolvedCase]:
     """Expand and validate every case; any bad modifier is refused before a case runs.
+
+    Parameters
+    ----------
+    definition : CampaignDefinition
+        The campaign.
+    satellite : SatelliteConfig
+        The base satellite every case modifies.
+    n_random : int, optional
+        Number of random cases (``--cases``) of a campaign with a ``[random]`` table;
+        default the definition's own.
+
+    Returns
+    -------
+    list of ResolvedCase
+        In run order, the nominal first when the campaign includes it.
 
     Raises
     ------

@@ -48,7 +48,19 @@ _CASE_ID = re.compile(r"^[A-Za-z0-9_+\-][A-Za-z0-9_.+\-]*$")
 
 
 def replay_case(store: str | Path, case_id: str):
-    """Re-run one stored case alone from its stored inputs; returns its ``Result``.
+    """Re-run one stored case alone from its stored inputs.
+
+    Parameters
+    ----------
+    store : str or Path
+        The campaign's store folder.
+    case_id : str
+        The id of the case (a row of ``results.parquet``).
+
+    Returns
+    -------
+    Result
+        The case's slew, as :func:`flexsat.simulate.run_slew` returns it.
 
     Raises
     ------
@@ -81,7 +93,19 @@ def replay_case(store: str | Path, case_id: str):
 
 
 def summarize(store: str | Path) -> dict:
-    """Pass rates and the worst cases of a stored campaign."""
+    """Pass rates and the worst cases of a stored campaign.
+
+    Parameters
+    ----------
+    store : str or Path
+        The campaign's store folder.
+
+    Returns
+    -------
+    dict
+        ``cases``, ``failed``, the pass rate of each requirement (``r1_pass_rate``...,
+        fractions in [0, 1]) and the worst cases by final pointing error [deg].
+    """
     rows = CampaignStore(store).rows()
     n = len(rows)
 
@@ -146,6 +170,18 @@ def run_case(case: ResolvedCase) -> dict:
     The row also holds, under :data:`HISTORY_KEY`, the decimated time history of
     the case (:func:`case_history`); :func:`run_campaign` stores it apart from the
     table. A case that fails before simulating has no history.
+
+    Parameters
+    ----------
+    case : ResolvedCase
+        The case to fly.
+
+    Returns
+    -------
+    dict
+        The case's row: ``case_id``, ``status``, ``message``, ``parameters``,
+        ``inputs``, ``metrics`` (:func:`flexsat.analysis.slew_metrics`, SI or the
+        key's unit).
     """
     from flexsat.analysis.requirements import slew_metrics
     from flexsat.config.models import SatelliteConfig
@@ -196,16 +232,26 @@ def run_campaign(
 
     Parameters
     ----------
+    definition : CampaignDefinition
+        The campaign (:func:`load_campaign`).
+    satellite : SatelliteConfig
+        The base satellite.
+    out : str or Path
+        The store folder.
     workers : int, optional
         Local worker processes; default all cores. 1 runs in this process.
     resume : bool
         Skip the cases already in the store (refused if the store was made with
         other inputs: definition, satellite config, number of cases).
+    n_random : int, optional
+        Number of random cases of a ``[random]`` campaign (``--cases``).
     scheduler : str, optional
         Address of a running Dask scheduler (``tcp://host:port``). Connecting to
         it means trusting it: it runs the code it is sent.
     dask_local : int, optional
         Start a Dask LocalCluster with this many single-threaded worker processes.
+    progress : bool
+        Show a progress bar on the terminal.
 
     Returns
     -------

@@ -70,7 +70,13 @@ _HISTORY_DESCRIPTIONS = {
 
 
 class CampaignStore:
-    """A folder holding one campaign's results."""
+    """A folder holding one campaign's results (``docs/campaigns.md``, 'Resume rules').
+
+    Parameters
+    ----------
+    root : str or Path
+        The store folder (``--out`` of ``flexsat campaign``); created when written.
+    """
 
     def __init__(self, root: str | Path) -> None:
         self.root = Path(root)

@@ -20,7 +20,22 @@ _MAX_REPORTED = 3  # problems listed in one error message
 
 
 def preset_path(name: str) -> Path:
-    """Path of a shipped preset TOML file (copy it to start your own)."""
+    """Path of a shipped preset TOML file (copy it to start your own).
+
+    Parameters
+    ----------
+    name : str
+        The preset's name, e.g. ``"nominal"``.
+
+    Returns
+    -------
+    Path
+
+    Raises
+    ------
+    ConfigError
+        If no preset has that name (the message lists them).
+    """
     if name not in PRESETS:
         raise ConfigError(f"unknown preset {name!r}; available: {', '.join(PRESETS)}")
     return Path(str(resources.files("flexsat.config") / "presets" / f"{name}.toml"))
@@ -68,7 +83,27 @@ def read_toml(path: str | Path, what: str = "config") -> dict[str, Any]:
 def validate_config(
     data: dict[str, Any], source: str = "config", model: type[BaseModel] = SatelliteConfig
 ) -> Any:
-    """Validate a plain dict as ``model`` and turn the first error into a :class:`ConfigError`."""
+    """Validate a plain dict as ``model`` and turn the first error into a :class:`ConfigError`.
+
+    Parameters
+    ----------
+    data : dict
+        The parsed table (from TOML or JSON).
+    source : str
+        What the data came from, for the message (a file name).
+    model : type of pydantic.BaseModel
+        The model to validate against; default :class:`SatelliteConfig`.
+
+    Returns
+    -------
+    pydantic.BaseModel
+        The validated, frozen model.
+
+    Raises
+    ------
+    ConfigError
+        Naming the field path and the allowed range of the first error.
+    """
     try:
         return model.model_validate(data)
     except ValidationError as exc:

@@ -170,7 +170,7 @@ class AppendageConfig(_Frozen):
     Give the mass either as ``surface_density_kg_m2`` (eq. 2.6) or as ``mass_kg``.
     """
 
-    name: Name
+    name: Name = Field(description="unique name of the appendage")
     model: Literal["plate"] = Field("plate", description="appendage model (registry key)")
     mount_point_m: Point3 = Field(description="root position from hub centre of mass, frame B [m]")
     mount_yaw_deg: Angle = Field(0.0, description="mount frame rotation about Z_B [deg]")
@@ -181,7 +181,9 @@ class AppendageConfig(_Frozen):
     thickness_m: Thickness = Field(description="thickness t_p [m]")
     surface_density_kg_m2: Density | None = Field(None, description="rho_sup [kg/m^2]")
     mass_kg: Mass | None = Field(None, description="panel mass M_p [kg]")
-    target_frequencies_hz: TargetFrequencies
+    target_frequencies_hz: TargetFrequencies = Field(
+        description="cantilever frequency of each joint DOF, tuning its stiffness (eq. 2.14)"
+    )
     damping_ratio: Annotated[float, Strict(), AllowInfNan(False), Field(ge=0.0, lt=1.0)] = Field(
         description="viscous damping ratio zeta of every joint DOF [-]"
     )
@@ -254,9 +256,11 @@ Appendage = SerializeAsAny[Annotated[AppendageConfig, WrapValidator(_by_model)]]
 class SatelliteConfig(_Frozen):
     """A hub and its list of appendages (each validated by its model's config class)."""
 
-    name: Name = "satellite"
-    hub: HubConfig
-    appendages: Annotated[list[Appendage], Field(min_length=1, max_length=64)]
+    name: Name = Field("satellite", description="name of the satellite")
+    hub: HubConfig = Field(description="the rigid hub")
+    appendages: Annotated[list[Appendage], Field(min_length=1, max_length=64)] = Field(
+        description="the appendages, each by its model (default the plate)"
+    )
 
     @model_validator(mode="after")
     def _unique_names(self) -> SatelliteConfig:

@@ -22,14 +22,18 @@ class DisturbanceConfig(_Frozen):
     are stored in the result's attributes so the run can be replayed.
     """
 
-    mode: Literal["maximum", "random"] = "maximum"
-    seed: Annotated[int, Field(ge=0)] = 0
+    mode: Literal["maximum", "random"] = Field(
+        "maximum", description="every bound at its maximum, or one random draw"
+    )
+    seed: Annotated[int, Field(ge=0)] = Field(0, description="seed of the random draw")
 
     environment_nm: Vector3 = Field((0.005, 0.005, 0.005), description="constant [N m]")
     sloshing_ratio: Annotated[float, Field(ge=0.0, le=1.0)] = Field(
         0.02, description="sloshing amplitude / commanded torque [-]"
     )
-    sloshing_hz: Annotated[float, Field(ge=0.0, le=100.0)] = 0.52
+    sloshing_hz: Annotated[float, Field(ge=0.0, le=100.0)] = Field(
+        0.52, description="sloshing frequency [Hz]"
+    )
     residual_nm: Vector3 = Field((0.0, 0.0, 0.0), description="unmodelled residual [N m]")
 
     def packed(self, actuator) -> np.ndarray:

@@ -45,10 +45,20 @@ def quaternion_error(q_d, q):
 
 
 def target_quaternion(euler_deg: tuple[float, float, float]) -> np.ndarray:
-    """Exact scalar-first quaternion of target ZYX Euler angles (roll, pitch, yaw) [deg].
+    """Exact scalar-first quaternion of target ZYX Euler angles (roll, pitch, yaw).
 
     The thesis's [0.8446, 0.1913, 0.4619, 0.1913] for 45 deg on each axis is this,
     printed to 4 decimals. scipy works scalar-last; this is the conversion point.
+
+    Parameters
+    ----------
+    euler_deg : tuple of float
+        Roll, pitch, yaw of the ZYX sequence [deg].
+
+    Returns
+    -------
+    ndarray, shape (4,)
+        Unit quaternion, scalar first [-].
     """
     roll, pitch, yaw = euler_deg
     x, y, z, w = Rotation.from_euler("ZYX", [yaw, pitch, roll], degrees=True).as_quat()

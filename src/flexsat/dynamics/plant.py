@@ -42,9 +42,21 @@ __all__ = ["HUB_DOFS", "JOINT_DOFS", "Plant"]
 class Plant:
     """Hub plus appendages, packed for the compiled kernels.
 
-    Build it with :meth:`from_config`. ``models[i]`` is appendage i's model and
-    ``params[i]`` its packed parameter row; ``layout`` says where its coordinates
-    live; ``packed`` is what the compiled code takes.
+    Build it with :meth:`from_config`; ``layout`` says where each appendage's
+    coordinates live in the state, ``packed`` is what the compiled code takes.
+
+    Parameters
+    ----------
+    config : SatelliteConfig
+        The validated satellite it was built from.
+    hub_mass : float
+        Hub mass m_h [kg].
+    hub_J : ndarray, shape (3, 3)
+        Hub inertia about its centre of mass, hub frame B [kg m^2].
+    models : tuple of AppendageModel
+        ``models[i]`` is appendage i's model (from the appendage registry).
+    params : tuple of ndarray
+        ``params[i]`` is appendage i's packed parameter row (SI, the model's layout) [-].
     """
 
     config: SatelliteConfig

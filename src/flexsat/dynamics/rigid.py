@@ -22,6 +22,11 @@ def rigid_inertia(plant: Plant) -> np.ndarray:
     mass by the parallel-axis theorem in matrix form, m (‖r‖^2 I - r r^T), with r its
     undeformed centre of mass.
 
+    Parameters
+    ----------
+    plant : Plant
+        The satellite.
+
     Returns
     -------
     ndarray, shape (3, 3)

@@ -43,6 +43,16 @@ def rigid_model(plant: Plant) -> LinearModel:
 
     ``J_tot theta_ddot = tau`` with J_tot of :func:`flexsat.dynamics.rigid.rigid_inertia`;
     states and outputs ``phi, theta, psi, omega_x, omega_y, omega_z``.
+
+    Parameters
+    ----------
+    plant : Plant
+        The satellite.
+
+    Returns
+    -------
+    LinearModel
+        Inputs body torque [N m], states and outputs [rad, rad/s].
     """
     J_inv = np.linalg.inv(rigid_inertia(plant))
     A = np.zeros((6, 6))
@@ -70,6 +80,11 @@ def effective_inertia(plant: Plant) -> tuple[np.ndarray, np.ndarray, np.ndarray]
     shows above every appendage mode) they add up to the locked inertia M(0)_hh.
     A large J_eff at a low frequency means strong control-structure interaction.
 
+    Parameters
+    ----------
+    plant : Plant
+        The satellite.
+
     Returns
     -------
     frequencies_hz : ndarray, shape (n_flex,)
@@ -94,6 +109,18 @@ def pd_gains(plant: Plant, pd: PDConfig | None = None) -> np.ndarray:
     The law ``tau = w x Jw - J (kp q_v,e + kd w)`` with ``q_v,e ~ theta / 2`` and
     J the rigid design inertia linearizes to ``tau = -J (wn^2 theta + 2 zeta wn w)``
     (the gyroscopic term is quadratic in the rate).
+
+    Parameters
+    ----------
+    plant : Plant
+        The satellite (its rigid design inertia).
+    pd : PDConfig, optional
+        The PD law's parameters; default the built-in defaults.
+
+    Returns
+    -------
+    ndarray, shape (3, 6)
+        K on [theta; omega] [N m/rad, N m s/rad].
     """
     return law_gains(plant, pd or PDConfig())
 
@@ -173,6 +200,23 @@ class LoopMargins:
     frequency); ``phase_margin_deg`` and ``delay_margin_s`` are the smallest over all
     gain crossovers (a flexible peak above 0 dB adds crossovers); the frequencies
     are those of the limiting crossing [Hz]; ``crossovers_hz`` lists them all.
+
+    Attributes
+    ----------
+    gain_margin : float
+        Gain margin [-].
+    phase_crossover_hz : float
+        Frequency where the phase crosses -180 deg [Hz].
+    phase_margin_deg : float
+        Smallest phase margin over the gain crossovers [deg].
+    gain_crossover_hz : float
+        The gain crossover that sets it [Hz].
+    delay_margin_s : float
+        Smallest delay margin over the gain crossovers [s].
+    delay_crossover_hz : float
+        The gain crossover that sets it [Hz].
+    crossovers_hz : tuple of float
+        Every gain crossover, ascending [Hz].
     """
 
     gain_margin: float
@@ -195,6 +239,17 @@ def loop_margins(loop: LinearModel, f_min_hz: float = 1e-4, f_max_hz: float = 20
     the two crossings beside a sharp or undamped peak are always bracketed), and are
     refined with Brent's method on the exact response (no fitting); phase crossings
     likewise.
+
+    Parameters
+    ----------
+    loop : LinearModel
+        SISO loop gain L(s) (one input, one output) [-].
+    f_min_hz, f_max_hz : float
+        Frequency band searched [Hz].
+
+    Returns
+    -------
+    LoopMargins
     """
     if loop.B.shape[1] != 1 or loop.C.shape[0] != 1:
         raise ConfigError("loop_margins needs a single-input single-output loop gain")

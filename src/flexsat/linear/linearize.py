@@ -55,6 +55,11 @@ _SPIN_MIN = 1e-12  # [rad/s] a spin vector shorter than this is "zero length"
 def signal_names(plant: Plant) -> dict[str, tuple[tuple[str, ...], tuple[str, ...]]]:
     """Names and units of the states, inputs and of each output group.
 
+    Parameters
+    ----------
+    plant : Plant
+        The satellite.
+
     Returns
     -------
     dict
@@ -255,6 +260,7 @@ def linearize(
     Parameters
     ----------
     plant : Plant
+        The satellite.
     about : "rest" or array_like, shape (3,)
         ``"rest"``, or the body rate W of a steady spin, hub frame B [rad/s]. The
         equilibrium deformation and the torque holding the spin (zero about a

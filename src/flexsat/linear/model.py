@@ -47,15 +47,17 @@ class LinearModel:
     Attributes
     ----------
     A, B, C, D : ndarray
-        Shapes (n_x, n_x), (n_x, n_u), (n_y, n_x), (n_y, n_u); SI units.
+        Shapes (n_x, n_x), (n_x, n_u), (n_y, n_x), (n_y, n_u) [SI: the units of the named signals].
     x0 : ndarray, shape (n_x,)
-        The equilibrium (perturbations are about it).
+        The equilibrium (perturbations are about it) [SI, ``state_units``].
     u0 : ndarray, shape (n_u,)
         Input at the equilibrium [N m].
     spin : ndarray, shape (3,)
         Body rate of the reference motion, hub frame B [rad/s]; zero at rest.
     state_names, input_names, output_names : tuple of str
+        Name of each state, input and output.
     state_units, input_units, output_units : tuple of str
+        SI unit of each.
     jacobian : str
         How A, B were obtained: ``"analytic"`` or ``"richardson"``.
     """

@@ -45,11 +45,11 @@ class ReducedModel:
     n_marginal : int
         States of the marginal (rigid) part kept exactly.
     hankel_singular_values : ndarray or None
-        Of the stable part, descending (balanced truncation only).
+        Of the stable part, descending (balanced truncation only) [units of the model's gain].
     error_bound : float
         Balanced: 2 x the sum of the discarded Hankel singular values (a bound on
         the H-infinity error). Modal: the H-infinity norm of the discarded part
-        estimated on a frequency grid (the error itself, not a bound).
+        estimated on a frequency grid (the error itself, not a bound) [units of the model's gain].
     """
 
     model: LinearModel
@@ -125,6 +125,17 @@ def _hinf_estimate(A, B, C, extra_rad_s: np.ndarray) -> float:
 def modal_truncation(full: LinearModel, order: int) -> ReducedModel:
     """Keep the marginal part and the lowest-frequency flexible modes, ``order`` states.
 
+    Parameters
+    ----------
+    full : LinearModel
+        The model to reduce.
+    order : int
+        States of the reduced model, marginal part included.
+
+    Returns
+    -------
+    ReducedModel
+
     Raises
     ------
     ConfigError
@@ -150,6 +161,17 @@ def modal_truncation(full: LinearModel, order: int) -> ReducedModel:
 
 def balanced_truncation(full: LinearModel, order: int) -> ReducedModel:
     """Square-root balanced truncation of the stable part to ``order`` states in all.
+
+    Parameters
+    ----------
+    full : LinearModel
+        The model to reduce.
+    order : int
+        States of the reduced model, marginal part included.
+
+    Returns
+    -------
+    ReducedModel
 
     Raises
     ------

@@ -132,6 +132,7 @@ def auto_magnification(
     Parameters
     ----------
     result : Result
+        A recorded run.
     plant : Plant, optional
         The run's plant; by default rebuilt with :func:`result_plant`.
     fraction : float
@@ -185,9 +186,9 @@ class RunFrames:
     time : ndarray, shape (k,)
         Frame times [s], recorded times picked evenly over the run.
     index : ndarray of int, shape (k,)
-        Their record indices in the result.
+        Their record indices in the result [-].
     q : ndarray, shape (k, n_dof)
-        Recorded generalized coordinates at those times (metres, radians).
+        Recorded generalized coordinates at those times [m, rad].
     magnification : float
         Factor applied to the joint coordinates (root translations and rotations)
         when drawing [-]; the hub position and attitude are drawn as recorded.

@@ -50,7 +50,7 @@ def rot_zyx(angles: np.ndarray) -> np.ndarray:
     Returns
     -------
     ndarray, shape (..., 3, 3)
-        Child (body) components -> parent components; the same matrix as
+        Child (body) components -> parent components [-]; the same matrix as
         :func:`flexsat.dynamics.linalg3.rot_zyx`.
     """
     a = np.asarray(angles, dtype=float)
@@ -115,6 +115,7 @@ def hub_outline(plant: Plant) -> HubOutline:
     Parameters
     ----------
     plant : Plant
+        The satellite.
 
     Returns
     -------
@@ -156,26 +157,26 @@ class SatelliteGeometry:
     Attributes
     ----------
     centre : ndarray, shape (3,)
-        Hub centre of mass, q[0:3].
+        Hub centre of mass, q[0:3] [m].
     R_NB : ndarray, shape (3, 3)
-        Hub attitude, hub frame B -> N.
+        Hub attitude, hub frame B -> N [-].
     hub_kind : {"cylinder", "box"}
         How the hub is drawn (see :func:`hub_outline`).
     hub_lines : tuple of ndarray, each shape (k, 3)
-        Hub wireframe polylines.
+        Hub wireframe polylines [m].
     arms : ndarray, shape (n, 2, 3)
         Massless arm of each appendage: from the hub surface (where the ray from
-        the hub centre to the mount point leaves the hub) to the displaced root.
+        the hub centre to the mount point leaves the hub) to the displaced root [m].
     roots : ndarray, shape (n, 3)
-        Panel roots (origin of P_i).
+        Panel roots (origin of P_i) [m].
     panels : ndarray, shape (n, 4, 3)
         Panel corners, in order: root at -W/2, root at +W/2, tip at +W/2, tip at
-        -W/2 (chord along X_P); a closed loop when the first is repeated.
+        -W/2 (chord along X_P); a closed loop when the first is repeated [m].
     tips : ndarray, shape (n, 3)
-        Panel tips (mid-chord of the free edge).
+        Panel tips (mid-chord of the free edge) [m].
     axes : ndarray, shape (3, 3)
         Row k is the hub body axis k (X_B, Y_B, Z_B) as a vector from ``centre``,
-        scaled to a length proportional to the hub size.
+        scaled to a length proportional to the hub size [m].
     """
 
     centre: np.ndarray
@@ -215,6 +216,16 @@ def panel_corners_local(plant: Plant) -> np.ndarray:
 
     Each model draws itself (``shape_points``); for the thesis plate the corners span
     0..L along +Y_P or -Y_P from its root and -W/2..W/2 along X_P (its mid-plane).
+
+    Parameters
+    ----------
+    plant : Plant
+        The satellite.
+
+    Returns
+    -------
+    ndarray, shape (n, 4, 3)
+        Corners of each appendage's outline, hub frame B [m].
     """
     return _shape_points(plant, np.zeros(plant.n_dof))[:, 0:4, :]
 
@@ -234,7 +245,7 @@ def satellite_geometry(plant: Plant, q: np.ndarray | None = None) -> SatelliteGe
     plant : Plant
         Any number of appendages.
     q : array_like, shape (plant.n_dof,), optional
-        Generalized coordinates (metres and radians, layout of
+        Generalized coordinates [m, rad] (layout of
         :mod:`flexsat.dynamics.kernels`); ``None`` is the undeformed satellite at
         the origin, q = 0.
 

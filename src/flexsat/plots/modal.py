@@ -77,6 +77,7 @@ def plot_interaction_map(analysis: ModalAnalysis, ax: Axes | None = None) -> Fig
     Parameters
     ----------
     analysis : ModalAnalysis
+        The modes (:func:`flexsat.analysis.modal_analysis`).
     ax : matplotlib.axes.Axes, optional
         Axes to draw into (the colour bar is added to its figure); by default a new
         figure sized to the number of DOFs.
@@ -158,6 +159,7 @@ def plot_frequencies(analysis: ModalAnalysis, ax: Axes | None = None) -> Figure:
     Parameters
     ----------
     analysis : ModalAnalysis
+        The modes (:func:`flexsat.analysis.modal_analysis`).
     ax : matplotlib.axes.Axes, optional
         Axes to draw into; by default a new figure sized to the number of modes.
 
@@ -279,6 +281,7 @@ def mode_amplitude(
     Parameters
     ----------
     analysis : ModalAnalysis
+        The modes (:func:`flexsat.analysis.modal_analysis`).
     mode_index : int
         1-based, as in ``analysis.modes``.
     fraction : float
@@ -345,6 +348,7 @@ def animate_mode(
     Parameters
     ----------
     analysis : ModalAnalysis
+        The modes (:func:`flexsat.analysis.modal_analysis`).
     mode_index : int
         1-based, as in ``analysis.modes``.
     path : str or Path
@@ -447,7 +451,18 @@ def _animation_title(mode: Mode, a: float, peak: float, length: float) -> str:
 
 
 def default_animated_modes(analysis: ModalAnalysis) -> list[int]:
-    """Flexible modes that drive a hub DOF, lowest first, at most six (1-based)."""
+    """Flexible modes that drive a hub DOF, lowest first, at most six (1-based).
+
+    Parameters
+    ----------
+    analysis : ModalAnalysis
+        The modes (:func:`flexsat.analysis.modal_analysis`).
+
+    Returns
+    -------
+    list of int
+        1-based mode indices.
+    """
     picked = [m.index for m in analysis.modes if m.kind != "rigid" and m.hub_dof is not None]
     return picked[:_MAX_DEFAULT_ANIMATIONS]
 
@@ -469,6 +484,7 @@ def write_modal_figures(
     Parameters
     ----------
     analysis : ModalAnalysis
+        The modes (:func:`flexsat.analysis.modal_analysis`).
     out_dir : str or Path
         Created if missing; existing files of the same names are replaced.
     mode_indices : list of int, optional

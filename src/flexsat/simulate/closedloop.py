@@ -65,6 +65,18 @@ def slew_design_inertia(plant: Plant, scenario: SlewScenario) -> np.ndarray:
     ``plant`` configuration. Uncertainty studies perturb the truth plant only: they
     give the nominal design model explicitly (campaigns write it into each case's
     scenario from the base configuration).
+
+    Parameters
+    ----------
+    plant : Plant
+        The truth plant.
+    scenario : SlewScenario
+        The slew.
+
+    Returns
+    -------
+    ndarray, shape (3, 3)
+        J, hub frame B [kg m^2].
     """
     if scenario.design_inertia_kg_m2 is not None:
         return np.array(scenario.design_inertia_kg_m2, dtype=float)

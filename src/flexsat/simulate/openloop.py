@@ -35,6 +35,20 @@ __all__ = ["initial_state", "run_openloop"]
 def initial_state(plant: Plant, scenario: OpenLoopScenario) -> tuple[np.ndarray, np.ndarray]:
     """q(0) and q_dot(0) from the scenario's initial state (degrees converted to radians).
 
+    Parameters
+    ----------
+    plant : Plant
+        The satellite.
+    scenario : OpenLoopScenario or SlewScenario
+        Its ``initial`` table.
+
+    Returns
+    -------
+    q : ndarray, shape (n_dof,)
+        Generalized coordinates [m, rad].
+    q_dot : ndarray, shape (n_dof,)
+        Their rates [m/s, rad/s].
+
     Raises
     ------
     ConfigError
@@ -76,6 +90,7 @@ def run_openloop(
     Parameters
     ----------
     plant : Plant
+        The satellite.
     scenario : OpenLoopScenario, optional
         Default: the thesis's scenario (1 N m about Z for 10 s, free to 120 s).
     progress : bool, optional

@@ -26,7 +26,14 @@ AXES = ("x", "y", "z")
 
 @dataclass(frozen=True)
 class Result:
-    """A simulation result wrapping its dataset (``result.dataset``)."""
+    """A simulation result wrapping its dataset (``result.dataset``).
+
+    Parameters
+    ----------
+    dataset : xarray.Dataset
+        The recorded run: every variable with its ``units``, the config and the
+        scenario in the attributes.
+    """
 
     dataset: xr.Dataset
 

@@ -48,8 +48,10 @@ _MAX_INERTIA_KG_M2 = 1e9  # a bound far beyond any spacecraft, so J's algebra ca
 class TorqueSegment(_Frozen):
     """A constant body torque applied over [start_s, end_s); ``end_s`` omitted: to the end."""
 
-    start_s: Annotated[float, Strict(), Field(ge=0.0, allow_inf_nan=False)] = 0.0
-    end_s: Positive | None = None
+    start_s: Annotated[float, Strict(), Field(ge=0.0, allow_inf_nan=False)] = Field(
+        0.0, description="switch-on time [s]"
+    )
+    end_s: Positive | None = Field(None, description="switch-off time; none: to the end [s]")
     torque_nm: Vector3 = Field(description="torque on the hub, hub frame B [N m]")
 
     @model_validator(mode="after")
@@ -60,14 +62,40 @@ class TorqueSegment(_Frozen):
 
 
 def step(start_s: float, torque_nm: tuple[float, float, float]) -> TorqueSegment:
-    """A torque switched on at ``start_s`` and held to the end of the run."""
+    """A torque switched on at ``start_s`` and held to the end of the run.
+
+    Parameters
+    ----------
+    start_s : float
+        Switch-on time [s].
+    torque_nm : tuple of float
+        Torque on the hub, hub frame B [N m].
+
+    Returns
+    -------
+    TorqueSegment
+    """
     return TorqueSegment(start_s=start_s, torque_nm=torque_nm)
 
 
 def pulse(
     start_s: float, duration_s: float, torque_nm: tuple[float, float, float]
 ) -> TorqueSegment:
-    """A torque applied for ``duration_s`` from ``start_s``."""
+    """A torque applied for ``duration_s`` from ``start_s``.
+
+    Parameters
+    ----------
+    start_s : float
+        Switch-on time [s].
+    duration_s : float
+        How long it acts [s].
+    torque_nm : tuple of float
+        Torque on the hub, hub frame B [N m].
+
+    Returns
+    -------
+    TorqueSegment
+    """
     return TorqueSegment(start_s=start_s, end_s=start_s + duration_s, torque_nm=torque_nm)
 
 
@@ -115,10 +143,16 @@ default 1 ms step; about an hour of wall time on one core."""
 class _TimedRun(_Frozen):
     """Duration, RK4 step and recording rate shared by every kind of run."""
 
-    name: str = "run"
-    duration_s: Annotated[float, Field(gt=0.0, le=1e6, allow_inf_nan=False)] = 120.0
-    dt_s: Annotated[float, Field(gt=0.0, le=0.1, allow_inf_nan=False)] = 1e-3
-    record_dt_s: Annotated[float, Field(gt=0.0, allow_inf_nan=False)] = 1e-2
+    name: str = Field("run", description="name of the run, in the result's attributes")
+    duration_s: Annotated[float, Field(gt=0.0, le=1e6, allow_inf_nan=False)] = Field(
+        120.0, description="simulated time [s]"
+    )
+    dt_s: Annotated[float, Field(gt=0.0, le=0.1, allow_inf_nan=False)] = Field(
+        1e-3, description="RK4 step [s]"
+    )
+    record_dt_s: Annotated[float, Field(gt=0.0, allow_inf_nan=False)] = Field(
+        1e-2, description="interval between records, a multiple of dt_s [s]"
+    )
 
     _MULTIPLES_OF_DT: ClassVar[tuple[str, ...]] = ("record_dt_s",)
 
@@ -155,13 +189,20 @@ class OpenLoopScenario(_TimedRun):
     """An open-loop run. The default is the thesis's (section 3.3): at rest,
     1 N m about body Z for 0 <= t < 10 s, then free, to 120 s, RK4 at 1 ms."""
 
-    name: str = "thesis-openloop"
-    solver: Literal["rk4", "dop853"] = "rk4"
-    rtol: Annotated[float, Field(gt=0.0, lt=1.0)] = 1e-10
-    atol: Annotated[float, Field(gt=0.0, lt=1.0)] = 1e-12
-    initial: InitialState = Field(default_factory=InitialState)
+    name: str = Field("thesis-openloop", description="name of the run")
+    solver: Literal["rk4", "dop853"] = Field(
+        "rk4", description="compiled fixed-step RK4 or adaptive DOP853 (scipy)"
+    )
+    rtol: Annotated[float, Field(gt=0.0, lt=1.0)] = Field(
+        1e-10, description="relative tolerance of DOP853 [-]"
+    )
+    atol: Annotated[float, Field(gt=0.0, lt=1.0)] = Field(
+        1e-12, description="absolute tolerance of DOP853 [SI units of the state]"
+    )
+    initial: InitialState = Field(default_factory=InitialState, description="state at t = 0")
     torque: list[TorqueSegment] = Field(
-        default_factory=lambda: [TorqueSegment(start_s=0.0, end_s=10.0, torque_nm=(0, 0, 1.0))]
+        default_factory=lambda: [TorqueSegment(start_s=0.0, end_s=10.0, torque_nm=(0, 0, 1.0))],
+        description="commanded torque segments (they add up where they overlap)",
     )
     disturbance_torque_nm: Vector3 = Field(_ZERO3, description="constant body torque [N m]")
 
@@ -181,9 +222,11 @@ class SlewScenario(_TimedRun):
     from the identity to 45 deg on roll, pitch and yaw, ASMC, disturbances at their
     maximum, 120 s, RK4 at 1 ms with the controller at every step."""
 
-    name: str = "thesis-slew"
-    control_dt_s: Annotated[float, Field(gt=0.0, le=10.0, allow_inf_nan=False)] = 1e-3
-    initial: InitialState = Field(default_factory=InitialState)
+    name: str = Field("thesis-slew", description="name of the run")
+    control_dt_s: Annotated[float, Field(gt=0.0, le=10.0, allow_inf_nan=False)] = Field(
+        1e-3, description="control period, a multiple of dt_s (torque held between) [s]"
+    )
+    initial: InitialState = Field(default_factory=InitialState, description="state at t = 0")
     target_euler_deg: Vector3 = Field(
         (45.0, 45.0, 45.0), description="target ZYX Euler angles (roll, pitch, yaw) [deg]"
     )
@@ -199,8 +242,12 @@ class SlewScenario(_TimedRun):
         default_factory=lambda: ACTUATORS.get(ACTUATORS.default).config(),
         description="the actuator stage, by its kind",
     )
-    disturbances: DisturbanceConfig = Field(default_factory=DisturbanceConfig)
-    requirements: Requirements = Field(default_factory=Requirements)
+    disturbances: DisturbanceConfig = Field(
+        default_factory=DisturbanceConfig, description="disturbance torques"
+    )
+    requirements: Requirements = Field(
+        default_factory=Requirements, description="R1-R3 and their observation window"
+    )
     design_inertia_kg_m2: Matrix3 | None = Field(
         None,
         description="the controller's design inertia J [kg m^2] (3x3, symmetric positive "
@@ -244,7 +291,22 @@ class SlewScenario(_TimedRun):
 
 
 def load_slew(path: str | Path | None = None) -> SlewScenario:
-    """Read and validate a slew scenario TOML; ``None`` gives the thesis's slew."""
+    """Read and validate a slew scenario TOML; ``None`` gives the thesis's slew.
+
+    Parameters
+    ----------
+    path : str or Path, optional
+        The TOML file.
+
+    Returns
+    -------
+    SlewScenario
+
+    Raises
+    ------
+    ConfigError
+        Naming the file, the field and the allowed range.
+    """
     if path is None:
         return SlewScenario()
     return validate_config(read_toml(path, "scenario"), source=str(path), model=SlewScenario)
@@ -256,7 +318,22 @@ def thesis_openloop() -> OpenLoopScenario:
 
 
 def load_scenario(path: str | Path | None = None) -> OpenLoopScenario:
-    """Read and validate an open-loop scenario TOML; ``None`` gives :func:`thesis_openloop`."""
+    """Read and validate an open-loop scenario TOML; ``None`` gives :func:`thesis_openloop`.
+
+    Parameters
+    ----------
+    path : str or Path, optional
+        The TOML file.
+
+    Returns
+    -------
+    OpenLoopScenario
+
+    Raises
+    ------
+    ConfigError
+        Naming the file, the field and the allowed range.
+    """
     if path is None:
         return thesis_openloop()
     return validate_config(read_toml(path, "scenario"), source=str(path), model=OpenLoopScenario)

@@ -40,8 +40,9 @@ def format_value(value) -> str:
     Parameters
     ----------
     value : float, int, bool, str, list or None
-        A value as read from a study JSON file (None is a quantity that does not
-        exist, e.g. a settling time never reached).
+        A value as read from a study JSON file, in the unit its key names [key's
+        unit] (None is a quantity that does not exist, e.g. a settling time never
+        reached).
 
     Returns
     -------

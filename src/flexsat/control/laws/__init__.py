@@ -60,12 +60,12 @@ class CompiledLaw:
     ----------
     config : LawConfig
         Parameters of any registered law.
-    actuator : actuator stage config
+    actuator : ActuatorStageConfig
         Gives the software limit RF * T_max.
     J : ndarray, shape (3, 3)
-        Design inertia [kg m^2].
+        Design inertia, hub frame B [kg m^2].
     q_d : ndarray, shape (4,)
-        Target quaternion, scalar first.
+        Target quaternion, scalar first [-].
     control_dt : float
         Control period [s].
     """

@@ -44,6 +44,7 @@ from typing import Any
 
 import numpy as np
 from numba import types
+from pydantic import Field
 
 from flexsat.config.models import _Frozen
 from flexsat.control.registry import Channel, Registry
@@ -77,7 +78,7 @@ class LawConfig(_Frozen):
     ranges, and implements :meth:`gains`.
     """
 
-    kind: str
+    kind: str = Field(description="the law's registered name")
 
     def gains(self, actuator: Any) -> np.ndarray:
         """The packed gains the compiled step reads, float64, shape (n_gains,).
@@ -156,14 +157,42 @@ LAWS: Registry[LawSpec] = Registry("control law", "flexsat.laws")
 
 
 def register_law(spec: LawSpec, default: bool = False) -> LawSpec:
-    """Register a law under ``spec.name`` (replacing one of that name); returns it."""
+    """Register a law under ``spec.name`` (replacing one of that name).
+
+    Parameters
+    ----------
+    spec : LawSpec
+        The law.
+    default : bool
+        Make it the law a ``[controller]`` table without ``kind`` selects.
+
+    Returns
+    -------
+    LawSpec
+        ``spec``, so a module can keep it: ``X = register_law(LawSpec(...))``.
+    """
     if spec.config.model_fields["kind"].default != spec.name:
         raise ValueError(f"law {spec.name!r}: its config's kind must default to {spec.name!r}")
     return LAWS.register(spec.name, spec, default=default)
 
 
 def get_law(name: str) -> LawSpec:
-    """The registered law ``name`` (ValueError listing the registered ones if none)."""
+    """The registered law ``name``.
+
+    Parameters
+    ----------
+    name : str
+        The law's ``kind`` (``"asmc"``, ``"pd"``...).
+
+    Returns
+    -------
+    LawSpec
+
+    Raises
+    ------
+    ValueError
+        Listing the registered laws, if none has that name.
+    """
     return LAWS.get(name)
 
 
@@ -173,5 +202,16 @@ def law_names() -> tuple[str, ...]:
 
 
 def validate_law_config(value: Any) -> LawConfig:
-    """A ``[controller]`` table validated by its law's model (no ``kind``: the default law)."""
+    """A ``[controller]`` table validated by its law's model (no ``kind``: the default law).
+
+    Parameters
+    ----------
+    value : dict or LawConfig
+        The table, or an already validated model.
+
+    Returns
+    -------
+    LawConfig
+        The model of the law its ``kind`` names.
+    """
     return LAWS.validate_table(value, lambda spec: spec.config)

@@ -66,7 +66,7 @@ ACTUATOR_SIGNATURE = types.int64(_vec, types.float64, types.float64, _vec, _vec,
 class StageConfig(_Frozen):
     """Base of every stage's parameter model; a subclass declares ``kind: Literal[...]``."""
 
-    kind: str
+    kind: str = Field(description="the stage's registered name")
 
     def packed(self, scenario: Any) -> np.ndarray:
         """The packed parameters the compiled step reads, float64, shape (n_params,).
@@ -93,15 +93,19 @@ class StageSpec:
     Parameters
     ----------
     role : {"sensor", "actuator"}
+        Where the stage sits in the loop.
     name : str
         The ``kind`` of its parameter table.
-    config : type[StageConfig]
+    config : type of StageConfig
+        Its parameter model.
     step : numba dispatcher
         Compiled with the role's signature (module docstring).
     state_size : int
-    records : tuple[Channel, ...]
+        Length of its state array (0 for a stateless stage).
+    records : tuple of Channel
         What ``record`` holds, in order; each becomes a variable of the result.
     description : str
+        One line for listings.
     """
 
     role: Literal["sensor", "actuator"]
@@ -131,22 +135,68 @@ def _register(role: str, spec: StageSpec, default: bool) -> StageSpec:
 
 
 def register_sensor(spec: StageSpec, default: bool = False) -> StageSpec:
-    """Register a sensor stage under ``spec.name`` (replacing one of that name)."""
+    """Register a sensor stage under ``spec.name`` (replacing one of that name).
+
+    Parameters
+    ----------
+    spec : StageSpec
+        The stage, with ``role = "sensor"``.
+    default : bool
+        Make it the stage a ``[sensor]`` table without ``kind`` selects.
+
+    Returns
+    -------
+    StageSpec
+        ``spec``, so a module can keep it.
+    """
     return _register("sensor", spec, default)
 
 
 def register_actuator(spec: StageSpec, default: bool = False) -> StageSpec:
-    """Register an actuator stage under ``spec.name`` (replacing one of that name)."""
+    """Register an actuator stage under ``spec.name`` (replacing one of that name).
+
+    Parameters
+    ----------
+    spec : StageSpec
+        The stage, with ``role = "actuator"``.
+    default : bool
+        Make it the stage an ``[actuator]`` table without ``kind`` selects.
+
+    Returns
+    -------
+    StageSpec
+        ``spec``, so a module can keep it: ``X = register_actuator(StageSpec(...))``.
+    """
     if not issubclass(spec.config, ActuatorStageConfig):
         raise ValueError(f"actuator {spec.name!r}: its config must derive ActuatorStageConfig")
     return _register("actuator", spec, default)
 
 
 def validate_sensor_config(value: Any) -> StageConfig:
-    """A ``[sensor]`` table validated by its stage's model (no ``kind``: the default)."""
+    """A ``[sensor]`` table validated by its stage's model (no ``kind``: the default).
+
+    Parameters
+    ----------
+    value : dict or StageConfig
+        The table, or an already validated model.
+
+    Returns
+    -------
+    StageConfig
+    """
     return SENSORS.validate_table(value, lambda spec: spec.config)
 
 
 def validate_actuator_config(value: Any) -> ActuatorStageConfig:
-    """An ``[actuator]`` table validated by its stage's model (no ``kind``: the default)."""
+    """An ``[actuator]`` table validated by its stage's model (no ``kind``: the default).
+
+    Parameters
+    ----------
+    value : dict or ActuatorStageConfig
+        The table, or an already validated model.
+
+    Returns
+    -------
+    ActuatorStageConfig
+    """
     return ACTUATORS.validate_table(value, lambda spec: spec.config)

@@ -120,7 +120,25 @@ tip displacement from the undeformed place, mount frame [m]."""
 
 
 class AppendageKernels(NamedTuple):
-    """The compiled kernels of one model, each with the signature of the same name."""
+    """The compiled kernels of one model, each with the signature of the same name.
+
+    Attributes
+    ----------
+    pass1 : numba dispatcher
+        Outward pass of q̈: the appendage's reaction on the hub.
+    pass2 : numba dispatcher
+        Inward pass: the appendage's accelerations once the hub's are known.
+    mass_matrix : numba dispatcher
+        Its blocks of M(q).
+    bias_forces : numba dispatcher
+        Its part of h(q, q̇).
+    observe : numba dispatcher
+        Its energies, momentum and locked inertia.
+    joint_wrench : numba dispatcher
+        The wrench its root joint puts on the hub.
+    tips : numba dispatcher
+        Displacement of its tip points.
+    """
 
     pass1: Any
     pass2: Any
@@ -140,7 +158,15 @@ SIGNATURES = AppendageKernels(
 
 @dataclass(frozen=True)
 class Coordinate:
-    """One generalized coordinate of an appendage: its name and SI unit."""
+    """One generalized coordinate of an appendage: its name and SI unit.
+
+    Attributes
+    ----------
+    name : str
+        Name in the state layout and the result (e.g. ``"flapping"``).
+    unit : str
+        Its SI unit (``"m"``, ``"rad"``).
+    """
 
     name: str
     unit: str
@@ -148,9 +174,17 @@ class Coordinate:
 
 @dataclass(frozen=True)
 class RigidBody:
-    """An appendage frozen undeformed: mass [kg], centre of mass from the hub centre of
-    mass in B [m], shape (3,), and inertia about its own centre of mass in B [kg m^2],
-    shape (3, 3)."""
+    """An appendage frozen undeformed.
+
+    Attributes
+    ----------
+    mass : float
+        Its mass [kg].
+    r_B : ndarray, shape (3,)
+        Its centre of mass from the hub centre of mass, hub frame B [m].
+    J_B : ndarray, shape (3, 3)
+        Its inertia about its own centre of mass, hub frame B [kg m^2].
+    """
 
     mass: float
     r_B: np.ndarray
@@ -161,8 +195,8 @@ class AppendageModel(ABC):
     """Contract of an appendage model. Subclass it, then register one instance with
     :func:`flexsat.dynamics.appendages.register_appendage_model`.
 
-    Class attributes
-    ----------------
+    Attributes
+    ----------
     name : str
         The ``model = "<name>"`` key of the satellite TOML's appendage table.
     config_class : type[pydantic.BaseModel]

@@ -16,7 +16,18 @@ _MODELS: dict[str, AppendageModel] = {}
 
 def register_appendage_model(model: AppendageModel) -> AppendageModel:
     """Register ``model`` under ``model.name``; appendage tables may then say
-    ``model = "<name>"``. Registering a name again replaces the model. Returns it."""
+    ``model = "<name>"``. Registering a name again replaces the model.
+
+    Parameters
+    ----------
+    model : AppendageModel
+        The model instance.
+
+    Returns
+    -------
+    AppendageModel
+        ``model``, so a module can keep it.
+    """
     if not isinstance(model, AppendageModel):
         raise TypeError(f"expected an AppendageModel instance, got {type(model).__name__}")
     register_appendage_config(model.name, model.config_class)
@@ -25,7 +36,22 @@ def register_appendage_model(model: AppendageModel) -> AppendageModel:
 
 
 def appendage_model(name: str) -> AppendageModel:
-    """The registered model called ``name``."""
+    """The registered model called ``name``.
+
+    Parameters
+    ----------
+    name : str
+        The model's key (``model = "<name>"`` in a satellite TOML).
+
+    Returns
+    -------
+    AppendageModel
+
+    Raises
+    ------
+    ConfigError
+        Listing the registered models, if none has that name.
+    """
     try:
         return _MODELS[name]
     except KeyError:

@@ -46,7 +46,7 @@ class ReferenceParameters:
     sadm : ndarray, shape (N,)
         SADM angles [rad].
     span_sign : ndarray, shape (N,)
-        +1 (span along +Y_P) or -1 (along -Y_P).
+        +1 (span along +Y_P) or -1 (along -Y_P) [-].
     length : ndarray, shape (N,)
         Panel lengths [m].
     mass : ndarray, shape (N,)
@@ -175,16 +175,21 @@ class ReferenceModel:
     (``math`` only) from :func:`derive` with common subexpressions eliminated;
     intended for verification, not speed (about a millisecond per call).
 
-    Attributes
+    Parameters
     ----------
     n_appendages : int
+        Number of appendages N.
     panel_rates : {"exact", "small_angle"}
-    n_dof : int
-        ``6 + 6 * n_appendages``.
+        Panel angular-velocity variant (eq. 2.31), see :func:`derive`.
     source : str
         The generated Python source.
     path : Path or None
         The cache file the source was read from or written to, if any.
+
+    Attributes
+    ----------
+    n_dof : int
+        ``6 + 6 * n_appendages``.
     """
 
     def __init__(
