@@ -2,19 +2,19 @@
 Frequency-domain design with the linear model
 =============================================
 
-Frequency-domain design with the linear model: PD loop, flexible modes, a reduced model.
-
 Linearizes the nominal satellite about rest, closes the PD law's loop one axis at a
 time and reports its margins, ranks the appendage modes by effective inertia, and
 builds a balanced reduced model of torque -> rate, checked against its error bound.
-Run it as ``python examples/linear_design.py [OUT_DIR]`` (figures go to OUT_DIR).
+``run(out_dir)`` also writes every figure of the linear analysis into ``out_dir``.
 """
 
-from __future__ import annotations
+# %%
+# The design, as one function
+# ---------------------------
 
-import sys
 from pathlib import Path
 
+import matplotlib.pyplot as plt
 import numpy as np
 
 from flexsat.config import nominal
@@ -29,6 +29,7 @@ from flexsat.linear import (
     pd_loop,
     rigid_model,
 )
+from flexsat.plots.linear import plot_bode, plot_loops
 
 
 def run(out_dir: str | Path | None = None, natural_frequency_rad_s: float = 0.3) -> dict:
@@ -74,14 +75,31 @@ def run(out_dir: str | Path | None = None, natural_frequency_rad_s: float = 0.3)
     }
 
 
-if __name__ == "__main__":
-    summary = run(sys.argv[1] if len(sys.argv) > 1 else None)
-    for axis, m in summary["margins"].items():
-        print(
-            f"axis {axis}: phase margin {m['phase_margin_deg']:.1f} deg, delay margin "
-            f"{m['delay_margin_s']:.3f} s at {m['delay_crossover_hz']:.2f} Hz"
-        )
-    for f_hz, axis, J in summary["strongest_modes"]:
-        print(f"mode {f_hz:.3f} Hz: effective inertia {J:.1f} kg m^2 about {axis}")
-    print(f"16-state model: peak error {summary['reduced_peak_error']:.3g}, "
-          f"bound {summary['reduced_error_bound']:.3g}")  # fmt: skip
+# %%
+# Margins, modes and a reduced model
+# ----------------------------------
+
+summary = run()
+for axis, m in summary["margins"].items():
+    print(
+        f"axis {axis}: phase margin {m['phase_margin_deg']:.1f} deg, delay margin "
+        f"{m['delay_margin_s']:.3f} s at {m['delay_crossover_hz']:.2f} Hz"
+    )
+for f_hz, axis, J in summary["strongest_modes"]:
+    print(f"mode {f_hz:.3f} Hz: effective inertia {J:.1f} kg m^2 about {axis}")
+print(f"16-state model: peak error {summary['reduced_peak_error']:.3g}, "
+      f"bound {summary['reduced_error_bound']:.3g}")  # fmt: skip
+
+# %%
+# Figures
+# -------
+# The flexible and rigid torque-to-rate Bode diagrams and the PD loop gains.
+
+plant = Plant.from_config(nominal())
+model = linearize(plant)
+plot_bode(model, rigid_model(plant))
+K = law_gains(plant, PDConfig(natural_frequency_rad_s=0.3, damping_ratio=0.9))
+loops = {axis: pd_loop(model, K, axis) for axis in "xyz"}
+margins = {axis: loop_margins(loop) for axis, loop in loops.items()}
+plot_loops(loops, margins, effective_inertia(plant)[0])  # flexible modes marked [Hz]
+plt.show()
