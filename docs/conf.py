@@ -160,8 +160,9 @@ def _pydantic_fields(app, what, name, obj, options, lines):
 
 def _no_type_docstring(app, what, name, obj, options, lines):
     """A constant without its own doc comment shows nothing, not its type's docstring."""
-    if what in ("data", "attribute") and lines and type(obj).__doc__:
-        if "\n".join(lines).strip() == inspect.cleandoc(type(obj).__doc__).strip():
+    own = getattr(type(obj), "__doc__", None)
+    if what in ("data", "attribute") and lines and isinstance(own, str):
+        if "\n".join(lines).strip() == inspect.cleandoc(own).strip():
             lines.clear()
 
 
