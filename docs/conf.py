@@ -16,9 +16,12 @@ import sys
 from pathlib import Path
 
 import pydantic
+from sphinx.errors import PycodeError
+from sphinx.pycode import ModuleAnalyzer
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "src"))
+sys.path.insert(0, str(ROOT / "docs" / "_ext"))  # gallery_figures
 os.environ.setdefault("MPLBACKEND", "Agg")
 
 import flexsat  # noqa: E402
@@ -62,7 +65,9 @@ sphinx_gallery_conf = {
     "remove_config_comments": True,
     "abort_on_example_error": True,
     "show_memory": False,
-    "image_scrapers": ("matplotlib",),
+    "capture_repr": (),  # a cell ending on a figure shows the figure, not its repr
+    # flexsat's figures are made without pyplot: a scraper that sees them
+    "image_scrapers": ("gallery_figures.scrape",),
 }
 
 html_theme = "pydata_sphinx_theme"
@@ -155,15 +160,22 @@ def _pydantic_fields(app, what, name, obj, options, lines):
         annotation = getattr(field.annotation, "__name__", None) or str(field.annotation)
         default = "" if field.is_required() else ", optional"
         lines.append(f"{field_name} : {annotation.replace('typing.', '')}{default}")
-        lines.append(f"    {field.description or ''}")
+        # a description is plain text: reST's markup characters stand for themselves
+        text = (field.description or "").replace("|", "\\|").replace("*", "\\*")
+        lines.append(f"    {text}")
 
 
 def _no_type_docstring(app, what, name, obj, options, lines):
     """A constant without its own doc comment shows nothing, not its type's docstring."""
-    own = getattr(type(obj), "__doc__", None)
-    if what in ("data", "attribute") and lines and isinstance(own, str):
-        if "\n".join(lines).strip() == inspect.cleandoc(own).strip():
-            lines.clear()
+    if what not in ("data", "attribute"):
+        return
+    module, _, attribute = name.rpartition(".")
+    try:
+        documented = ("", attribute) in ModuleAnalyzer.for_module(module).find_attr_docs()
+    except PycodeError:  # not a module-level constant
+        return
+    if not documented:
+        lines.clear()
 
 
 def setup(app):

@@ -15,8 +15,6 @@ side by side.
 
 import os
 
-import matplotlib.pyplot as plt
-
 from flexsat import Plant, nominal
 from flexsat.analysis import slew_metrics
 from flexsat.control import law_names
@@ -48,4 +46,3 @@ for law, m in metrics.items():
 # ------------
 
 plot_controller_comparison(datasets)
-plt.show()

@@ -19,7 +19,6 @@ registered it runs at the speed of a built-in law, from a scenario table
 import os
 from typing import Literal, NamedTuple
 
-import matplotlib.pyplot as plt
 import numpy as np
 from numba import njit
 from pydantic import Field
@@ -125,4 +124,3 @@ metrics = slew_metrics(result.dataset)  # the requirements of the stored scenari
 for key in ("final_pointing_error_deg", "settling_time_s", "r1_pass", "r2_pass", "r3_pass"):
     print(f"{key:26s} {metrics[key]}")
 plot_pointing(result.dataset)
-plt.show()

@@ -14,7 +14,6 @@ builds a balanced reduced model of torque -> rate, checked against its error bou
 
 from pathlib import Path
 
-import matplotlib.pyplot as plt
 import numpy as np
 
 from flexsat.config import nominal
@@ -102,4 +101,3 @@ K = law_gains(plant, PDConfig(natural_frequency_rad_s=0.3, damping_ratio=0.9))
 loops = {axis: pd_loop(model, K, axis) for axis in "xyz"}
 margins = {axis: loop_margins(loop) for axis, loop in loops.items()}
 plot_loops(loops, margins, effective_inertia(plant)[0])  # flexible modes marked [Hz]
-plt.show()

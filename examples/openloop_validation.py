@@ -19,8 +19,6 @@ thesis's.
 
 import os
 
-import matplotlib.pyplot as plt
-
 from flexsat import Plant, nominal
 from flexsat.analysis import modal_analysis, openloop_metrics
 from flexsat.plots import plot_angular_momentum, plot_energy, plot_spectrogram, plot_torques
@@ -52,4 +50,3 @@ plot_torques(result.dataset)
 plot_angular_momentum(result.dataset)
 plot_energy(result.dataset)
 plot_spectrogram(result.dataset, modal_analysis(plant))
-plt.show()

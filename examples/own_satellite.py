@@ -16,7 +16,6 @@ tables a TOML file holds, then analyses its coupled modes.
 # value is refused before anything runs, with one message naming the field and
 # its allowed range.
 
-import matplotlib.pyplot as plt
 
 from flexsat import Plant, SatelliteConfig
 from flexsat.analysis import modal_analysis
@@ -78,4 +77,3 @@ for mode in analysis.modes[6:12]:
     print(f"mode {mode.index:2d}: {mode.frequency_hz:6.3f} Hz  {mode.kind:12s} -> {mode.hub_dof}")
 plot_frequencies(analysis)
 plot_interaction_map(analysis)
-plt.show()

@@ -15,7 +15,6 @@ slower but needs no numba.
 
 import os
 
-import matplotlib.pyplot as plt
 import numpy as np
 
 from flexsat import Plant, nominal
@@ -66,4 +65,3 @@ metrics = slew_metrics(result.dataset)  # the requirements of the stored scenari
 for key in ("controller", "final_pointing_error_deg", "r1_pass", "r2_pass", "r3_pass"):
     print(f"{key:26s} {metrics[key]}")
 plot_pointing(result.dataset)
-plt.show()

@@ -18,8 +18,6 @@ Python (the tables a campaign TOML holds), run, and its worst case replayed.
 import os
 import tempfile
 
-import matplotlib.pyplot as plt
-
 from flexsat import nominal
 from flexsat.analysis import slew_metrics
 from flexsat.campaigns import CampaignDefinition, replay_case, run_campaign, summarize
@@ -54,4 +52,3 @@ replayed = replay_case(store_dir, worst_id)
 metrics = slew_metrics(replayed.dataset)
 print(f"replayed:   final pointing error {metrics['final_pointing_error_deg']:.3g} deg")
 plot_pointing(replayed.dataset)
-plt.show()

@@ -20,8 +20,6 @@ history.
 import os
 import tempfile
 
-import matplotlib.pyplot as plt
-
 from flexsat import nominal
 from flexsat.campaigns import CampaignStore, load_campaign, run_campaign, summarize
 from flexsat.plots.campaign import plot_envelope_pointing, plot_envelope_torque
@@ -56,4 +54,3 @@ print(view.rename(columns=lambda c: c.removeprefix("metrics.")).to_string())
 
 plot_envelope_pointing(store_dir)
 plot_envelope_torque(store_dir)
-plt.show()

@@ -19,8 +19,6 @@ disturbance at its maximum, and three requirements judged on the result:
 
 import os
 
-import matplotlib.pyplot as plt
-
 from flexsat import Plant, nominal
 from flexsat.analysis import slew_metrics
 from flexsat.plots import plot_adaptation, plot_pointing, plot_torque_limits
@@ -52,4 +50,3 @@ print("peak commanded torque [N m]:", metrics["max_commanded_torque_nm"])
 plot_pointing(result.dataset)
 plot_torque_limits(result.dataset)
 plot_adaptation(result.dataset)
-plt.show()

@@ -13,8 +13,8 @@ and Y, and flexible modes in degenerate pairs.
 # The configuration
 # -----------------
 
-import matplotlib.pyplot as plt
 import numpy as np
+from matplotlib.figure import Figure
 
 from flexsat import Plant, SatelliteConfig, nominal
 from flexsat.analysis import modal_analysis
@@ -42,7 +42,8 @@ plant = Plant.from_config(config)
 # inertial frame N at any generalized coordinates (here undeformed).
 
 geometry = satellite_geometry(plant)
-fig, ax = plt.subplots(figsize=(5, 5))
+fig = Figure(figsize=(5, 5), layout="constrained")
+ax = fig.subplots()
 for line in hub_outline(plant).lines:
     ax.plot(line[:, 0], line[:, 1], color="grey", linewidth=0.8)
 for corners in geometry.panels:
@@ -63,4 +64,3 @@ print("J_tot diagonal [kg m^2]:", np.diag(J_tot).round(3))
 analysis = modal_analysis(plant)
 print("first flexible modes [Hz]:", analysis.frequencies_hz[6:14].round(4))
 plot_frequencies(analysis)
-plt.show()

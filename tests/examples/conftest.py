@@ -5,7 +5,6 @@ from __future__ import annotations
 import runpy
 from pathlib import Path
 
-import matplotlib
 import pytest
 
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
@@ -16,13 +15,9 @@ def run_example(monkeypatch, tmp_path):
     """``run_example(name, duration_s)``: the example's globals after it ran.
 
     The example reads its run length from ``FLEXSAT_EXAMPLE_DURATION_S`` (the
-    documentation build runs the full length); its figures are drawn with Agg,
-    not shown, and closed afterwards. Temporary folders go to ``tmp_path``.
+    documentation build runs the full length); its figures are drawn, and
+    dropped with its variables. Temporary folders go to ``tmp_path``.
     """
-    import matplotlib.pyplot as plt
-
-    matplotlib.use("Agg")
-    monkeypatch.setattr(plt, "show", lambda *args, **kwargs: None)
     monkeypatch.setenv("TMPDIR", str(tmp_path))
     monkeypatch.setattr("tempfile.tempdir", None)
 
@@ -30,9 +25,6 @@ def run_example(monkeypatch, tmp_path):
         if duration_s is not None:
             monkeypatch.setenv("FLEXSAT_EXAMPLE_DURATION_S", str(duration_s))
         path = EXAMPLES / f"{name}.py"
-        try:
-            return runpy.run_path(str(path), run_name="__main__")
-        finally:
-            plt.close("all")
+        return runpy.run_path(str(path), run_name="__main__")
 
     return run
