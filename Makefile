@@ -4,7 +4,7 @@ VENV   := .venv
 BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.installed
 
-.PHONY: demo test bench lint clean chromium docs
+.PHONY: demo test bench lint clean chromium
 
 $(STAMP): pyproject.toml
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
@@ -38,7 +38,8 @@ bench: $(STAMP)
 	$(BIN)/python bench/run_all.py
 
 # The documentation site (docs/documentation.md): Sphinx builds it, every example of the
-# gallery is executed, and a warning is an error.
+# gallery is executed, and a warning is an error (outputs: docs/.gitignore).
+.PHONY: docs
 DOCS_STAMP := $(VENV)/.docs-installed
 $(DOCS_STAMP): pyproject.toml $(STAMP)
 	$(BIN)/python -m pip install --quiet -e '.[docs]'
@@ -52,4 +53,4 @@ lint: $(STAMP)
 	$(BIN)/ruff check src tests bench examples
 
 clean:
-	rm -rf $(VENV) out build docs/_build docs/api docs/auto_examples *.egg-info src/*.egg-info .pytest_cache .ruff_cache .hypothesis
+	rm -rf $(VENV) out build *.egg-info src/*.egg-info .pytest_cache .ruff_cache .hypothesis

@@ -13,6 +13,7 @@ import inspect
 import os
 import pkgutil
 import sys
+import typing
 from pathlib import Path
 
 import pydantic
@@ -28,7 +29,7 @@ import flexsat  # noqa: E402
 
 project = "flexsat"
 author = "the flexsat developers"
-copyright = "the flexsat developers"  # noqa: A001 (Sphinx's name)
+copyright = "the flexsat developers"
 release = version = flexsat.__version__
 
 extensions = [
@@ -142,6 +143,19 @@ def _write_api(app) -> None:
             page.write_text(text, encoding="utf-8")
 
 
+def _type_name(annotation) -> str:
+    """A field's type as a reader writes it: ``float``, ``{"rk4", "dop853"}``, ``tuple``."""
+    if typing.get_origin(annotation) is typing.Literal:
+        return "{" + ", ".join(repr(v) for v in typing.get_args(annotation)) + "}"
+    origin = typing.get_origin(annotation) or annotation
+    return getattr(origin, "__name__", None) or str(annotation).replace("typing.", "")
+
+
+def _pydantic_internals(app, what, name, obj, skip, options):
+    """pydantic's own class attributes (``model_config``...) are not the model's API."""
+    return True if name in ("model_config", "model_fields", "model_computed_fields") else None
+
+
 def _pydantic_fields(app, what, name, obj, options, lines):
     """Append a model's fields as a numpydoc Parameters section (its constructor).
 
@@ -157,9 +171,8 @@ def _pydantic_fields(app, what, name, obj, options, lines):
         return
     lines += ["", "Parameters", "----------"]
     for field_name, field in fields.items():
-        annotation = getattr(field.annotation, "__name__", None) or str(field.annotation)
         default = "" if field.is_required() else ", optional"
-        lines.append(f"{field_name} : {annotation.replace('typing.', '')}{default}")
+        lines.append(f"{field_name} : {_type_name(field.annotation)}{default}")
         # a description is plain text: reST's markup characters stand for themselves
         text = (field.description or "").replace("|", "\\|").replace("*", "\\*")
         lines.append(f"    {text}")
@@ -181,5 +194,6 @@ def _no_type_docstring(app, what, name, obj, options, lines):
 def setup(app):
     app.connect("autodoc-process-docstring", _no_type_docstring, priority=400)
     app.connect("builder-inited", _write_api)
+    app.connect("autodoc-skip-member", _pydantic_internals)
     # before numpydoc (priority 500) turns the sections into reST
     app.connect("autodoc-process-docstring", _pydantic_fields, priority=400)
