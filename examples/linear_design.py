@@ -90,13 +90,20 @@ print(f"16-state model: peak error {summary['reduced_peak_error']:.3g}, "
       f"bound {summary['reduced_error_bound']:.3g}")  # fmt: skip
 
 # %%
-# Figures
-# -------
-# The flexible and rigid torque-to-rate Bode diagrams and the PD loop gains.
+# Bode diagrams
+# -------------
+# Torque to rate about each axis, flexible and rigid: the appendage modes are the
+# peaks and notches the rigid model does not have.
 
 plant = Plant.from_config(nominal())
 model = linearize(plant)
 plot_bode(model, rigid_model(plant))
+
+# %%
+# Loop gains
+# ----------
+# The PD loop per axis, with its crossovers and the flexible modes marked.
+
 K = law_gains(plant, PDConfig(natural_frequency_rad_s=0.3, damping_ratio=0.9))
 loops = {axis: pd_loop(model, K, axis) for axis in "xyz"}
 margins = {axis: loop_margins(loop) for axis, loop in loops.items()}

@@ -36,17 +36,36 @@ metrics = openloop_metrics(result.dataset)
 # Beside the thesis
 # -----------------
 
-for key, (value, source) in OPEN_LOOP.items():
-    print(f"{key:28s} flexsat {metrics[key]!s:42.42s} thesis {value!s:6s} ({source})")
+print("each thesis value's source is in flexsat.study.thesis.OPEN_LOOP")
+for key, (value, _source) in OPEN_LOOP.items():
+    print(f"{key:28s} flexsat {metrics[key]!s:30.30s} thesis {value}")
 
 # %%
-# Figures
+# Torques
 # -------
-# The commanded torque and the torque the panels put back on the hub; the angular
-# momentum, constant once the torque is off; the energy balance; and the
-# spectrogram of the yaw acceleration with the coupled modal lines.
+# The commanded torque and the torque the panels put back on the hub.
 
 plot_torques(result.dataset)
+
+# %%
+# Angular momentum
+# ----------------
+# Constant once the torque is off: 10 N m s about Z.
+
 plot_angular_momentum(result.dataset)
+
+# %%
+# Energy balance
+# --------------
+# Kinetic and elastic energy, work in and dissipated energy; their balance error
+# measures the integration.
+
 plot_energy(result.dataset)
+
+# %%
+# Spectrogram
+# -----------
+# The yaw acceleration rings at the coupled in-plane frequency (dashed: the
+# modal lines that drive the hub about Z).
+
 plot_spectrogram(result.dataset, modal_analysis(plant))

@@ -76,4 +76,9 @@ analysis = modal_analysis(plant)
 for mode in analysis.modes[6:12]:
     print(f"mode {mode.index:2d}: {mode.frequency_hz:6.3f} Hz  {mode.kind:12s} -> {mode.hub_dof}")
 plot_frequencies(analysis)
+
+# %%
+# Which coordinate moves in which mode: the modal interaction map (thesis fig. 3.2),
+# each mode scaled to 1.
+
 plot_interaction_map(analysis)

@@ -50,7 +50,11 @@ print(view.rename(columns=lambda c: c.removeprefix("metrics.")).to_string())
 # %%
 # Envelopes
 # ---------
-# Every case's pointing error and torque over time, on one figure each.
+# Every case's pointing error over time, with the R1 band.
 
 plot_envelope_pointing(store_dir)
+
+# %%
+# And every case's torque against the limit of R3.
+
 plot_envelope_torque(store_dir)

@@ -36,17 +36,29 @@ print("requirements:", scenario.requirements)
 # The verdicts, beside the thesis
 # -------------------------------
 
-for key, (value, source) in CLOSED_LOOP.items():
-    print(f"{key:26s} flexsat {metrics[key]!s:24.24s} thesis {value!s:8s} ({source})")
+print("each thesis value's source is in flexsat.study.thesis.CLOSED_LOOP")
+for key, (value, _source) in CLOSED_LOOP.items():
+    print(f"{key:26s} flexsat {metrics[key]!s:24.24s} thesis {value}")
 print("peak commanded torque [N m]:", metrics["max_commanded_torque_nm"])
 
 # %%
-# Figures
-# -------
-# The pointing error and residual rate with the R1 and R2 bands; the torque
-# against its limits (the law clips at RF * T_max = 1.9 N m, the actuator
-# delivers G_act of it); the ASMC's adaptive gain Lambda.
+# Pointing and residual rate
+# --------------------------
+# With the R1 and R2 bands and the observation window.
 
 plot_pointing(result.dataset)
+
+# %%
+# Torque against its limits
+# -------------------------
+# The law clips at RF * T_max = 1.9 N m; the actuator delivers G_act of it (R3).
+
 plot_torque_limits(result.dataset)
+
+# %%
+# Adaptation
+# ----------
+# The ASMC's adaptive gain Lambda: at its minimum while the slew saturates, then
+# rising as the error closes.
+
 plot_adaptation(result.dataset)
