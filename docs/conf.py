@@ -22,7 +22,7 @@ from sphinx.pycode import ModuleAnalyzer
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "src"))
-sys.path.insert(0, str(ROOT / "docs" / "_ext"))  # gallery_figures
+sys.path.insert(0, str(ROOT / "docs" / "_ext"))  # gallery_figures, gallery_order
 os.environ.setdefault("MPLBACKEND", "Agg")
 
 import flexsat  # noqa: E402
@@ -61,7 +61,7 @@ sphinx_gallery_conf = {
     "gallery_dirs": ["auto_examples"],
     "filename_pattern": r"\.py$",  # execute every example, not only plot_*.py
     "ignore_pattern": r"__init__\.py",
-    "within_subsection_order": "FileNameSortKey",
+    "within_subsection_order": "gallery_order.ReadingOrder",
     "download_all_examples": False,
     "remove_config_comments": True,
     "abort_on_example_error": True,
