@@ -25,8 +25,8 @@ __all__ = ["FirstClassKernel", "PackedPlant", "first_class", "only"]
 class PackedPlant(NamedTuple):
     """Hub, groups of appendages and their kernels, for :mod:`flexsat.dynamics.kernels`.
 
-    Fields
-    ------
+    Attributes
+    ----------
     n_dof : int
         Number of generalized coordinates.
     hub_mass : float
