@@ -282,6 +282,43 @@ class ChainModel(AppendageModel):
                       points[k + 1] - half)  # fmt: skip
         return out
 
+    def mirror_block(self, params_i: np.ndarray, params_j: np.ndarray, reflect: np.ndarray,
+                     rtol: float) -> np.ndarray | None:  # fmt: skip
+        # At rest every segment frame has the mount's axes, so one map T = R_j^T reflect
+        # R_i takes i's segment-frame vectors to j's; j mirrors i when T is diagonal of
+        # signs, the geometry and joints map under it, and then each
+        # joint's translations map by T and its rotations (axial) by -T, as the plate's.
+        if len(params_i) != len(params_j):
+            return None
+        R_i, R_j = self.mount_rotation(params_i), self.mount_rotation(params_j)
+        T = R_j.T @ reflect @ R_i
+        if not np.allclose(np.abs(T), np.eye(3), atol=rtol):
+            return None
+        T = np.diag(np.round(np.diag(T)))
+        mount_i, mount_j = self.mount_point(params_i), self.mount_point(params_j)
+        scale_ = max(1.0, float(np.max(np.abs(mount_i))))
+        if not np.allclose(mount_j, reflect @ mount_i, atol=rtol * scale_):
+            return None
+        signs = []
+        for k in range(self.segment_count(params_i)):
+            g = HEADER + SEG * k
+            a, b = params_i[g : g + SEG], params_j[g : g + SEG]
+            J_a, J_b = a[G_J : G_J + 9].reshape(3, 3), b[G_J : G_J + 9].reshape(3, 3)
+            com, nxt = slice(G_COM, G_COM + 3), slice(G_NEXT, G_NEXT + 3)
+            same = (
+                np.isclose(b[G_MASS], a[G_MASS], rtol=rtol)
+                and np.allclose(J_b, T @ J_a @ T, atol=rtol * np.abs(J_a).max())
+                and np.allclose(b[com], T @ a[com], atol=rtol * scale_)
+                and np.allclose(b[nxt], T @ a[nxt], atol=rtol * scale_)
+                and np.array_equal(b[G_FREE : G_FREE + 6], a[G_FREE : G_FREE + 6])
+                and np.allclose(b[G_K : G_C + 6], a[G_K : G_C + 6], rtol=rtol)
+            )  # fmt: skip
+            if not same:
+                return None
+            axis_signs = np.concatenate([np.diag(T), -np.diag(T)])
+            signs += [axis_signs[i] for i in range(6) if a[G_FREE + i] != 0.0]
+        return np.diag(signs)
+
     @staticmethod
     def _chord(config: ChainConfig) -> np.ndarray:
         """Half the chord, segment frame [m] (0 for a listed chain without width)."""
