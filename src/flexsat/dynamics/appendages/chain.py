@@ -269,8 +269,8 @@ class ChainModel(AppendageModel):
         out[4], out[5] = root, end
         return out
 
-    def segment_outlines(self, config: ChainConfig, params: np.ndarray, q_block: np.ndarray
-                         ) -> np.ndarray:  # fmt: skip
+    def outlines(self, config: ChainConfig, params: np.ndarray, q_block: np.ndarray
+                 ) -> np.ndarray:  # fmt: skip
         """Each segment's quadrilateral at ``q_block``, hub frame B [m], shape (N, 4, 3)."""
         rotations, points = self.segment_poses(params, q_block)
         chord = self._chord(config)
@@ -328,6 +328,18 @@ class ChainModel(AppendageModel):
         if config.width_m is not None:
             half[_AXES[_CHORD_THICKNESS[config.span_direction[1]][0]]] = 0.5 * config.width_m
         return half
+
+    def target_frequencies(self, config: ChainConfig) -> tuple[tuple[str, float], ...]:
+        out = []
+        for seg in config.resolved_segments():
+            if seg.frequencies is None:
+                continue
+            for dof, value in zip(seg.dofs, seg.frequencies, strict=True):
+                kind = config.dof_kind(dof)
+                label = f"translation {dof}" if kind == "translation" else kind.replace("_", "-")
+                if (label, value) not in out:
+                    out.append((label, float(value)))
+        return tuple(out)
 
     def extent(self, config: ChainConfig) -> float:
         return float(np.linalg.norm(sum(s.next_joint for s in config.resolved_segments())))
