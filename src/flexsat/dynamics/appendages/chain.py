@@ -63,6 +63,19 @@ def _rotation(angles_xyz: np.ndarray) -> np.ndarray:
     return Rotation.from_euler("ZYX", angles_xyz[::-1]).as_matrix()
 
 
+def _scale_mass(table: dict, factor: float) -> None:
+    """Campaign path ``appendages[*].inertia``: scale the chain's mass and so its inertia
+    (every segment's of a listed chain; joints tuned to target frequencies keep them)."""
+    if table.get("segment_list") is not None:
+        for segment in table["segment_list"]:
+            segment["mass_kg"] = segment["mass_kg"] * factor
+            if segment.get("inertia_kg_m2") is not None:
+                segment["inertia_kg_m2"] = (np.asarray(segment["inertia_kg_m2"]) * factor).tolist()
+        return
+    field = "mass_kg" if table.get("mass_kg") is not None else "surface_density_kg_m2"
+    table[field] = table[field] * factor
+
+
 class ChainModel(AppendageModel):
     """Serial chain of rigid segments on elastic joints (:class:`ChainConfig`)."""
 
@@ -70,7 +83,7 @@ class ChainModel(AppendageModel):
     config_class = ChainConfig
     kernels = AppendageKernels(pass1, pass2, mass_matrix, bias_forces, observe, joint_wrench, tips)
     transmits_inertia = True
-    modifiers: ClassVar[dict] = {}
+    modifiers: ClassVar[dict] = {"inertia": _scale_mass}
     work_size = WSEG
 
     # -- layout ---------------------------------------------------------------------------
@@ -367,3 +380,4 @@ def _with_point_mass(seg, tip_mass: float, point: np.ndarray):
     inertia = (seg.inertia + seg.mass * (d1 @ d1 * np.eye(3) - np.outer(d1, d1))
                + tip_mass * (d2 @ d2 * np.eye(3) - np.outer(d2, d2)))  # fmt: skip
     return mass, com, inertia
+

@@ -387,13 +387,14 @@ def pass1(q, qd, Q, members, params, work, hub, qdd):
                 for r in range(6):
                     w[b + W_PA + r] += w[b + W_U + 6 * a + r] * y
             for r in range(6):
-                for s in range(6):
-                    acc = 0.0
+                # row r of U D^-1 (D^-1 symmetric), then I^A[r, :] -= (U D^-1)[r, :] U^T
+                for e in range(nf):
+                    v = 0.0
                     for a in range(nf):
-                        ua = w[b + W_U + 6 * a + r]
-                        for e in range(nf):
-                            acc += ua * w[b + W_DI + 6 * a + e] * w[b + W_U + 6 * e + s]
-                    w[b + W_IA + 6 * r + s] -= acc
+                        v += w[b + W_U + 6 * a + r] * w[b + W_DI + 6 * a + e]
+                    if v != 0.0:
+                        for s in range(6):
+                            w[b + W_IA + 6 * r + s] -= v * w[b + W_U + 6 * e + s]
             ia_n, ia_f = _mul6(w, b + W_IA, load_seg(w, b + W_CA), load_seg(w, b + W_CA + 3))
             for r in range(3):
                 w[b + W_PA + r] += ia_n[r]
