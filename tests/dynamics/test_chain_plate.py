@@ -69,7 +69,7 @@ def test_terms_agree_with_the_plate_at_random_states(nominal_plant, chain_plant)
 @pytest.mark.parametrize(("kind", "run"), [("openloop", run_openloop), ("slew", run_slew)])
 def test_thesis_runs_as_chains_reproduce_stored_histories(chain_plant, kind, run):
     # Same tolerance and argument as tests/simulate/test_reference_histories.py (measured:
-    # 2.8e-15 open loop, 4.0e-14 slew).
+    # 2.1e-15 open loop, 4.0e-14 slew).
     stored = np.load(DATA / f"reference_{kind}.npz")
     differences = _largest_difference(stored, run(chain_plant).dataset)
     worst = max(differences, key=differences.get)
