@@ -18,8 +18,9 @@ from __future__ import annotations
 from typing import ClassVar
 
 import numpy as np
+from scipy.spatial.transform import Rotation
 
-from flexsat.dynamics.appendages.chain_config import DOF_NAMES, ChainConfig
+from flexsat.dynamics.appendages.chain_config import AXES, CHORD_THICKNESS, DOF_NAMES, ChainConfig
 from flexsat.dynamics.appendages.chain_kernels import (
     G_C,
     G_COM,
@@ -58,8 +59,6 @@ __all__ = ["ChainModel"]
 
 def _rotation(angles_xyz: np.ndarray) -> np.ndarray:
     """Rz(rz) Ry(ry) Rx(rx) of a joint's (rx, ry, rz) [rad]."""
-    from scipy.spatial.transform import Rotation
-
     return Rotation.from_euler("ZYX", angles_xyz[::-1]).as_matrix()
 
 
@@ -335,11 +334,9 @@ class ChainModel(AppendageModel):
     @staticmethod
     def _chord(config: ChainConfig) -> np.ndarray:
         """Half the chord, segment frame [m] (0 for a listed chain without width)."""
-        from flexsat.dynamics.appendages.chain_config import _AXES, _CHORD_THICKNESS
-
         half = np.zeros(3)
         if config.width_m is not None:
-            half[_AXES[_CHORD_THICKNESS[config.span_direction[1]][0]]] = 0.5 * config.width_m
+            half[AXES[CHORD_THICKNESS[config.span_direction[1]][0]]] = 0.5 * config.width_m
         return half
 
     def target_frequencies(self, config: ChainConfig) -> tuple[tuple[str, float], ...]:
