@@ -208,7 +208,8 @@ class AppendageModel(ABC):
         False for a model on a full 6-DOF joint (the engine then skips the 6 x 6
         hub solve); True when ``pass1`` adds an articulated inertia.
     work_size : int
-        Columns of the scratch rows ``work`` that pass 1 may leave for pass 2.
+        Columns of the scratch rows ``work`` that pass 1 may leave for pass 2 (see
+        :meth:`work_columns` for a scratch that grows with the appendage).
     modifiers : dict
         Derived campaign modifier paths beyond the config's own fields: name ->
         function(table, value) that changes the appendage's plain-dict table in place
@@ -264,6 +265,17 @@ class AppendageModel(ABC):
             "no initial state to set"
         )
 
+    def work_columns(self, params: np.ndarray) -> int:
+        """Columns of the scratch row one member with packed row ``params`` needs (a
+        model whose scratch grows with its size overrides it). Default: ``work_size``."""
+        return self.work_size
+
+    def default_state(self, config: BaseModel) -> tuple[np.ndarray, np.ndarray]:
+        """Its rows of q(0) and q_dot(0) before any scenario entry (a model whose config
+        holds an initial state overrides it). Default: at rest, undeformed."""
+        count = len(self.coordinates(config))
+        return np.zeros(count), np.zeros(count)
+
     def describe(self, config: BaseModel, params: np.ndarray) -> dict:
         """Derived properties for reports and ``flexsat config`` (JSON-ready). Default:
         the rigid body's mass [kg] and inertia about its centre of mass in B [kg m^2]."""
@@ -280,6 +292,18 @@ class AppendageModel(ABC):
         """
         return np.tile(self.rigid_body(params).r_B, (6, 1))
 
+    def target_frequencies(self, config: BaseModel) -> tuple[tuple[str, float], ...]:
+        """The clamped-root target frequencies its config asks for, as (label, Hz) pairs
+        (labels such as ``flapping``, ``in-plane``, ``translation x``). Default: none."""
+        return ()
+
+    def outlines(self, config: BaseModel, params: np.ndarray, q_block: np.ndarray
+                 ) -> np.ndarray:  # fmt: skip
+        """The quadrilaterals it is drawn as at ``q_block``, hub frame B [m], shape (k, 4, 3)
+        (a model of several bodies draws each). Default: the outline of
+        :meth:`shape_points`."""
+        return self.shape_points(config, params, q_block)[None, 0:4]
+
     def extent(self, config: BaseModel) -> float:
         """Characteristic length [m] that plots relate tip motion to; 0: none."""
         return 0.0
@@ -289,10 +313,12 @@ class AppendageModel(ABC):
         coordinates hold most of its strain energy. Default: the coordinate names."""
         return tuple(c.name for c in self.coordinates(config))
 
-    def root_motion(self, q_block: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    def root_motion(self, q_block: np.ndarray, names: tuple[str, ...] = ()
+                    ) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
         """Root translation eta [m] and rotation rho [rad] of its joint, each (m, 3),
-        from recorded coordinates (or rates) ``q_block`` (m, count). Default: NaN (the
-        model has no root joint of that form)."""
+        from recorded coordinates (or rates) ``q_block`` (m, count) named ``names`` (its
+        coordinate names, in order). Default: NaN (the model has no root joint of that
+        form)."""
         nan = np.full((q_block.shape[0], 3), np.nan)
         return nan, nan.copy()
 
