@@ -97,8 +97,9 @@ def asmc_step(q_d, omega_d, omega_dot_d, q, omega_B, J, gains, state, t, dt, tau
     ``state``: Lambda of the previous call, and 1.0 once a call has been made.
     """
     limit = gains[G.reduction_factor] * gains[G.t_max]
-    qv, qv_dot, omega_e, theta_err = errors(q_d, q, omega_B)
+    qv, qv_dot, omega_e, theta_err, w_dot_d = errors(q_d, omega_d, omega_dot_d, q, omega_B)
     J3 = inertia3(J)
+    J_w_dot_d = mv(J3, w_dot_d)  # tracking feed-forward J omega_dot_d (eq. 4.12)
     tau_gyro = cross(omega_B, mv(J3, omega_B))  # omega x (J omega)
     J_qv_dot = mv(J3, qv_dot)
     jk_min, lam_min, lam_max = gains[G.jk_min], gains[G.lambda_min], gains[G.lambda_max]
@@ -108,12 +109,13 @@ def asmc_step(q_d, omega_d, omega_dot_d, q, omega_B, J, gains, state, t, dt, tau
     # eqs. 4.23, 4.28: budget-feasible slope; the most restrictive axis decides
     lam_feasible = 1e300
     for a in range(3):
-        budget = limit - abs(tau_gyro[a]) - jk_min
+        budget = limit - abs(tau_gyro[a]) - abs(J_w_dot_d[a]) - jk_min  # eq. 4.23
         if abs(J_qv_dot[a]) > 0.0:
             lam_feasible = min(lam_feasible, max(0.0, budget) / abs(J_qv_dot[a]))
     lam = max(lam_min, min(lam_target, lam_feasible))  # eq. 4.29
     s = (omega_e[0] + lam * qv[0], omega_e[1] + lam * qv[1], omega_e[2] + lam * qv[2])
-    tau_guide = (-lam * J_qv_dot[0], -lam * J_qv_dot[1], -lam * J_qv_dot[2])
+    tau_guide = (J_w_dot_d[0] - lam * J_qv_dot[0], J_w_dot_d[1] - lam * J_qv_dot[1],
+                 J_w_dot_d[2] - lam * J_qv_dot[2])  # J (omega_dot_d - Lambda q_v,e_dot)
     # eq. 4.30, per axis: all the residual budget outside the boundary layer, scaled
     # down towards JK_min inside it.
     jk = (
