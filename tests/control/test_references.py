@@ -76,5 +76,5 @@ def test_bad_reference_parameters_name_the_field():
     with pytest.raises(ValidationError, match="damping_ratios"):
         SlewScenario.model_validate({"reference": {"kind": "eigenaxis", "shaper": {
             "damping_ratios": [0.01]}}})  # fmt: skip
-    with pytest.raises(ValidationError, match="unknown kind|eigenaxis"):
+    with pytest.raises(ValidationError, match=r"unknown kind|eigenaxis"):
         SlewScenario.model_validate({"reference": {"kind": "ramp"}})
