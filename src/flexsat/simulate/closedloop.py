@@ -148,6 +148,7 @@ def run_slew(
     attrs["actuator"] = layout.actuator.name
     if controller is None:
         attrs.update(scenario.controller.plot_attributes())
+        attrs["law_diagnostics"] = [channel.name for channel in law.diagnostics]
     attrs["reference"] = layout.reference.name
     attrs["joint_actuator"] = layout.joint_actuator.name
     attrs["design_inertia"] = J.ravel().tolist()
