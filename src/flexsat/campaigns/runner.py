@@ -156,6 +156,7 @@ def run_case(case: ResolvedCase) -> dict:
     the case (:func:`case_history`); :func:`run_campaign` stores it apart from the
     table. A case that fails before simulating has no history.
     """
+    from flexsat.analysis.effort import effort_metrics
     from flexsat.analysis.requirements import slew_metrics
     from flexsat.config.models import SatelliteConfig
     from flexsat.dynamics.plant import Plant
@@ -176,6 +177,7 @@ def run_case(case: ResolvedCase) -> dict:
         result = run_slew(plant, scenario, progress=False)
         row[HISTORY_KEY] = case_history(result.dataset)
         metrics = slew_metrics(result.dataset)  # the stored scenario's requirements
+        metrics.update(effort_metrics(result.dataset))
         metrics.pop("wall_time_s")
         status, message = metrics.pop("status"), metrics.pop("message")
         row.update(status=status, error=message, metrics=metrics)
