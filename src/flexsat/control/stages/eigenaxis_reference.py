@@ -36,7 +36,8 @@ from flexsat.control.stages.shapers import shaper_for_modes
 __all__ = ["EIGENAXIS_REFERENCE", "EigenaxisReferenceConfig", "ShaperConfig", "coupled_modes"]
 
 _TRAPEZOID, _POLYNOMIAL = 0.0, 1.0
-# packed: q_0 (4), e (3), Theta, start, profile code, p1, p2, p3, n impulses, A (n), t (n)
+# packed: q_0 (4), e (3), Theta, start, profile code, p1, p2, p3, n impulses, A (n), t (n),
+# then the time the shaped reference comes to rest
 _Q0, _AXIS, _ANGLE, _START, _CODE, _P, _N, _IMPULSES = 0, 4, 7, 8, 9, 10, 13, 14
 
 
@@ -140,16 +141,14 @@ class EigenaxisReferenceConfig(PlantStageConfig):
         axis = rel[1:] / norm if norm > 0.0 else np.array([1.0, 0.0, 0.0])
         angle = 2.0 * np.arctan2(norm, rel[0])
         A, t = (np.ones(1), np.zeros(1)) if self.shaper is None else self.shaper.impulses(plant)
-        return np.concatenate([q0, axis, [angle, self.start_s],
-                               self.profile_parameters(angle), [A.size], A, t])  # fmt: skip
+        code, p1, p2, p3 = self.profile_parameters(angle)
+        end = self.start_s + (p1 if code == _POLYNOMIAL else 2.0 * p2 + p3) + t[-1]
+        return np.concatenate([q0, axis, [angle, self.start_s, code, p1, p2, p3, A.size],
+                               A, t, [end]])  # fmt: skip
 
     def duration(self, scenario, plant=None) -> float:
         """When the shaped reference comes to rest at the target [s]."""
-        p = self.packed(scenario, plant)
-        n = int(p[_N])
-        code, p1, p2, p3 = p[_CODE], p[_P], p[_P + 1], p[_P + 2]
-        length = p1 if code == _POLYNOMIAL else 2.0 * p2 + p3
-        return float(self.start_s + length + p[_IMPULSES + n + n - 1])
+        return float(self.packed(scenario, plant)[-1])
 
 
 @njit(cache=True)
@@ -187,6 +186,9 @@ def eigenaxis_reference_step(t, params, state, q_d, omega_d, omega_dot_d, record
     """The shaped eigenaxis reference at t (contract in ``stages.registry``)."""
     n = int(params[_N])
     theta, rate, acc = 0.0, 0.0, 0.0
+    if t >= params[_IMPULSES + 2 * n]:  # at rest at the target: no impulse to sum
+        theta = params[_ANGLE]
+        n = 0
     for i in range(n):  # theta_s(t) = sum A_i theta(t - t_i)
         a = params[_IMPULSES + i]
         th, w, dw = _profile(params, t - params[_START] - params[_IMPULSES + n + i])
