@@ -1,7 +1,7 @@
 """Run every flexsat benchmark in order and finish with the performance targets.
 
 ``python bench/run_all.py`` (what ``make bench`` runs) prints, in this order, the
-tables of bench_dynamics, bench_openloop, bench_slew, bench_scaling, bench_startup,
+tables of bench_dynamics, bench_openloop, bench_slew, bench_laws, bench_scaling, bench_startup,
 bench_campaigns, bench_figures and bench_basilisk (skipped with a line when Basilisk or the script
 is missing), then one table of the performance targets: each target, the measured
 value, and met / not met. A benchmark that fails is reported and the others still
@@ -35,6 +35,7 @@ BENCHMARKS = (
     "bench_dynamics",
     "bench_openloop",
     "bench_slew",
+    "bench_laws",
     "bench_scaling",
     "bench_startup",
     "bench_campaigns",

@@ -139,6 +139,11 @@ SCENARIOS = [
     _scenario("unknown scenario key", "duraton_s = 5.0\n", "did you mean 'duration_s'"),
     _scenario("unknown law", '[controller]\nkind = "magic"\n', "controller"),
     _scenario("negative requirement", "[requirements]\npointing_deg = -1.0\n", "requirements.pointing_deg", command="slew"),
+    _scenario("polynomial reference without duration", '[reference]\nkind = "eigenaxis"\nprofile = "polynomial"\n', "duration_s is required", command="slew"),
+    _scenario("unknown shaper", '[reference]\nkind = "eigenaxis"\n[reference.shaper]\nkind = "zvdd"\n', "reference.shaper.kind", command="slew"),
+    _scenario("negative joint authority", '[joint_actuator]\nkind = "rate_feedback"\ncoordinates = ["eta_ry"]\ngain = 1.0\nlimit = -0.1\n', "joint_actuator.limit", command="slew"),
+    _scenario("unknown joint coordinate", '[joint_actuator]\nkind = "rate_feedback"\ncoordinates = ["rho_q"]\ngain = 1.0\nlimit = 0.1\n', "joint_actuator.coordinates: unknown coordinate 'rho_q'", command="slew"),
+    _scenario("smooth lambda of zero time constant", '[controller]\nlambda_adaptation = "smooth"\nlambda_time_constant_s = 0.0\n', "controller.lambda_time_constant_s", command="slew"),
     Bad("missing scenario file", ["openloop", "--scenario", "{tmp}/absent.toml"], "scenario file not found"),
 ]  # fmt: skip
 
@@ -181,6 +186,7 @@ CAMPAIGNS = [
     Bad("unknown campaign", ["campaign", "no-such-campaign"], "neither a preset"),
     Bad("negative case count", ["campaign", "montecarlo-random", "--cases", "-3", "--out", "{tmp}/s"], "--cases must be >= 1"),
     Bad("zero workers", ["campaign", "sensitivity", "--workers", "0"], "Invalid value for '--workers'"),
+    Bad("campaign of an unknown law", ["campaign", "sensitivity", "--controller", "lqr", "--out", "{tmp}/s"], "--controller: unknown control law 'lqr'"),
 ]  # fmt: skip
 
 TABLE = CONFIGS + SCENARIOS + PATHS + CAMPAIGNS

@@ -139,10 +139,13 @@ HISTORY_DT_S = 0.1
 def case_history(ds, dt: float = HISTORY_DT_S) -> dict:
     """Time history of a slew decimated to every ``dt`` seconds, as plain lists.
 
-    Keys are those of :data:`HISTORY_UNITS`: ``tau_cmd`` and ``jk`` are lists of
-    [x, y, z] per sample, ``tip_displacement_max`` the largest tip-displacement
-    magnitude over the appendages [m]. Variables a dataset lacks are left out.
-    A partial (failed) run gives the history up to where it stopped.
+    Keys are those of :data:`HISTORY_UNITS` and the law's declared diagnostics
+    (``attrs["law_diagnostics"]``: ``lambda_act`` and ``jk`` for the ASMC, the
+    twisting integral for the STSMC...), whose units and descriptions go under
+    ``channels``; per-axis variables are lists of [x, y, z] per sample,
+    ``tip_displacement_max`` the largest tip-displacement magnitude over the
+    appendages [m]. Variables a dataset lacks are left out. A partial (failed) run
+    gives the history up to where it stopped.
     """
     import numpy as np
 
@@ -152,10 +155,16 @@ def case_history(ds, dt: float = HISTORY_DT_S) -> dict:
     grid = np.arange(t[0], t[-1] + 0.5 * dt, dt)
     index = np.unique(np.clip(np.searchsorted(t, grid - 1e-9 * dt), 0, t.size - 1))
     history = {"time": t[index].tolist()}
-    for name in ("pointing_error_deg", "rate_error_deg_s", "tau_cmd", "total_energy",
-                 "lambda_act", "jk"):  # fmt: skip
+    for name in ("pointing_error_deg", "rate_error_deg_s", "tau_cmd", "total_energy"):
         if name in ds:
             history[name] = np.asarray(ds[name].values, dtype=float)[index].tolist()
+    channels = {}
+    for name in ds.attrs.get("law_diagnostics", ()):
+        if name in ds:
+            history[name] = np.asarray(ds[name].values, dtype=float)[index].tolist()
+            channels[name] = {key: ds[name].attrs.get(key, "") for key in ("units", "description")}
+    if channels:
+        history["channels"] = channels
     if "tip_displacement" in ds:
         tips = np.asarray(ds["tip_displacement"].values, dtype=float)[index]
         magnitude = np.linalg.norm(tips, axis=-1)  # (time, appendage)
@@ -183,6 +192,7 @@ def run_case(case: ResolvedCase) -> dict:
         ``inputs``, ``metrics`` (:func:`flexsat.analysis.slew_metrics`, SI or the
         key's unit).
     """
+    from flexsat.analysis.effort import effort_metrics
     from flexsat.analysis.requirements import slew_metrics
     from flexsat.config.models import SatelliteConfig
     from flexsat.dynamics.plant import Plant
@@ -203,6 +213,7 @@ def run_case(case: ResolvedCase) -> dict:
         result = run_slew(plant, scenario, progress=False)
         row[HISTORY_KEY] = case_history(result.dataset)
         metrics = slew_metrics(result.dataset)  # the stored scenario's requirements
+        metrics.update(effort_metrics(result.dataset))
         metrics.pop("wall_time_s")
         status, message = metrics.pop("status"), metrics.pop("message")
         row.update(status=status, error=message, metrics=metrics)

@@ -53,10 +53,9 @@ HISTORY_UNITS = {
     "tau_cmd": "N m",
     "tip_displacement_max": "m",
     "total_energy": "J",
-    "lambda_act": "rad/s",
-    "jk": "N m",
 }
-"""Variables of a stored case history and their units."""
+"""Variables every stored case history has, and their units; the law's declared
+diagnostics come with their own (the history's ``channels``)."""
 
 _HISTORY_DESCRIPTIONS = {
     "pointing_error_deg": "2 asin |q_v,e|: absolute pointing error",
@@ -64,8 +63,6 @@ _HISTORY_DESCRIPTIONS = {
     "tau_cmd": "commanded body torque, frame B",
     "tip_displacement_max": "largest panel tip displacement magnitude over the appendages",
     "total_energy": "T + U",
-    "lambda_act": "Lambda_act",
-    "jk": "robust torque gain JK per axis",
 }
 
 
@@ -180,10 +177,12 @@ class CampaignStore:
         _write_atomic(self.cases_dir / f"{row['case_id']}.json", json.dumps(jsonable(row)))
 
     def write_history(self, case_id: str, data: dict, status: str = "ok") -> Path:
-        """Store a case's time history (plain lists keyed as :data:`HISTORY_UNITS`).
+        """Store a case's time history (plain lists keyed as :data:`HISTORY_UNITS`,
+        and the law's diagnostics named with their units under ``channels``).
 
         Written to ``histories/<case_id>.nc`` through a temporary file and an atomic
-        rename. ``tau_cmd`` and ``jk`` are (time, axis); the rest are (time,).
+        rename. Per-axis variables (``tau_cmd``, ``jk``...) are (time, axis); the rest
+        are (time,).
         """
         self.histories_dir.mkdir(parents=True, exist_ok=True)
         ds = xr.Dataset(
@@ -193,14 +192,15 @@ class CampaignStore:
             attrs={"case_id": case_id, "status": status,
                    "title": f"flexsat campaign case {case_id!r} (decimated history)"},
         )  # fmt: skip
-        for name, unit in HISTORY_UNITS.items():
+        described = {name: {"units": unit, "description": _HISTORY_DESCRIPTIONS.get(name, "")}
+                     for name, unit in HISTORY_UNITS.items()}  # fmt: skip
+        described.update(data.get("channels", {}))
+        for name, attrs in described.items():
             if name == "time" or name not in data:
                 continue
             values = np.asarray(data[name], dtype=float)
-            dims = ("time", "axis") if name in ("tau_cmd", "jk") else ("time",)
-            values = values.reshape(-1, 3) if len(dims) == 2 else values
-            attrs = {"units": unit, "description": _HISTORY_DESCRIPTIONS[name]}
-            ds[name] = (dims, values, attrs)
+            dims = ("time", "axis") if values.ndim == 2 else ("time",)
+            ds[name] = (dims, values, dict(attrs))
         path = self.histories_dir / f"{case_id}.nc"
         fd, tmp = tempfile.mkstemp(dir=self.histories_dir, suffix=".partial")
         os.close(fd)

@@ -466,6 +466,11 @@ def campaign(
     ] = None,
     resume: Annotated[bool, typer.Option(help="Skip the cases already in the store.")] = False,
     json_output: JsonOption = False,
+    controller: Annotated[
+        str | None,
+        typer.Option(help="Fly every case with this registered law (its default gains) "
+                     "instead of the campaign's [base.controller]."),
+    ] = None,
 ) -> None:
     """Robustness campaign: many slews of a varied plant, stored case by case (Parquet, CSV).
 
@@ -493,7 +498,18 @@ def campaign(
         data = definition.model_dump(mode="json")
         data["base"] = {**data["base"], "duration_s": duration}
         definition = validate_config(data, source="--duration", model=CampaignDefinition)
-    store = out or Path("out") / "campaigns" / definition.name
+    if controller is not None:
+        from flexsat.control.laws import get_law
+
+        try:
+            get_law(controller)
+        except ValueError as exc:
+            raise FlexsatError(f"--controller: {exc}") from None
+        data = definition.model_dump(mode="json")
+        data["base"] = {**data["base"], "controller": {"kind": controller}}
+        definition = validate_config(data, source="--controller", model=CampaignDefinition)
+    stem = definition.name if controller is None else f"{definition.name}-{controller}"
+    store = out or Path("out") / "campaigns" / stem
     summary = fly_campaign(
         definition, load_config(config), store, workers=workers, resume=resume, n_random=cases,
         scheduler=scheduler, dask_local=dask_local, progress=not json_output,

@@ -14,6 +14,7 @@ __all__ = [
     "pointing_error",
     "pointing_errors",
     "quaternion_error",
+    "quaternion_product",
     "target_quaternion",
 ]
 
@@ -42,6 +43,17 @@ def quaternion_error(q_d, q):
     if e0 < 0.0:
         return (-e0, -e1, -e2, -e3)
     return (e0, e1, e2, e3)
+
+
+@njit(cache=True)
+def quaternion_product(a, b):
+    """a (x) b, scalar first (Hamilton product: R(a (x) b) = R(a) R(b))."""
+    return (
+        a[0] * b[0] - a[1] * b[1] - a[2] * b[2] - a[3] * b[3],
+        a[0] * b[1] + a[1] * b[0] + a[2] * b[3] - a[3] * b[2],
+        a[0] * b[2] - a[1] * b[3] + a[2] * b[0] + a[3] * b[1],
+        a[0] * b[3] + a[1] * b[2] - a[2] * b[1] + a[3] * b[0],
+    )
 
 
 def target_quaternion(euler_deg: tuple[float, float, float]) -> np.ndarray:

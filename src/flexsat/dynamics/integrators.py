@@ -47,18 +47,21 @@ def applied_torque(t, seg_start, seg_end, seg_torque, disturbance):
 def augmented_derivative(x, torque_B, n, Q, dx, packed):
     """dx/dt of the augmented state [q, q_dot, W_in, W_diss] under a body torque.
 
-    ``torque_B`` is a 3-tuple [N m], ``Q`` scratch of length n, ``dx`` the output,
-    ``packed`` the :class:`~flexsat.dynamics.packed.PackedPlant`. Shared by the
-    compiled RK4 loop and the adaptive scipy solver. Returns a status.
+    ``torque_B`` is a 3-tuple [N m], ``Q`` (n,) the generalized forces: on input
+    ``Q[6:]`` holds those applied to the appendage coordinates (joint actuators; zero
+    without), ``Q[:6]`` is overwritten with the hub's. ``dx`` the output, ``packed``
+    the :class:`~flexsat.dynamics.packed.PackedPlant`. Shared by the compiled RK4
+    loop and the adaptive scipy solver. Returns a status. W_in integrates the power
+    of every applied generalized force, hub torque and joint actuators.
     """
     q = x[:n]
     qd = x[n : 2 * n]
-    Q[:] = 0.0
+    Q[0], Q[1], Q[2] = 0.0, 0.0, 0.0
     Q[3], Q[4], Q[5] = mtv(euler_rate_matrix(q[3], q[4]), torque_B)  # Q_Theta = S^T tau
     dx[:n] = qd
     status = accelerations(q, qd, Q, packed, dx[n : 2 * n])
     power_in = 0.0
-    for j in range(3, 6):
+    for j in range(3, n):
         power_in += Q[j] * qd[j]
     dx[2 * n] = power_in
     dx[2 * n + 1] = packed.hub[HUB_DISSIPATION]  # q_dot^T C q_dot, left by accelerations
@@ -69,8 +72,10 @@ def augmented_derivative(x, torque_B, n, Q, dx, packed):
 def rk4_step(x, dt, torque_B, n, Q, scratch, packed):
     """One RK4 step of the augmented state x, in place, under a held body torque.
 
-    ``scratch`` (5, len(x)) and ``Q`` (n,) are work arrays the caller allocates once.
-    On a non-zero status x is left unchanged.
+    ``scratch`` (5, len(x)) is a work array the caller allocates once; ``Q`` (n,) holds
+    the generalized forces held on the appendage coordinates in ``Q[6:]`` (zeros
+    without joint actuators; :func:`augmented_derivative`). On a non-zero status x is
+    left unchanged.
     """
     size = x.shape[0]
     k1, k2, k3, k4, stage = scratch[0], scratch[1], scratch[2], scratch[3], scratch[4]
@@ -99,7 +104,7 @@ def rk4_hold(x, dt, n_steps, torque_B, packed):
     """``n_steps`` RK4 steps under one held body torque (3-tuple). Returns (status, done)."""
     n = packed.n_dof
     scratch = np.empty((5, x.shape[0]))
-    Q = np.empty(n)
+    Q = np.zeros(n)  # no joint actuators
     for k in range(n_steps):
         status = rk4_step(x, dt, torque_B, n, Q, scratch, packed)
         if status != STATUS_OK:
@@ -141,7 +146,7 @@ def rk4_open_loop(
     """
     n = packed.n_dof
     scratch = np.empty((5, x.shape[0]))
-    Q = np.empty(n)
+    Q = np.zeros(n)  # no joint actuators
     row = rec_start
     for k in range(n_steps):
         t = t0 + k * dt

@@ -12,12 +12,12 @@ from flexsat.config import nominal
 from flexsat.config.models import SatelliteConfig
 from flexsat.control.laws import get_law
 from flexsat.control.quaternion import pointing_errors, target_quaternion
-from flexsat.control.stages import ACTUATORS, SENSORS
+from flexsat.control.stages import ACTUATORS, JOINT_ACTUATORS, REFERENCES, SENSORS
 from flexsat.dynamics.integrators import rk4_hold
 from flexsat.dynamics.plant import Plant
 from flexsat.dynamics.rigid import rigid_inertia
 from flexsat.dynamics.status import STATUS_CONTROL_FAILED
-from flexsat.errors import SimulationError
+from flexsat.errors import ConfigError, SimulationError
 from flexsat.simulate.common import PROGRESS_MIN_STEPS, chunk_steps, progress_bar, run_attributes
 from flexsat.simulate.layout import LoopLayout
 from flexsat.simulate.loops import (
@@ -121,7 +121,13 @@ def run_slew(
     )
     law = get_law(scenario.controller.kind)
     layout = LoopLayout(plant.layout, law, SENSORS.get(scenario.sensor.kind),
-                        ACTUATORS.get(scenario.actuator.kind))  # fmt: skip
+                        ACTUATORS.get(scenario.actuator.kind),
+                        REFERENCES.get(scenario.reference.kind),
+                        JOINT_ACTUATORS.get(scenario.joint_actuator.kind))  # fmt: skip
+    if controller is not None and (layout.reference.name != REFERENCES.default
+                                   or layout.joint_actuator.name != JOINT_ACTUATORS.default):
+        raise ConfigError("a Python controller flies the step reference without joint "
+                          "actuators: remove [reference] and [joint_actuator]")  # fmt: skip
     q0, qd0 = initial_state(plant, scenario)
     steps, every = scenario.n_steps, scenario.record_every
     n_records = steps // every + 2  # + the last good state of a failed run
@@ -129,8 +135,9 @@ def run_slew(
     rec_x = np.full((n_records, layout.plant.size), np.nan)
     rec_ctrl = np.full((n_records, layout.record_size), np.nan)
     x = np.concatenate([q0, qd0, [0.0, 0.0]])
-    data = _loop_data(layout, scenario, J)
-    stages = LoopStages((layout.sensor.step,), (law.step,), (layout.actuator.step,))
+    data = _loop_data(layout, scenario, J, plant)
+    stages = LoopStages((layout.sensor.step,), (law.step,), (layout.actuator.step,),
+                        (layout.reference.step,), (layout.joint_actuator.step,))  # fmt: skip
     show = steps >= PROGRESS_MIN_STEPS if progress is None else progress
     start = time.perf_counter()
     with progress_bar(show, scenario.duration_s) as (bar, task):
@@ -153,8 +160,12 @@ def run_slew(
     attrs["actuator"] = layout.actuator.name
     if controller is None:
         attrs.update(scenario.controller.plot_attributes())
+        attrs["law_diagnostics"] = [channel.name for channel in law.diagnostics]
+    attrs["reference"] = layout.reference.name
+    attrs["joint_actuator"] = layout.joint_actuator.name
     attrs["design_inertia"] = J.ravel().tolist()
-    attrs["target_quaternion"] = data.q_d.tolist()
+    target = target_quaternion(scenario.target_euler_deg)
+    attrs["target_quaternion"] = target.tolist()
     # gain (3), environment (3), sloshing ratio and Hz, residual (3), T_max
     attrs["realised_disturbances"] = data.actuator_params.tolist()
     at = layout.plant  # where each piece of the plant state lives
@@ -169,11 +180,11 @@ def run_slew(
         attributes = {"units": channel.units, "description": channel.description}
         ds[channel.name] = (ta if channel.per_axis else "time", values, attributes)
     # of the true attitude, whatever the sensor measured
-    pointing = pointing_errors(data.q_d, np.ascontiguousarray(rec_x[:, at.attitude]))
+    pointing = pointing_errors(target, np.ascontiguousarray(rec_x[:, at.attitude]))
     ds["pointing_error_deg"] = (
         "time", np.degrees(pointing),
-        {"units": "deg", "description": "2 asin |q_v,e| of the true attitude: absolute "
-         "pointing error"},
+        {"units": "deg", "description": "2 asin |q_v,e| of the true attitude from the "
+         "target: absolute pointing error"},
     )  # fmt: skip
     with np.errstate(over="ignore", invalid="ignore"):  # a diverged run's last state
         rate_error = np.degrees(np.linalg.norm(ds["omega"].values, axis=1))
@@ -184,7 +195,8 @@ def run_slew(
     return Result(ds)
 
 
-def _loop_data(layout: LoopLayout, scenario: SlewScenario, J: np.ndarray) -> LoopData:
+def _loop_data(layout: LoopLayout, scenario: SlewScenario, J: np.ndarray,
+               plant: Plant) -> LoopData:  # fmt: skip
     """The arrays of one run, record-row pieces as views into ``held``."""
     held = np.zeros(layout.record_size)
     state = np.zeros(layout.state_size)
@@ -194,8 +206,8 @@ def _loop_data(layout: LoopLayout, scenario: SlewScenario, J: np.ndarray) -> Loo
 
     return LoopData(
         J_design=J,
-        q_d=packed(target_quaternion(scenario.target_euler_deg)),
-        omega_d=np.zeros(3),  # rest-to-rest
+        q_d=packed(target_quaternion(scenario.target_euler_deg)),  # the reference writes these
+        omega_d=np.zeros(3),
         omega_dot_d=np.zeros(3),
         law_gains=packed(scenario.controller.gains(scenario.actuator)),
         law_state=state[layout.law_state],
@@ -211,6 +223,13 @@ def _loop_data(layout: LoopLayout, scenario: SlewScenario, J: np.ndarray) -> Loo
         law_diag=held[layout.law_diag],
         sensor_record=held[layout.sensor_record],
         actuator_record=held[layout.actuator_record],
+        reference_params=packed(scenario.reference.packed(scenario, plant)),
+        reference_state=state[layout.reference_state],
+        reference_record=held[layout.reference_record],
+        joint_params=packed(scenario.joint_actuator.packed(scenario, plant)),
+        joint_state=state[layout.joint_state],
+        joint_record=held[layout.joint_record],
+        Q=np.zeros(layout.plant.n_dof),
     )
 
 

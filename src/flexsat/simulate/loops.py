@@ -1,4 +1,4 @@
-"""Compiled closed loop: sensor -> law -> actuator -> RK4 plant (numba).
+"""Compiled closed loop: reference, sensor -> law -> actuator, joint actuator -> RK4 plant.
 
 The stages and the law are numba first-class functions handed over in tuples
 (:class:`LoopStages`), typed by their signatures: the loop is compiled once, cached
@@ -44,6 +44,8 @@ class LoopStages(NamedTuple):
     sensor: tuple  # (SENSOR_SIGNATURE,)
     law: tuple  # (LAW_SIGNATURE,)
     actuator: tuple  # (ACTUATOR_SIGNATURE,)
+    reference: tuple  # (REFERENCE_SIGNATURE,)
+    joint_actuator: tuple  # (JOINT_ACTUATOR_SIGNATURE,)
 
 
 class LoopData(NamedTuple):
@@ -72,6 +74,13 @@ class LoopData(NamedTuple):
     law_diag: np.ndarray
     sensor_record: np.ndarray
     actuator_record: np.ndarray
+    reference_params: np.ndarray
+    reference_state: np.ndarray
+    reference_record: np.ndarray  # view into held
+    joint_params: np.ndarray
+    joint_state: np.ndarray
+    joint_record: np.ndarray  # view into held
+    Q: np.ndarray  # (n_dof,) generalized forces on the appendage coordinates, Q[6:], held
 
 
 class LoopRecords(NamedTuple):
@@ -87,8 +96,9 @@ class LoopRecords(NamedTuple):
 def rk4_closed_loop(x, clock, stages, d, records, plant):
     """Run ``clock.n_steps`` closed-loop steps from ``clock.t0``; ``x`` advanced in place.
 
-    At each step k (time t0 + k dt): run sensor, law and actuator if k is a control
-    instant, record if k is a record instant, then take one RK4 step. Chunk
+    At each step k (time t0 + k dt): run the reference, sensor, law, actuator and
+    joint actuator if k is a control instant, record if k is a record instant, then
+    take one RK4 step under the held torque and joint forces ``d.Q``. Chunk
     boundaries must be multiples of ``control_every`` and ``record_every``.
     ``plant`` is the plant's named structure (``Plant.packed``), passed to ``rk4_step``.
 
@@ -98,13 +108,14 @@ def rk4_closed_loop(x, clock, stages, d, records, plant):
     """
     n = plant.n_dof
     scratch = np.empty((5, x.shape[0]))
-    Q = np.empty(n)
     control_dt = clock.control_every * clock.dt
     row = records.start
     for k in range(clock.n_steps + (1 if clock.final else 0)):
         t = clock.t0 + k * clock.dt
         if k % clock.control_every == 0:
-            status = stages.sensor[0](x, n, t, d.sensor_params, d.sensor_state, d.q_meas,
+            status = stages.reference[0](t, d.reference_params, d.reference_state, d.q_d,
+                                         d.omega_d, d.omega_dot_d, d.reference_record)  # fmt: skip
+            status |= stages.sensor[0](x, n, t, d.sensor_params, d.sensor_state, d.q_meas,
                                       d.omega_meas, d.sensor_record)  # fmt: skip
             status |= stages.law[0](
                 d.q_d, d.omega_d, d.omega_dot_d, d.q_meas, d.omega_meas, d.J_design,
@@ -114,6 +125,8 @@ def rk4_closed_loop(x, clock, stages, d, records, plant):
                 d.tau_cmd, t, control_dt, d.actuator_params, d.actuator_state, d.tau_applied,
                 d.actuator_record,
             )  # fmt: skip
+            status |= stages.joint_actuator[0](x, n, t, control_dt, d.q_d, d.joint_params,
+                                               d.joint_state, d.Q, d.joint_record)  # fmt: skip
             if status != 0:
                 return STATUS_CONTROL_FAILED, k, row - records.start
         if k % clock.record_every == 0:
@@ -124,7 +137,7 @@ def rk4_closed_loop(x, clock, stages, d, records, plant):
         if k == clock.n_steps:
             break
         torque = (d.tau_applied[0], d.tau_applied[1], d.tau_applied[2])
-        status = rk4_step(x, clock.dt, torque, n, Q, scratch, plant)
+        status = rk4_step(x, clock.dt, torque, n, d.Q, scratch, plant)
         if status != STATUS_OK:
             return status, k, row - records.start
     return STATUS_OK, clock.n_steps, row - records.start

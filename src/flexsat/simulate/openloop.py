@@ -190,7 +190,7 @@ def _run_dop853(plant, scenario, q0, qd0, profile):
     x = np.concatenate([q0, qd0, [0.0, 0.0]])
     X = np.empty((t_rec.size, x.size))
     X[0] = x
-    Q = np.empty(n)
+    Q = np.zeros(n)  # no joint actuators
     evaluations = 0
     kernel_status = STATUS_OK
 

@@ -19,10 +19,16 @@ from flexsat.control.config import DisturbanceConfig
 from flexsat.control.laws import LAWS, LawConfig, validate_law_config
 from flexsat.control.stages import (
     ACTUATORS,
+    JOINT_ACTUATORS,
+    REFERENCES,
     SENSORS,
     ActuatorStageConfig,
+    JointActuatorConfig,
+    PlantStageConfig,
     StageConfig,
     validate_actuator_config,
+    validate_joint_actuator_config,
+    validate_reference_config,
     validate_sensor_config,
 )
 
@@ -253,6 +259,15 @@ class SlewScenario(_TimedRun):
         description="the controller's design inertia J [kg m^2] (3x3, symmetric positive "
         "definite); default: J_tot of the rigidized nominal satellite of the config",
     )
+    reference: SerializeAsAny[PlantStageConfig] = Field(
+        default_factory=lambda: REFERENCES.get(REFERENCES.default).config(),
+        description="the reference the law tracks, by its kind (default: the step to the "
+        "target, the thesis's regulation)",
+    )
+    joint_actuator: SerializeAsAny[JointActuatorConfig] = Field(
+        default_factory=lambda: JOINT_ACTUATORS.get(JOINT_ACTUATORS.default).config(),
+        description="actuators on appendage joint coordinates, by kind (default: none)",
+    )
 
     _MULTIPLES_OF_DT: ClassVar[tuple[str, ...]] = ("control_dt_s", "record_dt_s")
 
@@ -270,6 +285,16 @@ class SlewScenario(_TimedRun):
     @classmethod
     def _registered_actuator(cls, value: object) -> ActuatorStageConfig:
         return validate_actuator_config(value)
+
+    @field_validator("reference", mode="before")
+    @classmethod
+    def _registered_reference(cls, value: object) -> PlantStageConfig:
+        return validate_reference_config(value)
+
+    @field_validator("joint_actuator", mode="before")
+    @classmethod
+    def _registered_joint_actuator(cls, value: object) -> JointActuatorConfig:
+        return validate_joint_actuator_config(value)
 
     @field_validator("design_inertia_kg_m2")
     @classmethod

@@ -164,6 +164,14 @@ def _campaigns(ctx: StudyContext) -> dict:
     return {"summaries": summaries, "figures": figures}
 
 
+def _laws(ctx: StudyContext) -> dict:
+    from flexsat.study.laws import law_comparison
+
+    law_comparison(ctx.config, ctx.out, ctx.laws, quick=ctx.quick, workers=ctx.workers,
+                   progress=ctx.progress is not False, default_law=LAWS.default)  # fmt: skip
+    return {"json": _relative(ctx, [ctx.out / "laws" / "laws.json"])[0]}
+
+
 PARTS = (
     Part("configuration", "Configuration", _configuration),
     Part("modal", "Modal analysis", _modal),
@@ -172,6 +180,7 @@ PARTS = (
     Part("comparison", "Controller comparison", _comparison, needs=("slew",)),
     Part("animation", "Slew animation", _animation, needs=("slew",)),
     Part("campaigns", "Robustness campaigns", _campaigns, full_only=True),
+    Part("laws", "Law comparison over the campaigns", _laws),
 )
 """The study's parts, in the order they run and appear in the report."""
 

@@ -392,6 +392,44 @@ def _campaigns(root: Path, outputs: dict, context: dict) -> str:
     return "".join(parts)
 
 
+_LAW_ROWS = (
+    ("cases", ("cases",)), ("failed", ("failed",)),
+    ("R1 pass rate", ("r1_pass_rate",)), ("R2 pass rate", ("r2_pass_rate",)),
+    ("R3 pass rate", ("r3_pass_rate",)),
+    *((f"R1 settling {q} [s]", ("settling_time_s", q)) for q in ("min", "median", "p90", "max")),
+    ("never in R1", ("settling_time_s", "never")),
+    *((f"R2 settling {q} [s]", ("r2_settling_time_s", q))
+      for q in ("min", "median", "p90", "max")),
+    ("never in R2", ("r2_settling_time_s", "never")),
+    ("peak tau_flex [N m]", ("peak_flex_torque_nm",)),
+    ("peak tip displacement [m]", ("peak_tip_displacement_m",)),
+    ("control energy median [J]", ("control_energy_j", "median")),
+    ("control energy max [J]", ("control_energy_j", "max")),
+    ("residual elastic energy median [J]", ("residual_elastic_energy_j", "median")),
+    ("residual elastic energy max [J]", ("residual_elastic_energy_j", "max")),
+)  # fmt: skip
+
+
+def _laws(root: Path, outputs: dict, context: dict) -> str:
+    src = _Source(root, outputs["json"])
+    variants = src.get("variants")
+    labels = [get_law(v).label if v in law_names() else v for v in variants]
+    scope = ("the first case of each campaign (quick study)" if src.get("quick")
+             else "every case of each campaign")  # fmt: skip
+    parts = [
+        f"<p>Each law with its default gains, and the ASMC with root actuators on the "
+        f"panels (hybrid active damping), flown through {scope}. Control energy is "
+        "the integral of |tau . omega|; residual elastic energy the largest elastic "
+        "energy over the last 10 s.</p>"
+    ]
+    for name in src.get("campaigns"):
+        rows = [[label, *(src.cell("campaigns", name, v, *path) for v in variants)]
+                for label, path in _LAW_ROWS]  # fmt: skip
+        parts.append(f"<h3>{_esc(name)}</h3>")
+        parts.append(_table(["figure", *labels], rows, f"Laws over the {name} campaign"))
+    return "".join(parts)
+
+
 _SECTIONS: dict[str, Callable[[Path, dict, dict], str]] = {
     "configuration": _configuration,
     "model": _model,
@@ -401,6 +439,7 @@ _SECTIONS: dict[str, Callable[[Path, dict, dict], str]] = {
     "comparison": _comparison,
     "animation": _animation,
     "campaigns": _campaigns,
+    "laws": _laws,
 }
 
 # The model section is drawn from the modal part's outputs (M(0) and J_tot are there).

@@ -40,14 +40,30 @@ def sat(x):
 
 
 @njit(cache=True)
-def errors(q_d, q, omega_B):
-    """q_v,e, its rate (eq. 4.3), omega_e and the pointing error 2 asin |q_v,e| [rad].
+def _to_body(e, v):
+    """Components in B of a vector given in D: C(q_e)^T v, q_e = q_d^-1 (x) q (eq. 4.1)."""
+    qv = (e[1], e[2], e[3])
+    a = cross(qv, v)
+    b = cross(qv, a)
+    return (v[0] - 2.0 * e[0] * a[0] + 2.0 * b[0], v[1] - 2.0 * e[0] * a[1] + 2.0 * b[1],
+            v[2] - 2.0 * e[0] * a[2] + 2.0 * b[2])  # fmt: skip
 
-    Rest-to-rest regulation as in the thesis (eq. 4.2 with omega_d = 0).
+
+@njit(cache=True)
+def errors(q_d, omega_d, omega_dot_d, q, omega_B):
+    """q_v,e, its rate (eq. 4.3), omega_e, the pointing error 2 asin |q_v,e| [rad] and the
+    reference acceleration in B [rad/s^2].
+
+    omega_e = omega - omega_d (eq. 4.2) with omega_d, given in the reference frame D,
+    rotated into B; the reference acceleration in B is d/dt (C omega_d) =
+    C omega_dot_d - omega_e x (C omega_d), the omega_dot_d of the tracking term
+    J omega_dot_d of eq. 4.12. A step reference (omega_d = omega_dot_d = 0, the
+    thesis's regulation) gives omega_e = omega and zero acceleration exactly.
     """
     e = quaternion_error(q_d, q)
     qv = (e[1], e[2], e[3])
-    omega_e = (omega_B[0], omega_B[1], omega_B[2])
+    w_d = _to_body(e, omega_d)
+    omega_e = (omega_B[0] - w_d[0], omega_B[1] - w_d[1], omega_B[2] - w_d[2])
     cross_term = cross(qv, omega_e)  # S(q_v,e) omega_e
     qv_dot = (
         0.5 * (e[0] * omega_e[0] + cross_term[0]),
@@ -55,7 +71,10 @@ def errors(q_d, q, omega_B):
         0.5 * (e[0] * omega_e[2] + cross_term[2]),
     )
     norm = sqrt(qv[0] ** 2 + qv[1] ** 2 + qv[2] ** 2)
-    return qv, qv_dot, omega_e, 2.0 * asin(min(1.0, norm))
+    a_d = _to_body(e, omega_dot_d)
+    transport = cross(omega_e, w_d)
+    w_dot_d = (a_d[0] - transport[0], a_d[1] - transport[1], a_d[2] - transport[2])
+    return qv, qv_dot, omega_e, 2.0 * asin(min(1.0, norm)), w_dot_d
 
 
 @njit(cache=True)

@@ -3,10 +3,18 @@
 s = omega_e + Lambda q_v,e (eq. 4.6); tau = omega x J omega - J Lambda q_v,e_dot
 - JK sat(s / Phi) (eq. 4.14), the slope Lambda adapted to the pointing error and
 to the torque budget (eqs. 4.27-4.29), the robust gain JK per axis (eq. 4.30).
+
+``lambda_adaptation = "smooth"`` replaces the piecewise-linear target of eq. 4.27
+by a C1 smoothstep in theta_err and passes it through a first-order filter of time
+constant ``lambda_time_constant_s`` (exact discretization at the control period),
+the budget cap of eqs. 4.28-4.29 still applied at once; Lambda_dot is then bounded
+and its term -J Lambda_dot q_v,e of eq. 4.12 is flown (``docs/control.md``,
+"A smoother Lambda adaptation").
 """
 
 from __future__ import annotations
 
+from math import exp
 from typing import Literal, NamedTuple
 
 import numpy as np
@@ -39,6 +47,8 @@ class ASMCGains(NamedTuple):
     phi: float  # boundary-layer width Phi [rad/s]
     theta_threshold: float  # theta_th [rad]
     include_lambda_dot: float  # 1.0: add -J Lambda_dot q_v,e
+    smooth: float  # 1.0: smoothstep target, filtered (module docstring)
+    lambda_time_constant: float  # tau_Lambda of the filter [s]
 
 
 G = ASMCGains(*range(len(ASMCGains._fields)))  # index of each gain in the packed array
@@ -54,6 +64,13 @@ class ASMCConfig(LawConfig):
     phi: Positive = Field(0.01, description="boundary-layer width Phi [rad/s]")
     theta_threshold_deg: Positive = Field(5.0, description="theta_th of eq. 4.27 [deg]")
     include_lambda_dot: bool = Field(False, description="add -J Lambda_dot q_v,e (eq. 4.12)")
+    lambda_adaptation: Literal["thesis", "smooth"] = Field(
+        "thesis", description="Lambda's adaptation: eq. 4.27 as published, or a smoothstep "
+        "target through a first-order filter (adds -J Lambda_dot q_v,e)"
+    )  # fmt: skip
+    lambda_time_constant_s: Positive = Field(
+        2.0, description="smooth adaptation: time constant of Lambda's filter [s]"
+    )
 
     @model_validator(mode="after")
     def _ordered(self) -> ASMCConfig:
@@ -66,6 +83,7 @@ class ASMCConfig(LawConfig):
             actuator.t_max_nm, actuator.reduction_factor, self.jk_min_nm, self.lambda_min,
             self.lambda_max, self.phi, np.radians(self.theta_threshold_deg),
             float(self.include_lambda_dot),
+            float(self.lambda_adaptation == "smooth"), self.lambda_time_constant_s,
         ), dtype=float)  # fmt: skip
 
     def plot_attributes(self) -> dict[str, float | str]:
@@ -97,23 +115,33 @@ def asmc_step(q_d, omega_d, omega_dot_d, q, omega_B, J, gains, state, t, dt, tau
     ``state``: Lambda of the previous call, and 1.0 once a call has been made.
     """
     limit = gains[G.reduction_factor] * gains[G.t_max]
-    qv, qv_dot, omega_e, theta_err = errors(q_d, q, omega_B)
+    qv, qv_dot, omega_e, theta_err, w_dot_d = errors(q_d, omega_d, omega_dot_d, q, omega_B)
     J3 = inertia3(J)
+    J_w_dot_d = mv(J3, w_dot_d)  # tracking feed-forward J omega_dot_d (eq. 4.12)
     tau_gyro = cross(omega_B, mv(J3, omega_B))  # omega x (J omega)
     J_qv_dot = mv(J3, qv_dot)
     jk_min, lam_min, lam_max = gains[G.jk_min], gains[G.lambda_min], gains[G.lambda_max]
     phi = gains[G.phi]
     # eq. 4.27: target slope from the pointing error
-    lam_target = lam_max - (lam_max - lam_min) * min(1.0, theta_err / gains[G.theta_threshold])
+    u = min(1.0, theta_err / gains[G.theta_threshold])
+    smooth = gains[G.smooth] > 0.0
+    if smooth:  # C1 smoothstep, then a first-order filter from the previous slope
+        lam_target = lam_max - (lam_max - lam_min) * u * u * (3.0 - 2.0 * u)
+        if state[1] > 0.0:
+            lam_target = state[0] + (1.0 - exp(-dt / gains[G.lambda_time_constant])) * (
+                lam_target - state[0])  # fmt: skip
+    else:
+        lam_target = lam_max - (lam_max - lam_min) * u
     # eqs. 4.23, 4.28: budget-feasible slope; the most restrictive axis decides
     lam_feasible = 1e300
     for a in range(3):
-        budget = limit - abs(tau_gyro[a]) - jk_min
+        budget = limit - abs(tau_gyro[a]) - abs(J_w_dot_d[a]) - jk_min  # eq. 4.23
         if abs(J_qv_dot[a]) > 0.0:
             lam_feasible = min(lam_feasible, max(0.0, budget) / abs(J_qv_dot[a]))
     lam = max(lam_min, min(lam_target, lam_feasible))  # eq. 4.29
     s = (omega_e[0] + lam * qv[0], omega_e[1] + lam * qv[1], omega_e[2] + lam * qv[2])
-    tau_guide = (-lam * J_qv_dot[0], -lam * J_qv_dot[1], -lam * J_qv_dot[2])
+    tau_guide = (J_w_dot_d[0] - lam * J_qv_dot[0], J_w_dot_d[1] - lam * J_qv_dot[1],
+                 J_w_dot_d[2] - lam * J_qv_dot[2])  # J (omega_dot_d - Lambda q_v,e_dot)
     # eq. 4.30, per axis: all the residual budget outside the boundary layer, scaled
     # down towards JK_min inside it.
     jk = (

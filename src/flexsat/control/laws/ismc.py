@@ -78,7 +78,7 @@ def ismc_step(q_d, omega_d, omega_dot_d, q, omega_B, J, gains, state, t, dt, tau
     has been made (the first call sets z so that s = 0).
     """
     limit = gains[G.reduction_factor] * gains[G.t_max]
-    qv, qv_dot, omega_e, _ = errors(q_d, q, omega_B)
+    qv, qv_dot, omega_e, _, w_dot_d = errors(q_d, omega_d, omega_dot_d, q, omega_B)
     J3 = inertia3(J)
     tau_gyro = cross(omega_B, mv(J3, omega_B))  # omega x (J omega)
     lam, k_i, jk, phi = gains[G.lambda_], gains[G.k_i], gains[G.jk], gains[G.phi]
@@ -91,7 +91,8 @@ def ismc_step(q_d, omega_d, omega_dot_d, q, omega_B, J, gains, state, t, dt, tau
     # the equivalent control: s_dot = 0 on the rigid design model without disturbance
     Jw = mv(J3, (lam * qv_dot[0] + k_i * qv[0], lam * qv_dot[1] + k_i * qv[1],
                  lam * qv_dot[2] + k_i * qv[2]))  # fmt: skip
-    tau_guide = (-Jw[0], -Jw[1], -Jw[2])
+    J_w_dot_d = mv(J3, w_dot_d)  # tracking feed-forward J omega_dot_d (eq. 4.12)
+    tau_guide = (J_w_dot_d[0] - Jw[0], J_w_dot_d[1] - Jw[1], J_w_dot_d[2] - Jw[2])
     tau_rob = (-jk * sat(s[0] / phi), -jk * sat(s[1] / phi), -jk * sat(s[2] / phi))
     clip_and_store(limit, tau_gyro, tau_guide, tau_rob, tau_cmd)
     diag[0], diag[1], diag[2] = s

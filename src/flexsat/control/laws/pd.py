@@ -58,14 +58,15 @@ class PDConfig(LawConfig):
 def pd_step(q_d, omega_d, omega_dot_d, q, omega_B, J, gains, state, t, dt, tau_cmd, diag):
     """The PD command (law contract in :mod:`flexsat.control.laws.registry`); no state."""
     limit = gains[G.reduction_factor] * gains[G.t_max]
-    qv, _, omega_e, _ = errors(q_d, q, omega_B)
+    qv, _, omega_e, _, w_dot_d = errors(q_d, omega_d, omega_dot_d, q, omega_B)
     J3 = inertia3(J)
     tau_gyro = cross(omega_B, mv(J3, omega_B))  # omega x (J omega)
     kp, kd = gains[G.kp], gains[G.kd]
     u = (kp * qv[0] + kd * omega_e[0], kp * qv[1] + kd * omega_e[1],
          kp * qv[2] + kd * omega_e[2])  # fmt: skip
     Ju = mv(J3, u)
-    tau_guide = (-Ju[0], -Ju[1], -Ju[2])
+    J_w_dot_d = mv(J3, w_dot_d)  # tracking feed-forward J omega_dot_d
+    tau_guide = (J_w_dot_d[0] - Ju[0], J_w_dot_d[1] - Ju[1], J_w_dot_d[2] - Ju[2])
     clip_and_store(limit, tau_gyro, tau_guide, (0.0, 0.0, 0.0), tau_cmd)
     diag[0], diag[1], diag[2] = tau_gyro
     diag[3], diag[4], diag[5] = tau_guide

@@ -153,13 +153,15 @@ def stsmc_step(q_d, omega_d, omega_dot_d, q, omega_B, J, gains, state, t, dt, ta
     ``state``: the twisting integral v per axis [rad/s^2].
     """
     limit = gains[G.reduction_factor] * gains[G.t_max]
-    qv, qv_dot, omega_e, _ = errors(q_d, q, omega_B)
+    qv, qv_dot, omega_e, _, w_dot_d = errors(q_d, omega_d, omega_dot_d, q, omega_B)
     J3 = inertia3(J)
+    J_w_dot_d = mv(J3, w_dot_d)  # tracking feed-forward J omega_dot_d (eq. 4.12)
     tau_gyro = cross(omega_B, mv(J3, omega_B))  # omega x (J omega)
     J_qv_dot = mv(J3, qv_dot)
     lam = gains[G.lambda_]
     s = (omega_e[0] + lam * qv[0], omega_e[1] + lam * qv[1], omega_e[2] + lam * qv[2])
-    tau_guide = (-lam * J_qv_dot[0], -lam * J_qv_dot[1], -lam * J_qv_dot[2])
+    tau_guide = (J_w_dot_d[0] - lam * J_qv_dot[0], J_w_dot_d[1] - lam * J_qv_dot[1],
+                 J_w_dot_d[2] - lam * J_qv_dot[2])  # J (omega_dot_d - lambda q_v,e_dot)
     rows = _inverse_row_sums(J)
     c1_root_L = gains[G.c1] * sqrt(gains[G.d_rate])  # k1_i = c1 sqrt(L) sqrt(rows_i)
     v = (state[0], state[1], state[2])

@@ -1,39 +1,69 @@
 """Loop stages around the law: sensors and actuators, one module each, one registry.
 
-Built in: the thesis's ideal sensor and static actuator. Write your own stage in
-your own file (see ``docs/control.md``): a parameter model, a compiled step of
-:data:`SENSOR_SIGNATURE` or :data:`ACTUATOR_SIGNATURE` and one registration line.
+Built in: the thesis's ideal sensor and static actuator; the reference generators
+(the thesis's ``step`` and the shaped ``eigenaxis`` slew) and the joint actuators
+(``none``, the thesis's hub-only control, and ``rate_feedback``, hybrid active
+damping). Write your own stage in your own file (see ``docs/control.md``): a
+parameter model, a compiled step of its role's signature and one registration line.
 """
 
+from flexsat.control.stages.eigenaxis_reference import EIGENAXIS_REFERENCE
 from flexsat.control.stages.ideal_sensor import IDEAL_SENSOR
+from flexsat.control.stages.joint_rate_feedback import JOINT_RATE_FEEDBACK
+from flexsat.control.stages.no_joint_actuator import NO_JOINT_ACTUATOR
 from flexsat.control.stages.registry import (
     ACTUATOR_SIGNATURE,
     ACTUATORS,
+    JOINT_ACTUATOR_SIGNATURE,
+    JOINT_ACTUATORS,
+    REFERENCE_SIGNATURE,
+    REFERENCES,
     SENSOR_SIGNATURE,
     SENSORS,
     ActuatorStageConfig,
+    JointActuatorConfig,
+    PlantStageConfig,
     StageConfig,
     StageSpec,
     register_actuator,
+    register_joint_actuator,
+    register_reference,
     register_sensor,
     validate_actuator_config,
+    validate_joint_actuator_config,
+    validate_reference_config,
     validate_sensor_config,
 )
 from flexsat.control.stages.static_actuator import STATIC_ACTUATOR
+from flexsat.control.stages.step_reference import STEP_REFERENCE
 
 __all__ = [
     "ACTUATORS",
     "ACTUATOR_SIGNATURE",
+    "JOINT_ACTUATORS",
+    "JOINT_ACTUATOR_SIGNATURE",
+    "REFERENCES",
+    "REFERENCE_SIGNATURE",
     "SENSORS",
     "SENSOR_SIGNATURE",
     "ActuatorStageConfig",
+    "JointActuatorConfig",
+    "PlantStageConfig",
     "StageConfig",
     "StageSpec",
     "register_actuator",
+    "register_joint_actuator",
+    "register_reference",
     "register_sensor",
     "validate_actuator_config",
+    "validate_joint_actuator_config",
+    "validate_reference_config",
     "validate_sensor_config",
 ]
 
 register_sensor(IDEAL_SENSOR, default=True)
 register_actuator(STATIC_ACTUATOR, default=True)
+register_reference(STEP_REFERENCE, default=True)
+register_reference(EIGENAXIS_REFERENCE)
+register_joint_actuator(NO_JOINT_ACTUATOR, default=True)
+register_joint_actuator(JOINT_RATE_FEEDBACK)

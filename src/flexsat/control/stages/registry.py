@@ -25,7 +25,30 @@ maps the law's command ``tau_cmd`` (3,) [N m] to the torque applied to the hub
 ``tau_applied`` (3,) [N m] (actuator dynamics and disturbances), ``dt`` being the
 control period [s].
 
-For both: ``params`` are the stage's packed parameters (:meth:`StageConfig.packed`),
+Reference step, ``@njit(REFERENCE_SIGNATURE, cache=True)``, run first at every
+control instant::
+
+    status = step(t, params, state, q_d, omega_d, omega_dot_d, record)
+
+writes the reference the law tracks: attitude ``q_d`` (4,), scalar first, rate
+``omega_d`` (3,) [rad/s] and acceleration ``omega_dot_d`` (3,) [rad/s^2], both in
+the reference frame D (the law rotates them into B). The default ``step`` reference
+holds the target with zero rate: the thesis's step regulation.
+
+Joint-actuator step, ``@njit(JOINT_ACTUATOR_SIGNATURE, cache=True)``, run last at
+every control instant::
+
+    status = step(x, n_dof, t, dt, q_d, params, state, Q, record)
+
+reads the plant state ``x`` and the reference ``q_d`` and writes the generalized
+forces it applies to appendage coordinates into ``Q[6:]`` (n_dof,) [N or N m per
+coordinate], held until the next instant; they enter the plant's equations as
+``Q`` of eq. 2.50, so the reaction on the hub is the joint equations' own. It never
+writes ``Q[:6]`` (the hub's, overwritten by the integrator). Its parameter model
+derives :class:`JointActuatorConfig` and packs against the plant's state layout
+(coordinates by name). The default ``none`` applies nothing.
+
+For all: ``params`` are the stage's packed parameters (:meth:`StageConfig.packed`),
 ``state`` (state_size,) its own state, zero at t = 0, ``record`` receives its
 declared records in order. Return 0, or non-zero to stop the run.
 """
@@ -45,14 +68,24 @@ from flexsat.control.registry import Channel, Registry
 __all__ = [
     "ACTUATORS",
     "ACTUATOR_SIGNATURE",
+    "JOINT_ACTUATORS",
+    "JOINT_ACTUATOR_SIGNATURE",
+    "REFERENCES",
+    "REFERENCE_SIGNATURE",
     "SENSORS",
     "SENSOR_SIGNATURE",
     "ActuatorStageConfig",
+    "JointActuatorConfig",
+    "PlantStageConfig",
     "StageConfig",
     "StageSpec",
     "register_actuator",
+    "register_joint_actuator",
+    "register_reference",
     "register_sensor",
     "validate_actuator_config",
+    "validate_joint_actuator_config",
+    "validate_reference_config",
     "validate_sensor_config",
 ]
 
@@ -61,6 +94,12 @@ SENSOR_SIGNATURE = types.int64(_vec, types.int64, types.float64, _vec, _vec, _ve
 """x, n_dof, t, params, state, q_meas (out), omega_meas (out), record (out)."""
 ACTUATOR_SIGNATURE = types.int64(_vec, types.float64, types.float64, _vec, _vec, _vec, _vec)
 """tau_cmd, t, dt, params, state, tau_applied (out), record (out)."""
+REFERENCE_SIGNATURE = types.int64(types.float64, _vec, _vec, _vec, _vec, _vec, _vec)
+"""t, params, state, q_d (out), omega_d (out), omega_dot_d (out), record (out)."""
+JOINT_ACTUATOR_SIGNATURE = types.int64(
+    _vec, types.int64, types.float64, types.float64, _vec, _vec, _vec, _vec, _vec
+)
+"""x, n_dof, t, dt, q_d, params, state, Q (out), record (out)."""
 
 
 class StageConfig(_Frozen):
@@ -86,13 +125,27 @@ class ActuatorStageConfig(StageConfig):
     )
 
 
+class PlantStageConfig(StageConfig):
+    """Base of the stages designed against the plant they fly (reference, joint actuator)."""
+
+    def packed(self, scenario: Any, plant: Any = None) -> np.ndarray:
+        """Packed parameters; ``plant`` is the :class:`~flexsat.dynamics.plant.Plant`
+        the run flies (its state layout names the coordinates, its modal analysis
+        gives the modes)."""
+        return np.zeros(0)
+
+
+class JointActuatorConfig(PlantStageConfig):
+    """Base of every joint actuator's model."""
+
+
 @dataclass(frozen=True)
 class StageSpec:
     """A loop stage as the loop and every consumer see it.
 
     Parameters
     ----------
-    role : {"sensor", "actuator"}
+    role : {"sensor", "actuator", "reference", "joint_actuator"}
         Where the stage sits in the loop.
     name : str
         The ``kind`` of its parameter table.
@@ -108,7 +161,7 @@ class StageSpec:
         One line for listings.
     """
 
-    role: Literal["sensor", "actuator"]
+    role: Literal["sensor", "actuator", "reference", "joint_actuator"]
     name: str
     config: type[StageConfig]
     step: Any
@@ -123,7 +176,10 @@ class StageSpec:
 
 SENSORS: Registry[StageSpec] = Registry("sensor", "flexsat.sensors")
 ACTUATORS: Registry[StageSpec] = Registry("actuator", "flexsat.actuators")
-_BY_ROLE = {"sensor": SENSORS, "actuator": ACTUATORS}
+REFERENCES: Registry[StageSpec] = Registry("reference", "flexsat.references")
+JOINT_ACTUATORS: Registry[StageSpec] = Registry("joint actuator", "flexsat.joint_actuators")
+_BY_ROLE = {"sensor": SENSORS, "actuator": ACTUATORS, "reference": REFERENCES,
+            "joint_actuator": JOINT_ACTUATORS}  # fmt: skip
 
 
 def _register(role: str, spec: StageSpec, default: bool) -> StageSpec:
@@ -172,6 +228,19 @@ def register_actuator(spec: StageSpec, default: bool = False) -> StageSpec:
     return _register("actuator", spec, default)
 
 
+def register_reference(spec: StageSpec, default: bool = False) -> StageSpec:
+    """Register a reference generator under ``spec.name`` (replacing one of that name)."""
+    return _register("reference", spec, default)
+
+
+def register_joint_actuator(spec: StageSpec, default: bool = False) -> StageSpec:
+    """Register a joint actuator under ``spec.name`` (replacing one of that name)."""
+    if not issubclass(spec.config, JointActuatorConfig):
+        raise ValueError(f"joint actuator {spec.name!r}: its config must derive "
+                         "JointActuatorConfig")  # fmt: skip
+    return _register("joint_actuator", spec, default)
+
+
 def validate_sensor_config(value: Any) -> StageConfig:
     """A ``[sensor]`` table validated by its stage's model (no ``kind``: the default).
 
@@ -200,3 +269,13 @@ def validate_actuator_config(value: Any) -> ActuatorStageConfig:
     ActuatorStageConfig
     """
     return ACTUATORS.validate_table(value, lambda spec: spec.config)
+
+
+def validate_reference_config(value: Any) -> PlantStageConfig:
+    """A ``[reference]`` table validated by its generator's model (no ``kind``: ``step``)."""
+    return REFERENCES.validate_table(value, lambda spec: spec.config)
+
+
+def validate_joint_actuator_config(value: Any) -> JointActuatorConfig:
+    """A ``[joint_actuator]`` table validated by its model (no ``kind``: ``none``)."""
+    return JOINT_ACTUATORS.validate_table(value, lambda spec: spec.config)

@@ -1,0 +1,81 @@
+"""Benchmark: per-step cost of each law and of the reference and joint-actuator slots.
+
+Flies the thesis's 45/45/45 deg slew (RK4 dt = 1 ms, controller every step,
+compiled loop) with each registered law, the ASMC with the smooth Lambda
+adaptation, the ASMC tracking the eigenaxis trapezoid, the same with the
+five-mode ZVD shaper (243 impulses summed per control instant), and the ASMC
+with the root actuators of the deployment-shock solution, and prints
+microseconds per RK4 step against the thesis's ASMC (step reference, no joint
+actuator). Target: within 1.2x. Runs interleaved, best of three, so a load change
+on a shared machine affects every row alike. ``--duration`` shortens the runs.
+"""
+
+from __future__ import annotations
+
+import argparse
+
+from rich.console import Console
+from rich.table import Table
+
+from flexsat import Plant, nominal
+from flexsat.control.laws import get_law, law_names
+from flexsat.simulate import SlewScenario, run_slew
+from flexsat.study.laws import HYBRID_DAMPING
+
+TARGET = 1.2  # per step, against the ASMC with the step reference
+TRAPEZOID = {"kind": "eigenaxis", "rate_limit_deg_s": 2.0, "acceleration_limit_deg_s2": 0.2}
+
+
+def _variants() -> dict[str, dict]:
+    rows = {get_law(kind).label: {"controller": {"kind": kind}} for kind in law_names()}
+    rows["ASMC, smooth Lambda"] = {"controller": {"lambda_adaptation": "smooth"}}
+    rows["ASMC, eigenaxis reference"] = {"reference": TRAPEZOID}
+    rows["ASMC, ZVD-shaped reference (5 modes)"] = {"reference": {**TRAPEZOID,
+                                                                  "shaper": {"kind": "zvd"}}}
+    rows["ASMC + root actuators"] = {"joint_actuator": HYBRID_DAMPING}
+    return rows
+
+
+def _interleaved_best(fns, repeats: int = 3) -> list[float]:
+    import time
+
+    for fn in fns:
+        fn()  # compile / warm up
+    best = [float("inf")] * len(fns)
+    for _ in range(repeats):
+        for k, fn in enumerate(fns):
+            start = time.perf_counter()
+            fn()
+            best[k] = min(best[k], time.perf_counter() - start)
+    return best
+
+
+def main(argv: list[str] | None = None) -> dict:
+    """Print the table; return microseconds per step and the ratio to the ASMC per row."""
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--duration", type=float, default=120.0, help="simulated s per run")
+    args = parser.parse_args(argv)
+    plant = Plant.from_config(nominal())
+    variants = _variants()
+    scenarios = {name: SlewScenario.model_validate({"duration_s": args.duration, **fields})
+                 for name, fields in variants.items()}  # fmt: skip
+    walls = _interleaved_best([lambda s=s: run_slew(plant, s, progress=False)
+                               for s in scenarios.values()])  # fmt: skip
+    steps = args.duration / 1e-3
+    per_step = {name: 1e6 * wall / steps for name, wall in zip(scenarios, walls, strict=True)}
+    reference = per_step[get_law("asmc").label]
+    table = Table(title=f"Per-step cost in the compiled loop ({args.duration:g} s slews, "
+                        "RK4 1 ms, controller every step)")  # fmt: skip
+    for column in ("run", "us per step", "/ ASMC", f"target <= {TARGET}"):
+        table.add_column(column, justify="left" if column == "run" else "right")
+    numbers = {}
+    for name, us in per_step.items():
+        ratio = us / reference
+        numbers[name] = {"us_per_step": us, "ratio_to_asmc": ratio}
+        table.add_row(name, f"{us:.2f}", f"{ratio:.3f}", "met" if ratio <= TARGET else "MISSED")
+    Console().print(table)
+    return numbers
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,33 @@
+"""No joint actuator: the appendages' coordinates receive no applied force (the thesis's)."""
+
+from __future__ import annotations
+
+from typing import Literal
+
+from numba import njit
+
+from flexsat.control.stages.registry import (
+    JOINT_ACTUATOR_SIGNATURE,
+    JointActuatorConfig,
+    StageSpec,
+)
+
+__all__ = ["NO_JOINT_ACTUATOR", "NoJointActuatorConfig"]
+
+
+class NoJointActuatorConfig(JointActuatorConfig):
+    """Hub-only control: no parameters."""
+
+    kind: Literal["none"] = "none"
+
+
+@njit(JOINT_ACTUATOR_SIGNATURE, cache=True)
+def no_joint_actuator_step(x, n_dof, t, dt, q_d, params, state, Q, record):
+    """Leaves Q[6:] at zero (contract in ``stages.registry``)."""
+    return 0
+
+
+NO_JOINT_ACTUATOR = StageSpec(
+    role="joint_actuator", name="none", config=NoJointActuatorConfig,
+    step=no_joint_actuator_step, description="no actuator on the appendages (hub-only control)",
+)  # fmt: skip

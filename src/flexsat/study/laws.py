@@ -1,0 +1,174 @@
+"""The law comparison over the thesis's campaigns: every law, and the ASMC with hybrid
+active damping, flown through the same cases.
+
+For each campaign of :data:`~flexsat.study.pipeline.CAMPAIGNS` and each variant
+(the study's laws with their default gains, then :data:`DAMPED` = the ASMC with the
+root actuators of :data:`HYBRID_DAMPING`), the cases' stored metrics are reduced to
+one column of figures (:func:`law_statistics`): R1/R2/R3 pass rates, the
+settling-time distributions, peak tau_flex, peak tip displacement, the control
+energy and the residual elastic energy (``docs/control.md``, "Comparing the laws
+over the campaigns"). The full study flies every case into a store per campaign
+and variant (``campaigns/<campaign>-<variant>``; the default law's is the
+campaigns part's own, resumed); the quick study flies the first
+:data:`QUICK_CASES` case(s) of each campaign in-process.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+__all__ = ["DAMPED", "HYBRID_DAMPING", "QUICK_CASES", "law_comparison", "law_statistics"]
+
+HYBRID_DAMPING = {
+    "kind": "rate_feedback",
+    "coordinates": ["eta_rx", "eta_ry", "eta_rz"],
+    "gain": 10.0,
+    "limit": 0.1,
+    "bandwidth_hz": 20.0,
+}
+"""The root actuators of the deployment-shock solution (``docs/control.md``, "Hybrid
+active damping"): 0.1 N m on each panel root rotation, 20 Hz, 10 N m s/rad."""
+
+DAMPED = "asmc+damping"
+"""The name of the ASMC-with-hybrid-damping variant in the comparison."""
+
+QUICK_CASES = 1
+"""Cases per campaign and variant in the quick study."""
+
+_QUANTILES = {"min": 0.0, "median": 0.5, "p90": 0.9, "max": 1.0}
+
+
+def _variants(laws: tuple[str, ...], default_law: str) -> dict[str, dict]:
+    """Base-scenario overrides of each variant: the laws (none for the default law: the
+    campaign as it stands), then the damped ASMC."""
+    out = {law: {} if law == default_law else {"controller": {"kind": law}} for law in laws}
+    out[DAMPED] = {"controller": {"kind": "asmc"}, "joint_actuator": HYBRID_DAMPING}
+    return out
+
+
+def _distribution(values: list[float]) -> dict:
+    """Quantiles of the finite values, and how many never settled (NaN/None)."""
+    finite = np.array([v for v in values if v is not None and np.isfinite(v)], dtype=float)
+    out: dict = {"never": len(values) - finite.size}
+    for name, q in _QUANTILES.items():
+        out[name] = float(np.quantile(finite, q)) if finite.size else None
+    return out
+
+
+def law_statistics(rows: list[dict]) -> dict:
+    """One variant's figures over a campaign's case rows (``run_case`` rows).
+
+    Returns
+    -------
+    dict
+        ``cases``, ``failed``, ``r1_pass_rate``, ``r2_pass_rate``, ``r3_pass_rate``,
+        ``settling_time_s`` and ``r2_settling_time_s`` (min, median, p90, max over
+        the cases that settle, ``never`` the count of those that do not),
+        ``peak_flex_torque_nm`` and ``peak_tip_displacement_m`` (largest over the
+        cases), ``control_energy_j`` and ``residual_elastic_energy_j`` (median and
+        max over the cases).
+    """
+    ok = [r["metrics"] for r in rows if r.get("status") == "ok"]
+    n = len(rows)
+
+    def rate(key: str) -> float | None:
+        return sum(bool(m.get(key)) for m in ok) / n if n else None
+
+    def largest(key: str) -> float | None:
+        values = [np.max(m[key]) for m in ok if m.get(key) is not None]
+        return float(np.max(values)) if values else None
+
+    def spread(key: str) -> dict:
+        values = [m[key] for m in ok if m.get(key) is not None]
+        return {"median": float(np.median(values)) if values else None,
+                "max": float(np.max(values)) if values else None}  # fmt: skip
+
+    return {
+        "cases": n,
+        "failed": n - len(ok),
+        "r1_pass_rate": rate("r1_pass"),
+        "r2_pass_rate": rate("r2_pass"),
+        "r3_pass_rate": rate("r3_pass"),
+        "settling_time_s": _distribution([m.get("settling_time_s") for m in ok]),
+        "r2_settling_time_s": _distribution([m.get("r2_settling_time_s") for m in ok]),
+        "peak_flex_torque_nm": largest("peak_flex_torque_nm"),
+        "peak_tip_displacement_m": largest("peak_tip_displacement_m"),
+        "control_energy_j": spread("control_energy_j"),
+        "residual_elastic_energy_j": spread("residual_elastic_energy_j"),
+    }
+
+
+def _with_base(definition, overrides: dict):
+    from flexsat.campaigns.definition import CampaignDefinition
+    from flexsat.config import validate_config
+
+    if not overrides:
+        return definition
+    data = definition.model_dump(mode="json")
+    data["base"] = {**data["base"], **overrides}
+    return validate_config(data, source="law comparison", model=CampaignDefinition)
+
+
+def _rows(definition, config, store: Path | None, workers: int | None, progress: bool):
+    """The case rows: every case into ``store``, or the first QUICK_CASES in-process."""
+    from flexsat.campaigns import resolve_cases
+    from flexsat.campaigns.runner import run_case
+    from flexsat.campaigns.store import CampaignStore
+    from flexsat.study.outputs import fly_campaign
+
+    if store is None:
+        return [run_case(case) for case in resolve_cases(definition, config)[:QUICK_CASES]]
+    fly_campaign(definition, config, store, progress=progress, workers=workers, resume=True)
+    return CampaignStore(store).rows()
+
+
+def law_comparison(
+    config, out: Path, laws: tuple[str, ...], *, quick: bool, workers: int | None = None,
+    progress: bool = True, campaigns: tuple[str, ...] | None = None, default_law: str = "asmc",
+) -> dict:  # fmt: skip
+    """Fly each campaign with each variant and write ``out/laws/laws.json``.
+
+    Parameters
+    ----------
+    config : SatelliteConfig
+        The base satellite the campaigns vary.
+    out : Path
+        The study folder.
+    laws : tuple of str
+        Registered laws compared (with their default gains).
+    quick : bool
+        Only the first :data:`QUICK_CASES` case(s) of each campaign, in-process.
+    workers : int, optional
+        Campaign worker processes (full study).
+    progress : bool
+        Progress bars (full study).
+    campaigns : tuple of str, optional
+        Campaign presets; default the thesis's three.
+    default_law : str
+        The law of the campaigns part, whose stores are reused.
+
+    Returns
+    -------
+    dict
+        ``quick``, ``variants`` (names, in order), ``campaigns``: per campaign, per
+        variant, :func:`law_statistics`; also written to ``out/laws/laws.json``.
+    """
+    from flexsat.campaigns import load_campaign
+    from flexsat.study.outputs import write_json
+    from flexsat.study.pipeline import CAMPAIGNS
+
+    variants = _variants(laws, default_law)
+    payload: dict = {"quick": quick, "variants": list(variants), "campaigns": {}}
+    for name in campaigns or CAMPAIGNS:
+        base = load_campaign(name)
+        per_variant = {}
+        for variant, overrides in variants.items():
+            folder = name if not overrides else f"{name}-{variant}"
+            store = None if quick else out / "campaigns" / folder
+            rows = _rows(_with_base(base, overrides), config, store, workers, progress)
+            per_variant[variant] = law_statistics(rows)
+        payload["campaigns"][name] = per_variant
+    write_json(out / "laws" / "laws.json", payload)
+    return payload
