@@ -229,12 +229,38 @@ def register_actuator(spec: StageSpec, default: bool = False) -> StageSpec:
 
 
 def register_reference(spec: StageSpec, default: bool = False) -> StageSpec:
-    """Register a reference generator under ``spec.name`` (replacing one of that name)."""
+    """Register a reference generator under ``spec.name`` (replacing one of that name).
+
+    Parameters
+    ----------
+    spec : StageSpec
+        The stage: its name, config model, compiled step and records.
+    default : bool
+        Whether it is used when a table gives no ``kind``.
+
+    Returns
+    -------
+    StageSpec
+        ``spec``, so that registration can decorate an assignment.
+    """
     return _register("reference", spec, default)
 
 
 def register_joint_actuator(spec: StageSpec, default: bool = False) -> StageSpec:
-    """Register a joint actuator under ``spec.name`` (replacing one of that name)."""
+    """Register a joint actuator under ``spec.name`` (replacing one of that name).
+
+    Parameters
+    ----------
+    spec : StageSpec
+        The stage: its name, config model, compiled step and records.
+    default : bool
+        Whether it is used when a table gives no ``kind``.
+
+    Returns
+    -------
+    StageSpec
+        ``spec``, so that registration can decorate an assignment.
+    """
     if not issubclass(spec.config, JointActuatorConfig):
         raise ValueError(f"joint actuator {spec.name!r}: its config must derive "
                          "JointActuatorConfig")  # fmt: skip
@@ -272,10 +298,30 @@ def validate_actuator_config(value: Any) -> ActuatorStageConfig:
 
 
 def validate_reference_config(value: Any) -> PlantStageConfig:
-    """A ``[reference]`` table validated by its generator's model (no ``kind``: ``step``)."""
+    """A ``[reference]`` table validated by its generator's model (no ``kind``: ``step``).
+
+    Parameters
+    ----------
+    value : dict or PlantStageConfig
+        The table, or an already validated model.
+
+    Returns
+    -------
+    PlantStageConfig
+    """
     return REFERENCES.validate_table(value, lambda spec: spec.config)
 
 
 def validate_joint_actuator_config(value: Any) -> JointActuatorConfig:
-    """A ``[joint_actuator]`` table validated by its model (no ``kind``: ``none``)."""
+    """A ``[joint_actuator]`` table validated by its model (no ``kind``: ``none``).
+
+    Parameters
+    ----------
+    value : dict or JointActuatorConfig
+        The table, or an already validated model.
+
+    Returns
+    -------
+    JointActuatorConfig
+    """
     return JOINT_ACTUATORS.validate_table(value, lambda spec: spec.config)
