@@ -121,7 +121,7 @@ class Plant:
         for indices in groups.values():
             offsets = [self.layout.blocks[i].offset for i in indices]
             members.append(np.array([indices, offsets], dtype=np.int64).T.copy())
-            params.append(np.ascontiguousarray(np.stack([self.params[i] for i in indices])))
+            params.append(_stack_rows([self.params[i] for i in indices]))
             kernel_sets.append(self.models[indices[0]].kernels)
             models.append(self.models[indices[0]])
         hub_J = np.ascontiguousarray(self.hub_J, dtype=float)
@@ -307,3 +307,14 @@ class Plant:
         out = np.zeros((self.n_appendages, 3))
         kernels.tip_displacement(self._state(q), self._views["tips"], out)
         return out
+
+
+def _stack_rows(rows: list[np.ndarray]) -> np.ndarray:
+    """The parameter rows of one group as a (k, p) array; rows of different lengths (a
+    model whose row grows with its coordinates, such as the modal appendage) are padded
+    with zeros to the longest."""
+    width = max(row.size for row in rows)
+    out = np.zeros((len(rows), width))
+    for k, row in enumerate(rows):
+        out[k, : row.size] = row
+    return out

@@ -1,7 +1,8 @@
 """Appendage models: the contract, the registry and the built-in models.
 
-The thesis's plate on its 6-DOF root joint (:mod:`.plate`) is registered here; a
-user's model is registered the same way, from the user's own file.
+The thesis's plate on its 6-DOF root joint (:mod:`.plate`) and the modal
+(hybrid-coordinate) appendage (:mod:`.modal`) are registered here; a user's model is
+registered the same way, from the user's own file.
 """
 
 from flexsat.dynamics.appendages.contract import (
@@ -10,6 +11,7 @@ from flexsat.dynamics.appendages.contract import (
     Coordinate,
     RigidBody,
 )
+from flexsat.dynamics.appendages.modal import ModalModel
 from flexsat.dynamics.appendages.plate import PlateModel
 from flexsat.dynamics.appendages.registry import (
     appendage_model,
@@ -18,11 +20,13 @@ from flexsat.dynamics.appendages.registry import (
 )
 
 register_appendage_model(PlateModel())
+register_appendage_model(ModalModel())
 
 __all__ = [
     "AppendageKernels",
     "AppendageModel",
     "Coordinate",
+    "ModalModel",
     "PlateModel",
     "RigidBody",
     "appendage_model",
