@@ -68,7 +68,8 @@ def test_a_modal_file_drives_the_modal_command(capsys, tmp_path, panel_data):
         (lambda d: d.__setitem__("frequencies_hz", [-0.2, *d["frequencies_hz"][1:]]),
          "frequencies_hz"),
         (lambda d: d["damping_ratios"].pop(), "damping_ratios"),
-        (lambda d: d.__setitem__("participation", [[5.0 * x for x in r] for r in d["participation"]]),
+        (lambda d: d.__setitem__("participation",
+                                 [[5.0 * x for x in r] for r in d["participation"]]),
          "participation"),
     ],
 )  # fmt: skip

@@ -103,7 +103,8 @@ def _pulse(amplitude: float) -> OpenLoopScenario:
 
 
 def _history_error(plate: Plant, modal: Plant, amplitude: float) -> float:
-    a, b = run_openloop(plate, _pulse(amplitude)).dataset, run_openloop(modal, _pulse(amplitude)).dataset
+    a = run_openloop(plate, _pulse(amplitude)).dataset
+    b = run_openloop(modal, _pulse(amplitude)).dataset
     return max(float(np.abs(a[v].values - b[v].values).max() / np.abs(a[v].values).max())
                for v in ("omega", "tau_flex", "tip_displacement"))  # fmt: skip
 
@@ -234,7 +235,7 @@ def test_a_bad_file_in_a_satellite_config_is_one_clear_message(tmp_path):
     data = nominal_dict()
     data["appendages"][0] = {"name": "wing", "model": "modal", "mount_point_m": [0, 0.8, 0],
                              "file": str(tmp_path / "missing.npz")}  # fmt: skip
-    with pytest.raises(ConfigError, match="appendages\\[0\\].*modal data file not found"):
+    with pytest.raises(ConfigError, match=r"appendages\[0\].*modal data file not found"):
         validate_config(data)
 
 

@@ -73,7 +73,9 @@ def craig_bampton(
     M, K = sp.csr_matrix(M, dtype=float), sp.csr_matrix(K, dtype=float)
     n = M.shape[0]
     if M.shape != (n, n) or K.shape != (n, n):
-        raise ConfigError(f"M and K: expected square matrices of one size, got {M.shape}, {K.shape}")
+        raise ConfigError(
+            f"M and K: expected square matrices of one size, got {M.shape}, {K.shape}"
+        )
     b = np.asarray(interface_dofs, dtype=int)
     _check_dofs("interface_dofs", b, n)
     T_b = np.eye(6) if interface_map is None else np.asarray(interface_map, dtype=float)

@@ -27,7 +27,7 @@ from flexsat.config.modal_data import FORMAT_VERSION, ModalData, modal_data_from
 from flexsat.config.models import SatelliteConfig
 from flexsat.dynamics.plant import Plant
 
-__all__ = ["mount_rotation", "modal_data", "modal_satellite"]
+__all__ = ["modal_data", "modal_satellite", "mount_rotation"]
 
 _TIP_STEP = 1e-6  # [sqrt(kg) m] central-difference step of the tip map (exact for a
 # map linear + quadratic in q: the error is the cubic term, ~1e-12 relative)
