@@ -21,7 +21,6 @@ from __future__ import annotations
 
 import numpy as np
 from scipy.linalg import eigh
-from scipy.spatial.transform import Rotation
 
 from flexsat.config.modal_data import FORMAT_VERSION, ModalData, modal_data_from_dict
 from flexsat.config.models import SatelliteConfig
@@ -33,12 +32,11 @@ _TIP_STEP = 1e-6  # [sqrt(kg) m] central-difference step of the tip map (exact f
 # map linear + quadratic in q: the error is the cubic term, ~1e-12 relative)
 
 
-def mount_rotation(config) -> np.ndarray:
-    """R_BM of an appendage config with ``mount_yaw_deg`` and ``sadm_angle_deg`` (identity
-    for a model without them), shape (3, 3)."""
-    angles = np.radians([getattr(config, "mount_yaw_deg", 0.0),
-                         getattr(config, "sadm_angle_deg", 0.0)])  # fmt: skip
-    return Rotation.from_euler("ZY", angles).as_matrix()
+def mount_rotation(model, params: np.ndarray) -> np.ndarray:
+    """R_BM of a packed row from the model's ``mount_rotation(params)`` (the plate, chain
+    and modal models have one); identity for a model without (its data is then in B)."""
+    rotation = getattr(model, "mount_rotation", None)
+    return np.eye(3) if rotation is None else np.asarray(rotation(params), dtype=float)
 
 
 def _skew(v: np.ndarray) -> np.ndarray:
@@ -65,7 +63,7 @@ def modal_data(plant: Plant, appendage: str, n_modes: int | None = None) -> Moda
     block = plant.layout.block(appendage)
     i = [a.name for a in plant.config.appendages].index(appendage)
     model, params, config = plant.models[i], plant.params[i], plant.config.appendages[i]
-    R = mount_rotation(config)
+    R = mount_rotation(model, params)
     R6 = np.kron(np.eye(2), R)
     at_rest = model.shape_points(config, params, np.zeros(block.count))
     r_m, tip_B = at_rest[4], at_rest[5]
@@ -109,19 +107,18 @@ def modal_data(plant: Plant, appendage: str, n_modes: int | None = None) -> Moda
 def modal_satellite(plant: Plant, n_modes: int | None = None) -> SatelliteConfig:
     """``plant``'s satellite with every appendage replaced by its modal export.
 
-    Each modal appendage keeps the original's name, root point and mount angles.
+    Each modal appendage keeps the original's name, root point and mount frame.
     """
     from flexsat.config.load import validate_config
 
     tables = []
     for app in plant.config.appendages:
         i = [a.name for a in plant.config.appendages].index(app.name)
-        r_m = plant.models[i].shape_points(app, plant.params[i], np.zeros(
-            plant.layout.block(app.name).count))[4]  # fmt: skip
+        model, params = plant.models[i], plant.params[i]
+        r_m = model.shape_points(app, params, np.zeros(plant.layout.block(app.name).count))[4]
         tables.append({
             "name": app.name, "model": "modal", "mount_point_m": r_m.tolist(),
-            "mount_yaw_deg": getattr(app, "mount_yaw_deg", 0.0),
-            "sadm_angle_deg": getattr(app, "sadm_angle_deg", 0.0),
+            "mount_matrix": mount_rotation(model, params).tolist(),
             "data": modal_data(plant, app.name, n_modes).model_dump(),
         })  # fmt: skip
     data = {"name": plant.config.name, "hub": plant.config.hub.model_dump(exclude_none=True),

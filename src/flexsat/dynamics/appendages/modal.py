@@ -48,7 +48,7 @@ from pydantic import (
 from scipy.spatial.transform import Rotation
 
 from flexsat.config.modal_data import ModalData, load_modal_data
-from flexsat.config.models import Angle, Name, Point3
+from flexsat.config.models import Angle, Matrix3, Name, Point3
 from flexsat.dynamics.appendages.contract import (
     BIAS_SIGNATURE,
     HUB_ACC,
@@ -131,6 +131,9 @@ class ModalAppendageConfig(BaseModel):
     mount_point_m: Point3 = Field(description="interface point from hub centre of mass, B [m]")
     mount_yaw_deg: Angle = Field(0.0, description="mount frame rotation about Z_B [deg]")
     sadm_angle_deg: Angle = Field(0.0, description="SADM angle about Y_M [deg]")
+    mount_matrix: Matrix3 | None = Field(
+        None, description="R_BM (mount -> hub), instead of the two angles"
+    )
     file: str | None = Field(None, description="modal data file (.toml or .npz)")
     data: ModalData | None = Field(None, description="modal data (the file's content)")
     frequency_scale: Scale = Field(1.0, description="factor on every modal frequency [-]")
@@ -146,6 +149,12 @@ class ModalAppendageConfig(BaseModel):
 
     @model_validator(mode="after")
     def _scaled_valid(self) -> ModalAppendageConfig:
+        if self.mount_matrix is not None:
+            if self.mount_yaw_deg or self.sadm_angle_deg:
+                raise ValueError("give either mount_yaw_deg/sadm_angle_deg or mount_matrix")
+            R = np.array(self.mount_matrix, dtype=float)
+            if not np.allclose(R @ R.T, np.eye(3), atol=1e-9) or np.linalg.det(R) < 0.0:
+                raise ValueError("mount_matrix must be a rotation (orthonormal, det +1)")
         if self.data is None:
             raise ValueError("give the modal data: file = '<path>' or a data table")
         self.modal()  # the scaled data must be valid too (effective masses, damping)
@@ -164,6 +173,14 @@ class ModalAppendageConfig(BaseModel):
             "damping_ratios": [z * self.damping_scale for z in d.damping_ratios],
             "participation": [[p * x for x in row] for row in d.participation],
         })  # fmt: skip
+
+    def mount_rotation(self) -> np.ndarray:
+        """R_BM: ``mount_matrix``, else Rz(yaw) Ry(sadm) (intrinsic Z then Y, as for the
+        plate), shape (3, 3)."""
+        if self.mount_matrix is not None:
+            return np.array(self.mount_matrix, dtype=float)
+        angles = np.radians([self.mount_yaw_deg, self.sadm_angle_deg])
+        return Rotation.from_euler("ZY", angles).as_matrix()
 
     def tip(self) -> int | None:
         """Index of the output point called 'tip', else the first one; None: no points."""
@@ -404,12 +421,6 @@ def tips(q, members, params, out):
         out[i, 0], out[i, 1], out[i, 2] = d
 
 
-def _mount_rotation(config: ModalAppendageConfig) -> np.ndarray:
-    """R_BM = Rz(yaw) Ry(sadm) (intrinsic Z then Y), as for the plate."""
-    angles = np.radians([config.mount_yaw_deg, config.sadm_angle_deg])
-    return Rotation.from_euler("ZY", angles).as_matrix()
-
-
 class ModalModel(AppendageModel):
     """A hybrid-coordinate appendage (:class:`ModalAppendageConfig`) rigidly mounted."""
 
@@ -424,7 +435,7 @@ class ModalModel(AppendageModel):
     def pack(self, config: ModalAppendageConfig) -> np.ndarray:
         data = config.modal()
         n = data.n_modes
-        R = _mount_rotation(config)
+        R = config.mount_rotation()
         R6 = np.kron(np.eye(2), R)
         L_M = data.participation_matrix()
         row = np.zeros(P_MODES + MODE_SIZE * n)
@@ -503,6 +514,11 @@ class ModalModel(AppendageModel):
         if tip is None:
             return 2.0 * float(np.linalg.norm(config.data.center_of_mass_m))
         return float(np.linalg.norm(config.data.output_points[tip].position_m))
+
+    @staticmethod
+    def mount_rotation(params: np.ndarray) -> np.ndarray:
+        """R_BM of a packed row, shape (3, 3)."""
+        return params[P_R_BM : P_R_BM + 9].reshape(3, 3)
 
     def mode_kinds(self, config: ModalAppendageConfig) -> tuple[str, ...]:
         return tuple(f"mode_{k + 1}" for k in range(config.data.n_modes))
