@@ -11,11 +11,10 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from scipy.optimize import brentq
 
 from flexsat import ConfigError, Plant
 from flexsat.config import validate_config
-from flexsat.fe import craig_bampton, uniform_beam
+from flexsat.fe import craig_bampton, euler_bernoulli_hub_frequencies, uniform_beam
 
 pytest.importorskip("skfem")
 
@@ -104,34 +103,7 @@ def test_rigid_mass_and_effective_masses():
 
 
 def _analytic_hub_frequencies(count: int) -> np.ndarray:
-    """Antisymmetric in-plane modes of a hub (J about Z) carrying two cantilevers at
-    radius R: Y = a cosh + b sinh + c cos + d sin (beta s), the absolute transverse
-    displacement, with Y(0) = R Theta, Y'(0) = Theta, Y''(L) = Y'''(L) = 0 and the
-    angular momentum J Theta + 2 rho A int (R + s) Y ds = 0."""
-    s, w = np.polynomial.legendre.leggauss(80)
-    s, w = 0.5 * L * (s + 1.0), 0.5 * L * w
-
-    def det(omega: float) -> float:
-        beta = (RHO_A * omega**2 / EI_Z) ** 0.25
-        x = beta * L
-        basis = np.array([np.cosh(beta * s), np.sinh(beta * s), np.cos(beta * s),
-                          np.sin(beta * s)])  # fmt: skip
-        moment = 2.0 * RHO_A * basis @ ((ROOT + s) * w)
-        A = np.array([
-            [1.0, 0.0, 1.0, 0.0, -ROOT],
-            [0.0, beta, 0.0, beta, -1.0],
-            [np.cosh(x), np.sinh(x), -np.cos(x), -np.sin(x), 0.0],
-            [np.sinh(x), np.cosh(x), np.sin(x), -np.cos(x), 0.0],
-            [*moment, HUB_J],
-        ])  # fmt: skip
-        return float(np.linalg.det(A) / np.cosh(x) ** 2)
-
-    grid = 2.0 * np.pi * np.linspace(0.01, 30.0, 6000)
-    values = [det(o) for o in grid]
-    roots = [brentq(det, a, b, xtol=1e-14, rtol=1e-14)
-             for a, b, fa, fb in zip(grid, grid[1:], values, values[1:], strict=False)
-             if fa * fb < 0.0]  # fmt: skip
-    return np.array(roots[:count]) / (2.0 * np.pi)
+    return euler_bernoulli_hub_frequencies(HUB_J, ROOT, L, RHO_A, EI_Z, count)
 
 
 def _satellite(n_elements: int, n_modes: int) -> Plant:

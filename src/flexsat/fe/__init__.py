@@ -3,10 +3,11 @@
 :func:`craig_bampton` reduces a user's FE mass and stiffness matrices, clamped at an
 interface node, to the modal data format (:mod:`flexsat.config.modal_data`) that the
 ``modal`` appendage reads; :func:`uniform_beam` builds a uniform beam with
-scikit-fem (the ``fe`` extra) as a reference structure.
+scikit-fem (the ``fe`` extra) as a reference structure, and
+:func:`euler_bernoulli_hub_frequencies` is its analytic counterpart on a hub.
 """
 
-from flexsat.fe.beam import BeamModel, uniform_beam
+from flexsat.fe.beam import BeamModel, euler_bernoulli_hub_frequencies, uniform_beam
 from flexsat.fe.craig_bampton import craig_bampton
 
-__all__ = ["BeamModel", "craig_bampton", "uniform_beam"]
+__all__ = ["BeamModel", "craig_bampton", "euler_bernoulli_hub_frequencies", "uniform_beam"]
