@@ -281,3 +281,15 @@ def test_chain_round_trip_frequencies_and_history(beam_chains):
     large = _history_error(chain, modal, 1e-4, compared)
     assert small <= 1e-6
     assert large / small == pytest.approx(100.0, rel=0.05)
+
+
+def test_the_modal_equation_table_resolves():
+    # docs/model.md, "Modal appendages": every function its table names imports.
+    from tests.test_docs import DOCS, REFERENCE, _resolve
+
+    text = (DOCS / "model.md").read_text(encoding="utf-8")
+    section = text.split("\n## Modal appendages\n", 1)[1].split("\n## ", 1)[0]
+    references = set(REFERENCE.findall(section))
+    assert len(references) >= 10
+    for reference in sorted(references):
+        _resolve(reference)
