@@ -28,15 +28,19 @@ from scipy.sparse.linalg import eigsh, splu
 from flexsat.config.modal_data import FORMAT_VERSION, ModalData, modal_data_from_dict
 from flexsat.errors import ConfigError
 
-__all__ = ["craig_bampton"]
+__all__ = ["craig_bampton", "rigid_interface_map"]
 
-_RIGID_RTOL = 1e-8  # the translational block of M_rr must be m I to this (round-off of K_ii^-1)
+# The translational block of M_rr must be m I to this: the round-off of K_ii^-1 (1e-7
+# for a thin solid plate) is below it, while a missing interface DOF or a structure
+# that is not free-free is off by O(1).
+_RIGID_RTOL = 1e-6
 _DENSE_MAX = 600  # interior DOFs up to which the clamped eigenproblem is solved densely
 
 
 def craig_bampton(
     M, K, interface_dofs: Sequence[int], n_modes: int, *,
-    interface_map: np.ndarray | None = None, damping_ratio: float | Sequence[float] = 0.0,
+    interface_map: np.ndarray | None = None, rigid_modes: np.ndarray | None = None,
+    damping_ratio: float | Sequence[float] = 0.0,
     outputs: Mapping[str, tuple[Sequence[int], Sequence[float]]] | None = None,
 ) -> ModalData:  # fmt: skip
     """Reduce FE matrices clamped at an interface to the modal data format.
@@ -53,6 +57,11 @@ def craig_bampton(
         T_b: boundary displacement per unit interface motion [tx, ty, tz, rx, ry, rz] in
         frame M (a rigid link, or signs of rotational DOFs). Default: identity (six
         DOFs of one node in that order).
+    rigid_modes : ndarray, shape (n, 6), optional
+        The structure's rigid motions per unit interface motion, when the caller knows
+        them (from the node positions): used as the constraint modes instead of
+        solving K_ii Psi_i = -K_ib T_b, whose round-off grows with the condition number
+        of K_ii (1e-7 for a thin solid plate). Their boundary rows must be T_b.
     damping_ratio : float or sequence of float
         Modal damping ratio zeta_k, one for all or one per mode [-].
     outputs : mapping, optional
@@ -90,7 +99,15 @@ def craig_bampton(
     K_ii, M_ii = K[i][:, i].tocsc(), M[i][:, i].tocsc()
     psi = np.zeros((n, 6))
     psi[b] = T_b
-    psi[i] = -splu(K_ii).solve(K[i][:, b] @ T_b)  # constraint modes
+    if rigid_modes is None:
+        psi[i] = splu(K_ii).solve(-(K[i][:, b] @ T_b))  # constraint modes
+    else:
+        psi = np.asarray(rigid_modes, dtype=float)
+        if psi.shape != (n, 6) or not np.allclose(psi[b], T_b, rtol=0.0, atol=1e-12):
+            raise ConfigError(
+                f"rigid_modes: expected shape ({n}, 6) with the interface_map as its "
+                "interface rows"
+            )
     M_rr = psi.T @ (M @ psi)
     M_rr = 0.5 * (M_rr + M_rr.T)
     mass = float(np.trace(M_rr[:3, :3]) / 3.0)
@@ -152,3 +169,29 @@ def _clamped_modes(K_ii, M_ii, n_modes: int) -> tuple[np.ndarray, np.ndarray]:
         omega2, phi = omega2[order], phi[:, order]
         phi /= np.sqrt(np.einsum("ik,ik->k", phi, M_ii @ phi))
     return omega2, phi
+
+
+def rigid_interface_map(points_m: np.ndarray, components: np.ndarray) -> np.ndarray:
+    """T_b of boundary DOFs rigidly linked to the interface point (an RBE2 link).
+
+    Parameters
+    ----------
+    points_m : ndarray, shape (n_b, 3)
+        Each boundary DOF's node position from the interface point, frame M [m].
+    components : ndarray, shape (n_b,), int
+        Each DOF's translation component (0, 1, 2 for x, y, z).
+
+    Returns
+    -------
+    ndarray, shape (n_b, 6)
+        u_b = T_b [t; r]: u = t + r x p, so row j is e_c then the row c of -[p]x.
+    """
+    p = np.asarray(points_m, dtype=float)
+    c = np.asarray(components, dtype=int)
+    rows = np.zeros((len(c), 6))
+    rows[np.arange(len(c)), c] = 1.0
+    skew = np.zeros((len(c), 3, 3))
+    skew[:, 0, 1], skew[:, 0, 2], skew[:, 1, 2] = -p[:, 2], p[:, 1], -p[:, 0]
+    skew[:, 1, 0], skew[:, 2, 0], skew[:, 2, 1] = p[:, 2], -p[:, 1], p[:, 0]
+    rows[:, 3:] = -skew[np.arange(len(c)), c]
+    return rows
