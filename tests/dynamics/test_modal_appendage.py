@@ -293,3 +293,19 @@ def test_the_modal_equation_table_resolves():
     assert len(references) >= 10
     for reference in sorted(references):
         _resolve(reference)
+
+
+def test_design_model_and_drawing_of_the_fitted_thesis_plates(nominal):
+    # The rigid design inertia J_tot of the modal satellite is the thesis's (appendix
+    # A.4, printed to 2 decimals); the drawn tip moves by the tip mode-shape rows.
+    from flexsat.dynamics.rigid import rigid_inertia
+
+    modal = Plant.from_config(modal_satellite(nominal))
+    np.testing.assert_allclose(rigid_inertia(modal), thesis.J_TOT_NOMINAL, atol=thesis.PRINTED_2DP)
+    model, config, params = modal.models[0], modal.config.appendages[0], modal.params[0]
+    q = np.zeros(6)
+    q[0] = 1e-3
+    moved = model.shape_points(config, params, q)[5] - model.shape_points(config, params, 0 * q)[5]
+    tip = np.zeros(modal.n_dof)
+    tip[modal.layout.blocks[0].slice] = q
+    np.testing.assert_allclose(moved, modal.tip_displacement(tip)[0], atol=1e-15)
