@@ -268,19 +268,18 @@ def beam_chains():
 
 def test_chain_round_trip_frequencies_and_history(beam_chains):
     # Two 8-segment chains (in-plane joints): all 8 modes each kept, the coupled
-    # frequencies agree to round-off (required 1e-9) and a small pulse's history to
-    # the chain's quadratic terms (error proportional to the amplitude, as for the plate;
-    # measured 5e-8 at 1e-6 N m). tau_flex is left out: a chain's is the elastic wrench
+    # frequencies agree to round-off (required 1e-9) and a small pulse's history within
+    # 1e-6 (measured 1.6e-13 at 1e-6 N m: with the exported inertia derivatives the
+    # planar chain's leading terms are all in the modal model; 7.9e-7 at 1e-4 N m,
+    # 7.9e-5 at 1e-2 N m). tau_flex is left out: a chain's is the elastic wrench
     # of its free joint DOFs only, without the reaction of the locked ones (the root
     # shear of this beam), the modal appendage's the whole elastic interface load.
     chain, modal = beam_chains
     np.testing.assert_allclose(modal_analysis(modal).frequencies_hz[6:],
                                modal_analysis(chain).frequencies_hz[6:], rtol=1e-9)  # fmt: skip
     compared = ("omega", "tip_displacement")
-    small = _history_error(chain, modal, 1e-6, compared)
-    large = _history_error(chain, modal, 1e-4, compared)
-    assert small <= 1e-6
-    assert large / small == pytest.approx(100.0, rel=0.05)
+    assert _history_error(chain, modal, 1e-6, compared) <= 1e-6
+    assert _history_error(chain, modal, 1e-4, compared) <= 1e-5
 
 
 def test_the_modal_equation_table_resolves():

@@ -80,6 +80,11 @@ class ModalData(_Frozen):
         description="L_k per mode: translation [sqrt(kg)], rotation about the interface "
         "[sqrt(kg) m], frame M"
     )
+    inertia_derivatives: list[Matrix3] = Field(
+        default_factory=list,
+        description="optional: J'_k = dJ_I/d eta_k per mode, about the interface, frame M "
+        "[sqrt(kg) m]; none: the inertia does not change with the modes",
+    )
     output_points: list[OutputPoint] = Field(default_factory=list)
 
     @model_validator(mode="after")
@@ -98,6 +103,15 @@ class ModalData(_Frozen):
                 f"frequencies_hz: must be sorted ascending, mode {k + 2} ({f[k + 1]:.6g} Hz) "
                 f"is below mode {k + 1} ({f[k]:.6g} Hz)"
             )
+        if self.inertia_derivatives and len(self.inertia_derivatives) != n:
+            raise ValueError(
+                f"inertia_derivatives: expected one 3 x 3 matrix per mode ({n}) or none, "
+                f"got {len(self.inertia_derivatives)}"
+            )
+        dJ = self.inertia_derivative_array()
+        if np.abs(dJ - dJ.transpose(0, 2, 1)).max(initial=0.0) > _PSD_RTOL * max(
+                np.abs(dJ).max(initial=0.0), 1e-300):  # fmt: skip
+            raise ValueError("inertia_derivatives: each matrix must be symmetric")
         zeta = np.asarray(self.damping_ratios, dtype=float)
         if n and (zeta.min() < 0.0 or zeta.max() >= 1.0):
             raise ValueError("damping_ratios: each must be in [0, 1)")
@@ -153,6 +167,12 @@ class ModalData(_Frozen):
         """L, shape (n, 6): row k is mode k's participation factors."""
         return np.asarray(self.participation, dtype=float).reshape(self.n_modes, 6)
 
+    def inertia_derivative_array(self) -> np.ndarray:
+        """J'_k per mode, shape (n, 3, 3) (zeros when the file gives none)."""
+        if not self.inertia_derivatives:
+            return np.zeros((self.n_modes, 3, 3))
+        return np.asarray(self.inertia_derivatives, dtype=float).reshape(self.n_modes, 3, 3)
+
     def effective_mass(self) -> np.ndarray:
         """Sum of the modal effective masses L^T L about the interface, frame M, (6, 6)."""
         L = self.participation_matrix()
@@ -169,6 +189,8 @@ class ModalData(_Frozen):
             "frequencies_hz": np.array(self.frequencies_hz, dtype=float),
             "damping_ratios": np.array(self.damping_ratios, dtype=float),
             "participation": self.participation_matrix(),
+            "inertia_derivatives": np.array(self.inertia_derivatives,
+                                            dtype=float).reshape(-1, 3, 3),
             "output_names": np.array([p.name for p in self.output_points], dtype=str),
             "output_positions_m": np.array([p.position_m for p in self.output_points],
                                            dtype=float).reshape(-1, 3),

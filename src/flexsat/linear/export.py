@@ -13,6 +13,8 @@ L = phi^T M_Ii^T, all in the mount frame M. With every mode kept, the modal appe
 has the same M(0) and K_sys as the original: the same coupled frequencies
 (docs/model.md, "Modal appendages").
 
+The inertia's first-order change with the modes, J'_k = dJ_I / d eta_k, comes from
+the locked inertia by central differences (it is quadratic in q: exact to round-off).
 Modal damping keeps the diagonal of phi^T C phi (zeta_k = (phi^T C phi)_kk / 2
 omega_k); the off-diagonal terms, non-zero when C is not proportional, are dropped.
 """
@@ -84,13 +86,20 @@ def modal_data(plant: Plant, appendage: str, n_modes: int | None = None) -> Moda
     body = model.rigid_body(params)
     c_M = R.T @ (body.r_B - r_m)
     J_I = R.T @ body.J_B @ R + body.mass * _skew(c_M).T @ _skew(c_M)
-    shapes = []
+    shapes, inertia_rates = [], []
+    R_skew = _skew(r_m)
     for k in range(keep):
         q = plant.zeros()
         q[b] = _TIP_STEP * phi[:, k]
         plus = plant.tip_displacement(q)[i]
         minus = plant.tip_displacement(-q)[i]
         shapes.append(((plus - minus) / (2.0 * _TIP_STEP)).tolist())
+        # J'_k about the interface from the locked inertia about the hub centre of mass:
+        # dJ_O = J'_k - [r]x [l_t]x - [l_t]x [r]x (parallel axes, c~ moving with eta).
+        dJ_O = (plant.locked_inertia(q) - plant.locked_inertia(-q)) / (2.0 * _TIP_STEP)
+        l_t = _skew(R @ L[k, :3])
+        dJ = R.T @ (dJ_O + R_skew @ l_t + l_t @ R_skew) @ R
+        inertia_rates.append((0.5 * (dJ + dJ.T)).tolist())
     return modal_data_from_dict({
         "format_version": FORMAT_VERSION,
         "mass_kg": body.mass,
@@ -99,6 +108,7 @@ def modal_data(plant: Plant, appendage: str, n_modes: int | None = None) -> Moda
         "frequencies_hz": (omega / (2.0 * np.pi)).tolist(),
         "damping_ratios": zeta.tolist(),
         "participation": L.tolist(),
+        "inertia_derivatives": inertia_rates,
         "output_points": [{"name": "tip", "position_m": (R.T @ (tip_B - r_m)).tolist(),
                            "mode_shapes": shapes}],
     }, source=f"export of appendage {appendage!r}")  # fmt: skip

@@ -109,7 +109,8 @@ MODE_C = 1  # 2 zeta_k omega_k [1/s]
 MODE_LT = 2  # (3) l_t,k [sqrt(kg)]
 MODE_LR = 5  # (3) l_r,k [sqrt(kg) m]
 MODE_TIP = 8  # (3) tip mode-shape row, frame M [m / (sqrt(kg) m)]
-MODE_SIZE = 11
+MODE_DJ = 11  # (9) J'_k = dJ_I / d eta_k, B, row-major [sqrt(kg) m]
+MODE_SIZE = 20
 
 Scale = Annotated[float, Strict(), AllowInfNan(False), Field(gt=0.0, le=1e3)]
 
@@ -227,11 +228,29 @@ def _add_inertia(hub, r0, c0, A):
 
 
 @njit(cache=True, error_model="numpy")
-def _inertia_about_hub(p, r, c1):
-    """Inertia about the hub centre of mass (at -r from the interface), first moment c1
-    about the interface: J_I - m [r]x [r]x - [r]x [c1]x - [c1]x [r]x (parallel axes)."""
+def _inertia(q, qd, o, p):
+    """J(eta) = J_I + sum_k eta_k J'_k and its rate sum_k eta_dot_k J'_k (B)."""
+    J, J_dot = load_m33_at(p, P_J_I), ((0.0, 0.0, 0.0), (0.0, 0.0, 0.0), (0.0, 0.0, 0.0))
+    for k in range(int(p[P_N])):
+        dJ = load_m33_at(p, P_MODES + MODE_SIZE * k + MODE_DJ)
+        J = _madd(J, dJ, q[o + k])
+        J_dot = _madd(J_dot, dJ, qd[o + k])
+    return J, J_dot
+
+
+@njit(cache=True, error_model="numpy")
+def _centrifugal(p, k, omega):
+    """1/2 omega^T J'_k omega: the centrifugal generalized force on mode k (-dT/d eta_k)."""
+    return 0.5 * dot(omega, mv(load_m33_at(p, P_MODES + MODE_SIZE * k + MODE_DJ), omega))
+
+
+@njit(cache=True, error_model="numpy")
+def _inertia_about_hub(p, J, r, c1):
+    """Inertia about the hub centre of mass (at -r from the interface) of a body with
+    inertia J about the interface and first moment c1 there:
+    J - m [r]x [r]x - [r]x [c1]x - [c1]x [r]x (parallel axes)."""
     R, C = skew(r), skew(c1)
-    J = _madd(load_m33_at(p, P_J_I), mm(R, R), -p[P_MASS])
+    J = _madd(J, mm(R, R), -p[P_MASS])
     return _madd(_madd(J, mm(R, C), -1.0), mm(C, R), -1.0)
 
 
@@ -246,26 +265,28 @@ def pass1(q, qd, Q, members, params, work, hub, qdd):
         o, p = members[j, 1], params[j]
         r = load_seg(p, P_MOUNT)
         s, s_dot, h_r = _modal_sums(q, qd, o, p)
+        J, J_dot = _inertia(q, qd, o, p)
         g_t, g_r = (0.0, 0.0, 0.0), (0.0, 0.0, 0.0)
         for k in range(int(p[P_N])):
             b = P_MODES + MODE_SIZE * k
             f = Q[o + k] - p[b + MODE_K] * q[o + k] - p[b + MODE_C] * qd[o + k]
+            f += _centrifugal(p, k, omega)
             qdd[o + k] = f
             g_t = add(g_t, scale(f, load_seg(p, b + MODE_LT)))
             g_r = add(g_r, scale(f, load_seg(p, b + MODE_LR)))
             hub[HUB_DISSIPATION] += p[b + MODE_C] * qd[o + k] ** 2  # eq. 2.36
         c1 = add(load_seg(p, P_FIRST), s)  # c~ = m c + L_t^T eta
-        # M_I = [[A, B], [C, D]] = M_res + [[0, -[s]x], [[s]x, 0]], about the interface.
+        # M_I = [[A, B], [C, D]] = M_res + [[0, -[s]x], [[s]x, J(eta) - J_I]], about I.
         S = skew(s)
-        A, D = _block(p, 0, 0), _block(p, 3, 3)
+        A = _block(p, 0, 0)
+        D = _madd(_madd(_block(p, 3, 3), J, 1.0), load_m33_at(p, P_J_I), -1.0)
         B, C = _madd(_block(p, 0, 3), S, -1.0), _madd(_block(p, 3, 0), S, 1.0)
         # Wrench on the appendage at a_hub = 0, alpha = 0: M_I [w x (w x r); 0] + b_a.
         w2r = cross(omega, cross(omega, r))
         F = add(add(cross(omega, cross(omega, c1)), scale(2.0, cross(omega, s_dot))), g_t)
         F = add(F, mv(A, w2r))
-        J = load_m33_at(p, P_J_I)
         N = add(add(cross(omega, mv(J, omega)), cross(omega, h_r)), g_r)
-        N = add(N, mv(C, w2r))
+        N = add(add(N, mv(C, w2r)), mv(J_dot, omega))
         T = add(N, cross(r, F))
         for a in range(3):
             hub[HUB_FORCE + a] -= F[a]
@@ -312,7 +333,8 @@ def mass_matrix(q, members, params, M):
         first_hub = add(scale(m, r), c1)  # first moment about the hub centre of mass
         add_block(M, 0, 0, identity, m)
         add_block(M, 0, 3, mm(R_NB, mm(skew(first_hub), S)), -1.0)
-        add_block(M, 3, 3, mtm(S, mm(_inertia_about_hub(p, r, c1), S)), 1.0)
+        J, _ = _inertia(q, q, o, p)
+        add_block(M, 3, 3, mtm(S, mm(_inertia_about_hub(p, J, r, c1), S)), 1.0)
         for k in range(int(p[P_N])):
             b = P_MODES + MODE_SIZE * k
             l_t, l_r = load_seg(p, b + MODE_LT), load_seg(p, b + MODE_LR)
@@ -338,11 +360,11 @@ def bias_forces(q, qd, members, params, hub, h):
         m, r = p[P_MASS], load_seg(p, P_MOUNT)
         s, s_dot, h_r = _modal_sums(q, qd, o, p)
         c1 = add(load_seg(p, P_FIRST), s)
-        J = load_m33_at(p, P_J_I)
+        J, J_dot = _inertia(q, qd, o, p)
         a_I = add(cross(alpha, r), cross(omega, cross(omega, r)))
         F = add(add(scale(m, a_I), cross(alpha, c1)),
                 add(cross(omega, cross(omega, c1)), scale(2.0, cross(omega, s_dot))))
-        N = add(add(cross(c1, a_I), mv(J, alpha)),
+        N = add(add(add(cross(c1, a_I), mv(J, alpha)), mv(J_dot, omega)),
                 add(cross(omega, mv(J, omega)), cross(omega, h_r)))  # fmt: skip
         F_N = mv(R_NB, F)
         T = add(N, cross(r, F))
@@ -351,7 +373,8 @@ def bias_forces(q, qd, members, params, hub, h):
             hub[HUB_TORQUE + a] += T[a]
         for k in range(int(p[P_N])):
             b = P_MODES + MODE_SIZE * k
-            h[o + k] = dot(load_seg(p, b + MODE_LT), a_I) + dot(load_seg(p, b + MODE_LR), alpha)
+            h[o + k] = (dot(load_seg(p, b + MODE_LT), a_I) + dot(load_seg(p, b + MODE_LR), alpha)
+                        - _centrifugal(p, k, omega))
 
 
 @njit(OBSERVE_SIGNATURE, cache=True, error_model="numpy")
@@ -366,7 +389,7 @@ def observe(q, qd, members, params, out):
         m, r = p[P_MASS], load_seg(p, P_MOUNT)
         s, s_dot, h_r = _modal_sums(q, qd, o, p)
         c1 = add(load_seg(p, P_FIRST), s)
-        J = load_m33_at(p, P_J_I)
+        J, _ = _inertia(q, qd, o, p)
         v = add(v_hub, cross(omega, r))
         kinetic = 0.5 * m * dot(v, v) + dot(v, cross(omega, c1)) + 0.5 * dot(omega, mv(J, omega))
         kinetic += dot(v, s_dot) + dot(omega, h_r)
@@ -382,7 +405,7 @@ def observe(q, qd, members, params, out):
         H_I = add(add(cross(c1, v), mv(J, omega)), h_r)
         p_I = add(r_hub, mv(R_NB, r))
         H = add(cross(p_I, mv(R_NB, P)), mv(R_NB, H_I))
-        J_O = _inertia_about_hub(p, r, c1)
+        J_O = _inertia_about_hub(p, J, r, c1)
         for a in range(3):
             out[OBS_MOMENTUM + a] += H[a]
             for b in range(3):
@@ -456,6 +479,7 @@ class ModalModel(AppendageModel):
         tip = config.tip()
         if tip is not None:
             modes[:, MODE_TIP : MODE_TIP + 3] = data.output_points[tip].mode_shapes
+        modes[:, MODE_DJ : MODE_DJ + 9] = (R @ data.inertia_derivative_array() @ R.T).reshape(n, 9)
         return row
 
     @staticmethod
@@ -505,7 +529,8 @@ class ModalModel(AppendageModel):
             end = root + 2.0 * R @ np.asarray(config.data.center_of_mass_m)
         else:
             point = config.data.output_points[tip]
-            moved = np.asarray(point.position_m) + self._modes(params)[:, MODE_TIP:].T @ q_block
+            rows = self._modes(params)[:, MODE_TIP : MODE_TIP + 3]
+            moved = np.asarray(point.position_m) + rows.T @ q_block
             end = root + R @ moved
         return np.array([root, root, end, end, root, end])
 
