@@ -40,6 +40,7 @@ BENCHMARKS = (
     "bench_startup",
     "bench_campaigns",
     "bench_figures",
+    "bench_modal",
     "bench_basilisk",
 )
 OPTIONAL = {"bench_basilisk"}  # skipped, not failed, when it or its dependency is missing

@@ -26,7 +26,15 @@ from flexsat.dynamics.rigid import rigid_inertia
 from flexsat.dynamics.symmetry import mirror_operator
 from flexsat.errors import SimulationError
 
-__all__ = ["HUB_DOFS", "JOINT_DOFS", "ModalAnalysis", "Mode", "dof_names", "modal_analysis"]
+__all__ = [
+    "HUB_DOFS",
+    "JOINT_DOFS",
+    "ModalAnalysis",
+    "Mode",
+    "dof_names",
+    "effective_mass_table",
+    "modal_analysis",
+]
 
 _PARITY_MIN = 0.9  # |<phi, P phi>_M| above this: the mode has a definite mirror parity
 _DOMINANT_MIN = 0.5  # normalized mass-weighted amplitude for a DOF to count as dominant
@@ -132,7 +140,45 @@ class ModalAnalysis:
             "frequencies_hz": self.frequencies_hz.tolist(),
             "modes": [m.to_dict() for m in self.modes],
             "rigid_inertia": rigid_inertia(self.plant).tolist(),
+            "mode_shapes": self.shapes.T.tolist(),
+            "modal_damping_ratios": self.damping_ratios().tolist(),
+            "effective_masses": effective_mass_table(self.plant),
         }
+
+    def damping_ratios(self) -> np.ndarray:
+        """Modal damping ratio of each coupled mode, shape (n_dof,): the diagonal of
+        phi^T C phi / 2 omega (0 for the rigid-body modes) [-]."""
+        C = self.plant.damping_matrix()
+        omega = 2.0 * np.pi * self.frequencies_hz
+        modal = np.einsum("ik,ij,jk->k", self.shapes, C, self.shapes)
+        return np.where(omega > 0.0, modal / np.where(omega > 0.0, 2.0 * omega, 1.0), 0.0)
+
+
+_DIRECTIONS = ("x", "y", "z", "rx", "ry", "rz")
+
+
+def effective_mass_table(plant: Plant) -> dict:
+    """The hub-fixed appendage modes' effective masses and inertias (JSON-ready).
+
+    Per mode and hub direction (x, y, z [kg]; rx, ry, rz about the hub centre of mass
+    [kg m^2]), with the cumulative fraction of the satellite's total in that direction
+    (diag of M(0) at the hub: total mass, locked inertia; modes plus residual), see
+    :func:`flexsat.linear.frequency.effective_masses`.
+    """
+    from flexsat.linear.frequency import effective_masses
+
+    frequencies, effective, residual = effective_masses(plant)
+    total = effective.sum(axis=0) + residual
+    cumulative = np.cumsum(effective, axis=0) / np.where(total > 0.0, total, 1.0)
+    return {
+        "directions": list(_DIRECTIONS),
+        "units": ["kg"] * 3 + ["kg m^2"] * 3,
+        "frequencies_hz": frequencies.tolist(),
+        "effective": effective.tolist(),
+        "cumulative_fraction": cumulative.tolist(),
+        "residual": residual.tolist(),
+        "total": total.tolist(),
+    }
 
 
 # Relative residual |K phi - lambda M phi| / |lambda M phi| allowed for a flexible mode: it

@@ -73,12 +73,14 @@ def finite_part(ds: xr.Dataset) -> xr.Dataset:
 
     A diverging run's last records can overflow (energies, momenta of a state that
     blew up); metrics are computed on what came before. The first record is always
-    kept.
+    kept. A column that is not finite from the first record on (a quantity the model
+    does not have, such as the root rotation of a modal appendage) is not a divergence.
     """
     bad = np.zeros(ds.sizes["time"], dtype=bool)
     for var in ds.data_vars.values():
         if "time" in var.dims and np.issubdtype(var.dtype, np.floating):
             values = var.transpose("time", ...).values.reshape(ds.sizes["time"], -1)
+            values = values[:, np.isfinite(values[0])]
             bad |= ~np.isfinite(values).all(axis=1)
     first_bad = int(np.argmax(bad)) if bad.any() else ds.sizes["time"]
     return ds.isel(time=slice(0, max(first_bad, 1)))

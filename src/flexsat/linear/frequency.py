@@ -27,6 +27,7 @@ from flexsat.linear.model import LinearModel
 __all__ = [
     "LoopMargins",
     "effective_inertia",
+    "effective_masses",
     "law_gains",
     "loop_margins",
     "pd_gains",
@@ -94,13 +95,32 @@ def effective_inertia(plant: Plant) -> tuple[np.ndarray, np.ndarray, np.ndarray]
     J_residual : ndarray, shape (3,)
         Residual inertia about X, Y, Z [kg m^2].
     """
+    frequencies, effective, residual = effective_masses(plant)
+    return frequencies, effective[:, 3:], residual[3:]
+
+
+def effective_masses(plant: Plant) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Modal effective masses and inertias of the hub-fixed appendage modes, 6 directions.
+
+    As :func:`effective_inertia`, for every hub direction: translations x, y, z
+    (L_k,a^2 [kg]) and rotations about the hub centre of mass x, y, z ([kg m^2]).
+
+    Returns
+    -------
+    frequencies_hz : ndarray, shape (n_flex,)
+        Frequencies of the hub-fixed appendage modes, ascending [Hz].
+    effective : ndarray, shape (n_flex, 6)
+        L_k,a^2 per mode and direction [kg] x 3, [kg m^2] x 3.
+    residual : ndarray, shape (6,)
+        diag(M_hh - M_hf M_ff^-1 M_fh), what no mode carries [kg] x 3, [kg m^2] x 3.
+    """
     M0 = plant.mass_matrix()
     K = plant.stiffness_matrix()
     M_ff, M_fh, K_ff = M0[6:, 6:], M0[6:, :6], K[6:, 6:]
     omega2, phi = eigh(K_ff, M_ff)
-    L = phi.T @ M_fh[:, 3:6]
-    residual = M0[3:6, 3:6] - M_fh[:, 3:6].T @ np.linalg.solve(M_ff, M_fh[:, 3:6])
-    return np.sqrt(omega2) / (2 * np.pi), L**2, np.diag(residual).copy()
+    L = phi.T @ M_fh
+    residual = M0[:6, :6] - M_fh.T @ np.linalg.solve(M_ff, M_fh)
+    return np.sqrt(np.clip(omega2, 0.0, None)) / (2 * np.pi), L**2, np.diag(residual).copy()
 
 
 def pd_gains(plant: Plant, pd: PDConfig | None = None) -> np.ndarray:

@@ -38,7 +38,7 @@ from collections.abc import Callable, Sequence
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from flexsat.dynamics.plant import JOINT_DOFS, Plant
+from flexsat.dynamics.plant import Plant
 from flexsat.errors import ConfigError, SimulationError
 from flexsat.linear.model import LinearModel
 
@@ -67,9 +67,9 @@ def signal_names(plant: Plant) -> dict[str, tuple[tuple[str, ...], tuple[str, ..
         pair (names, units).
     """
     apps = [a.name for a in plant.config.appendages]
-    joint_units = ("m", "m", "m", "rad", "rad", "rad")
-    eta = [f"{a}.{d}" for a in apps for d in JOINT_DOFS]
-    eta_units = [u for _ in apps for u in joint_units]
+    # Each appendage's own coordinates, as the plant's layout names them.
+    eta = plant.layout.dof_names()[6:]
+    eta_units = plant.layout.dof_units()[6:]
     states = (
         [f"r_B_{a}" for a in _AXES] + ["phi", "theta", "psi"] + eta
         + [f"v_B_{a}" for a in _AXES] + [f"omega_{a}" for a in _AXES]

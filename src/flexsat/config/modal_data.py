@@ -1,0 +1,289 @@
+"""The modal-appendage data format: an interface-clamped structure's modes, versioned.
+
+One file describes one appendage as the hybrid-coordinate model needs it
+(docs/modal_format.md): its rigid mass properties about the interface point, in the
+interface (mount) frame M, and n flexible modes of the structure clamped at that
+point, mass-normalized (phi^T M phi = 1), each with its frequency, damping ratio and
+six participation factors at the interface, plus optional output points with their
+mode-shape rows. TOML suits a handful of modes, NPZ many; both carry the same keys and
+``format_version``. Files are validated at load; NPZ files are read with
+``allow_pickle=False``.
+"""
+
+from __future__ import annotations
+
+import tomllib
+from pathlib import Path
+from typing import Annotated, Any, Literal
+
+import numpy as np
+from pydantic import AllowInfNan, BaseModel, ConfigDict, Field, Strict, model_validator
+
+from flexsat.errors import ConfigError
+
+__all__ = [
+    "FORMAT_VERSION",
+    "ModalData",
+    "OutputPoint",
+    "load_modal_data",
+    "modal_data_from_dict",
+    "save_modal_data",
+]
+
+FORMAT_VERSION = 1
+
+Real = Annotated[float, Strict(), AllowInfNan(False)]
+Vector3 = tuple[Real, Real, Real]
+Vector6 = tuple[Real, Real, Real, Real, Real, Real]
+Matrix3 = tuple[Vector3, Vector3, Vector3]
+_MAX_MODES = 2000
+# Relative slack of the positive-semidefiniteness tests (round-off of the file's own
+# digits: a reduction written with 16 significant digits is exact to ~1e-15).
+_PSD_RTOL = 1e-9
+
+
+class _Frozen(BaseModel):
+    model_config = ConfigDict(frozen=True, extra="forbid")
+
+
+class OutputPoint(_Frozen):
+    """A point of the structure whose motion is reported (e.g. the tip)."""
+
+    name: Annotated[str, Field(min_length=1, max_length=64)]
+    position_m: Vector3 = Field(description="undeformed position from the interface, frame M [m]")
+    mode_shapes: list[Vector3] = Field(
+        description="per mode, the point's translation per unit modal coordinate, frame M "
+        "[m/(sqrt(kg) m)]"
+    )
+
+
+class ModalData(_Frozen):
+    """One interface-clamped appendage: rigid mass properties and flexible modes.
+
+    Frame M is the appendage's interface (mount) frame; the interface point is its
+    origin. Participation factors are L_k = phi_k^T M_fr: the first three the
+    translational ones [sqrt(kg)], the last three the rotational ones about the
+    interface point [sqrt(kg) m]; the effective mass of mode k is L_k^T L_k (6 x 6).
+    """
+
+    format_version: Literal[1] = Field(description="version of this format")
+    mass_kg: Annotated[float, Strict(), AllowInfNan(False), Field(gt=0.0, le=1e7)]
+    center_of_mass_m: Vector3 = Field(description="interface -> centre of mass, frame M [m]")
+    inertia_interface_kg_m2: Matrix3 = Field(
+        description="inertia about the interface point, frame M [kg m^2]"
+    )
+    frequencies_hz: Annotated[list[Real], Field(max_length=_MAX_MODES)] = Field(
+        description="interface-clamped natural frequencies, ascending [Hz]"
+    )
+    damping_ratios: list[Real] = Field(description="modal damping ratio zeta_k, in [0, 1) [-]")
+    participation: list[Vector6] = Field(
+        description="L_k per mode: translation [sqrt(kg)], rotation about the interface "
+        "[sqrt(kg) m], frame M"
+    )
+    inertia_derivatives: list[Matrix3] = Field(
+        default_factory=list,
+        description="optional: J'_k = dJ_I/d eta_k per mode, about the interface, frame M "
+        "[sqrt(kg) m]; none: the inertia does not change with the modes",
+    )
+    output_points: list[OutputPoint] = Field(default_factory=list)
+
+    @model_validator(mode="after")
+    def _consistent(self) -> ModalData:
+        n = len(self.frequencies_hz)
+        for field in ("damping_ratios", "participation"):
+            got = len(getattr(self, field))
+            if got != n:
+                raise ValueError(f"{field}: expected one entry per mode ({n}), got {got}")
+        f = np.asarray(self.frequencies_hz, dtype=float)
+        if n and f.min() <= 0.0:
+            raise ValueError(f"frequencies_hz: must be > 0 Hz, got {f.min():.6g}")
+        if np.any(np.diff(f) < 0.0):
+            k = int(np.argmax(np.diff(f) < 0.0))
+            raise ValueError(
+                f"frequencies_hz: must be sorted ascending, mode {k + 2} ({f[k + 1]:.6g} Hz) "
+                f"is below mode {k + 1} ({f[k]:.6g} Hz)"
+            )
+        if self.inertia_derivatives and len(self.inertia_derivatives) != n:
+            raise ValueError(
+                f"inertia_derivatives: expected one 3 x 3 matrix per mode ({n}) or none, "
+                f"got {len(self.inertia_derivatives)}"
+            )
+        dJ = self.inertia_derivative_array()
+        if np.abs(dJ - dJ.transpose(0, 2, 1)).max(initial=0.0) > _PSD_RTOL * max(
+                np.abs(dJ).max(initial=0.0), 1e-300):  # fmt: skip
+            raise ValueError("inertia_derivatives: each matrix must be symmetric")
+        zeta = np.asarray(self.damping_ratios, dtype=float)
+        if n and (zeta.min() < 0.0 or zeta.max() >= 1.0):
+            raise ValueError("damping_ratios: each must be in [0, 1)")
+        J = np.asarray(self.inertia_interface_kg_m2, dtype=float)
+        if np.max(np.abs(J - J.T)) > _PSD_RTOL * np.max(np.abs(J)):
+            raise ValueError("inertia_interface_kg_m2: must be symmetric (J == J^T)")
+        rigid = self.rigid_mass_matrix()
+        scale = float(np.max(np.abs(rigid)))
+        if np.linalg.eigvalsh(rigid)[0] <= _PSD_RTOL * scale:
+            raise ValueError(
+                "inertia_interface_kg_m2: the rigid mass matrix about the interface "
+                "[[m I, -m [c]x], [m [c]x, J]] must be positive definite (the inertia about "
+                "the centre of mass J - m [c]x^T [c]x must be positive definite)"
+            )
+        for p, point in enumerate(self.output_points):
+            if len(point.mode_shapes) != n:
+                raise ValueError(
+                    f"output_points[{p}].mode_shapes: expected one row per mode ({n}), "
+                    f"got {len(point.mode_shapes)}"
+                )
+        residual = rigid - self.effective_mass()
+        worst = float(np.linalg.eigvalsh(residual)[0])
+        if worst < -_PSD_RTOL * scale:
+            axis = int(np.argmin(np.diag(residual)))
+            names = ("translation x", "translation y", "translation z",
+                     "rotation x", "rotation y", "rotation z")  # fmt: skip
+            raise ValueError(
+                "participation: the modal effective masses exceed the rigid mass (sum_k "
+                "L_k^T L_k must not exceed the rigid mass matrix about the interface; "
+                f"worst direction {names[axis]}: effective {self.effective_mass()[axis, axis]:.6g}"
+                f" > rigid {rigid[axis, axis]:.6g}); check the participation factors' units "
+                "(mass-normalized modes)"
+            )
+        return self
+
+    @property
+    def n_modes(self) -> int:
+        return len(self.frequencies_hz)
+
+    def rigid_mass_matrix(self) -> np.ndarray:
+        """M_rr about the interface point, frame M, ordered [translation; rotation], (6, 6)."""
+        m = self.mass_kg
+        c = np.asarray(self.center_of_mass_m, dtype=float)
+        C = np.array([[0.0, -c[2], c[1]], [c[2], 0.0, -c[0]], [-c[1], c[0], 0.0]])
+        out = np.zeros((6, 6))
+        out[:3, :3] = m * np.eye(3)
+        out[:3, 3:] = -m * C
+        out[3:, :3] = m * C
+        out[3:, 3:] = np.asarray(self.inertia_interface_kg_m2, dtype=float)
+        return out
+
+    def participation_matrix(self) -> np.ndarray:
+        """L, shape (n, 6): row k is mode k's participation factors."""
+        return np.asarray(self.participation, dtype=float).reshape(self.n_modes, 6)
+
+    def inertia_derivative_array(self) -> np.ndarray:
+        """J'_k per mode, shape (n, 3, 3) (zeros when the file gives none)."""
+        if not self.inertia_derivatives:
+            return np.zeros((self.n_modes, 3, 3))
+        return np.asarray(self.inertia_derivatives, dtype=float).reshape(self.n_modes, 3, 3)
+
+    def effective_mass(self) -> np.ndarray:
+        """Sum of the modal effective masses L^T L about the interface, frame M, (6, 6)."""
+        L = self.participation_matrix()
+        return L.T @ L
+
+    def to_arrays(self) -> dict[str, np.ndarray]:
+        """The format's keys as arrays (the NPZ layout)."""
+        n = self.n_modes
+        return {
+            "format_version": np.array(FORMAT_VERSION),
+            "mass_kg": np.array(self.mass_kg),
+            "center_of_mass_m": np.array(self.center_of_mass_m),
+            "inertia_interface_kg_m2": np.array(self.inertia_interface_kg_m2),
+            "frequencies_hz": np.array(self.frequencies_hz, dtype=float),
+            "damping_ratios": np.array(self.damping_ratios, dtype=float),
+            "participation": self.participation_matrix(),
+            "inertia_derivatives": np.array(self.inertia_derivatives,
+                                            dtype=float).reshape(-1, 3, 3),
+            "output_names": np.array([p.name for p in self.output_points], dtype=str),
+            "output_positions_m": np.array([p.position_m for p in self.output_points],
+                                           dtype=float).reshape(-1, 3),
+            "output_mode_shapes": np.array([p.mode_shapes for p in self.output_points],
+                                           dtype=float).reshape(-1, n, 3),
+        }  # fmt: skip
+
+
+def _from_arrays(arrays: dict[str, np.ndarray]) -> dict[str, Any]:
+    """NPZ arrays -> the plain dict of the format (validated by :class:`ModalData`)."""
+    data: dict[str, Any] = {}
+    for key, value in arrays.items():
+        if key.startswith("output_"):
+            continue
+        data[key] = value.item() if value.ndim == 0 else value.tolist()
+    names = arrays.get("output_names", np.zeros(0, dtype=str))
+    positions = arrays.get("output_positions_m", np.zeros((0, 3)))
+    shapes = arrays.get("output_mode_shapes", np.zeros((0, 0, 3)))
+    if not len(names) == len(positions) == len(shapes):
+        raise ValueError(
+            "output_names, output_positions_m and output_mode_shapes: expected one entry "
+            f"per output point, got {len(names)}, {len(positions)} and {len(shapes)}"
+        )
+    data["output_points"] = [
+        {"name": str(n), "position_m": p.tolist(), "mode_shapes": s.tolist()}
+        for n, p, s in zip(names, positions, shapes, strict=True)
+    ]
+    return data
+
+
+def modal_data_from_dict(data: dict[str, Any], source: str = "modal data") -> ModalData:
+    """Validate a plain dict of the format; one :class:`ConfigError` naming the field."""
+    from flexsat.config.load import validate_config
+
+    return validate_config(data, source=source, model=ModalData)
+
+
+def load_modal_data(path: str | Path) -> ModalData:
+    """Read and validate a modal data file (``.toml`` or ``.npz``).
+
+    Raises
+    ------
+    ConfigError
+        Missing or unreadable file, unknown suffix, or any invalid field (the message
+        names it).
+    """
+    path = Path(path)
+    suffix = path.suffix.lower()
+    if suffix == ".toml":
+        try:
+            data = tomllib.loads(path.read_text(encoding="utf-8"))
+        except FileNotFoundError:
+            raise ConfigError(f"modal data file not found: {path}") from None
+        except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError) as exc:
+            raise ConfigError(f"cannot read modal data file {path}: {exc}") from None
+    elif suffix == ".npz":
+        try:
+            with np.load(path, allow_pickle=False) as npz:
+                data = _from_arrays({k: npz[k] for k in npz.files})
+        except FileNotFoundError:
+            raise ConfigError(f"modal data file not found: {path}") from None
+        except (OSError, ValueError) as exc:
+            raise ConfigError(f"cannot read modal data file {path}: {exc}") from None
+    else:
+        raise ConfigError(f"modal data file {path}: the suffix must be .toml or .npz")
+    return modal_data_from_dict(data, source=str(path))
+
+
+def save_modal_data(data: ModalData, path: str | Path) -> Path:
+    """Write ``data`` as ``.toml`` (every float with 17 significant digits: exact) or
+    ``.npz``; returns the path."""
+    path = Path(path)
+    suffix = path.suffix.lower()
+    if suffix == ".npz":
+        np.savez(path, **data.to_arrays())
+    elif suffix == ".toml":
+        path.write_text(_toml(data.model_dump()), encoding="utf-8")
+    else:
+        raise ConfigError(f"modal data file {path}: the suffix must be .toml or .npz")
+    return path
+
+
+def _value(v: Any) -> str:
+    if isinstance(v, (list, tuple)):
+        return "[" + ", ".join(_value(x) for x in v) + "]"
+    if isinstance(v, str):
+        return '"' + v.replace("\\", "\\\\").replace('"', '\\"') + '"'
+    return repr(float(v)) if isinstance(v, float) else str(v)
+
+
+def _toml(data: dict[str, Any]) -> str:
+    """The few shapes of the format as TOML (floats by repr: they round-trip exactly)."""
+    lines = [f"{k} = {_value(v)}" for k, v in data.items() if k != "output_points"]
+    for point in data["output_points"]:
+        lines += ["", "[[output_points]]"] + [f"{k} = {_value(v)}" for k, v in point.items()]
+    return "\n".join(lines) + "\n"

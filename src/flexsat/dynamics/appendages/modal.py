@@ -1,0 +1,549 @@
+"""Modal (hybrid-coordinate) appendage: a rigid body plus n interface-clamped modes.
+
+An appendage given by its modal data (:mod:`flexsat.config.modal_data`): its rigid
+mass properties about the interface point and n mass-normalized modes of the
+structure clamped there, each with frequency omega_k, damping ratio zeta_k and
+participation factors l_k = (l_t,k, l_r,k) at the interface. The interface is rigidly
+fixed to the hub at the mount point r_m (frame M = R_BM, as for the plate).
+
+Coordinates: the modal coordinates eta_k [sqrt(kg) m], one per mode.
+
+Kinetic energy (docs/model.md, "Modal appendages"), v the interface velocity and
+omega the hub rate, both in B, c~ = m c + L_t^T eta the first moment about the
+interface::
+
+    T = 1/2 m v.v + v.(omega x c~) + 1/2 omega.J_I omega
+        + eta_dot^T (L_t v + L_r omega) + 1/2 eta_dot^T eta_dot
+    U = 1/2 sum_k omega_k^2 eta_k^2,   2 D = sum_k 2 zeta_k omega_k eta_dot_k^2
+
+Its equations (Euler-Poincare for the hub, Lagrange for eta)::
+
+    eta_ddot_k = f_k - l_t,k . a_I - l_r,k . alpha
+    f_k = Q_k - omega_k^2 eta_k - 2 zeta_k omega_k eta_dot_k
+    F_a = m a_I + alpha x c~ + omega x (omega x c~) + 2 omega x s_dot + L_t^T eta_ddot
+    N_a = c~ x a_I + J_I alpha + omega x J_I omega + omega x (L_r^T eta_dot) + L_r^T eta_ddot
+
+with a_I = a_hub + alpha x r_m + omega x (omega x r_m) the interface acceleration and
+(F_a, N_a) the wrench the hub exerts on the appendage at the interface. Eliminating
+eta_ddot leaves the residual mass M_rr(c~) - L^T L at the interface: the articulated
+inertia this model transmits to the hub. Every sum is over the modes once: cost is
+linear in n.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated, Any, Literal
+
+import numpy as np
+from numba import njit
+from pydantic import (
+    AllowInfNan,
+    BaseModel,
+    ConfigDict,
+    Field,
+    Strict,
+    model_validator,
+)
+from scipy.spatial.transform import Rotation
+
+from flexsat.config.modal_data import ModalData, load_modal_data
+from flexsat.config.models import Angle, Matrix3, Name, Point3
+from flexsat.dynamics.appendages.contract import (
+    BIAS_SIGNATURE,
+    HUB_ACC,
+    HUB_ALPHA,
+    HUB_DISSIPATION,
+    HUB_FORCE,
+    HUB_INERTIA,
+    HUB_OMEGA,
+    HUB_SBIAS,
+    HUB_TORQUE,
+    MASS_SIGNATURE,
+    OBS_DISSIPATION,
+    OBS_ELASTIC,
+    OBS_KINETIC,
+    OBS_LOCKED_INERTIA,
+    OBS_MOMENTUM,
+    OBSERVE_SIGNATURE,
+    PASS1_SIGNATURE,
+    PASS2_SIGNATURE,
+    TIPS_SIGNATURE,
+    WRENCH_SIGNATURE,
+    AppendageKernels,
+    AppendageModel,
+    Coordinate,
+    RigidBody,
+)
+from flexsat.dynamics.linalg3 import (
+    add,
+    add_block,
+    cross,
+    dot,
+    euler_rate_matrix,
+    load_m33_at,
+    load_seg,
+    mm,
+    mtm,
+    mtv,
+    mv,
+    rot_zyx,
+    scale,
+    skew,
+)
+from flexsat.dynamics.status import STATUS_OK
+
+__all__ = ["ModalAppendageConfig", "ModalModel"]
+
+# Packed parameter row of one modal appendage (everything in hub frame B unless noted).
+P_MOUNT = 0  # (3) r_m, interface point from the hub centre of mass [m]
+P_R_BM = 3  # (9) R_BM, mount frame M -> B, row-major
+P_MASS = 12  # (1) m [kg]
+P_FIRST = 13  # (3) m c, first moment about the interface [kg m]
+P_J_I = 16  # (9) J_I, inertia about the interface point [kg m^2]
+P_RES = 25  # (36) M_rr - L^T L at eta = 0, about the interface, row-major 6 x 6
+P_N = 61  # (1) number of modes n
+P_MODES = 62  # n blocks of MODE_SIZE
+MODE_K = 0  # omega_k^2 [1/s^2]
+MODE_C = 1  # 2 zeta_k omega_k [1/s]
+MODE_LT = 2  # (3) l_t,k [sqrt(kg)]
+MODE_LR = 5  # (3) l_r,k [sqrt(kg) m]
+MODE_TIP = 8  # (3) tip mode-shape row, frame M [m / (sqrt(kg) m)]
+MODE_DJ = 11  # (9) J'_k = dJ_I / d eta_k, B, row-major [sqrt(kg) m]
+MODE_SIZE = 20
+
+Scale = Annotated[float, Strict(), AllowInfNan(False), Field(gt=0.0, le=1e3)]
+
+
+class ModalAppendageConfig(BaseModel):
+    """An appendage given by its interface-clamped modal data (hybrid coordinates).
+
+    Give the data inline (``data``, a table of the modal data format) or as a file
+    (``file``, ``.toml`` or ``.npz``; a relative path is relative to the working
+    directory). The mount frame is the hub frame rotated by ``mount_yaw_deg`` about Z_B
+    and then ``sadm_angle_deg`` about Y, as for the plate; the data's frame M is it.
+    The ``*_scale`` factors are campaign handles on every mode at once.
+    """
+
+    model_config = ConfigDict(frozen=True, extra="forbid", validate_default=True)
+
+    name: Name
+    model: Literal["modal"] = Field("modal", description="appendage model (registry key)")
+    mount_point_m: Point3 = Field(description="interface point from hub centre of mass, B [m]")
+    mount_yaw_deg: Angle = Field(0.0, description="mount frame rotation about Z_B [deg]")
+    sadm_angle_deg: Angle = Field(0.0, description="SADM angle about Y_M [deg]")
+    mount_matrix: Matrix3 | None = Field(
+        None, description="R_BM (mount -> hub), instead of the two angles"
+    )
+    file: str | None = Field(None, description="modal data file (.toml or .npz)")
+    data: ModalData | None = Field(None, description="modal data (the file's content)")
+    frequency_scale: Scale = Field(1.0, description="factor on every modal frequency [-]")
+    damping_scale: Scale = Field(1.0, description="factor on every damping ratio [-]")
+    participation_scale: Scale = Field(1.0, description="factor on every participation [-]")
+
+    @model_validator(mode="before")
+    @classmethod
+    def _read_file(cls, value: Any) -> Any:
+        if isinstance(value, dict) and value.get("file") is not None and value.get("data") is None:
+            value = {**value, "data": load_modal_data(Path(value["file"])).model_dump()}
+        return value
+
+    @model_validator(mode="after")
+    def _scaled_valid(self) -> ModalAppendageConfig:
+        if self.mount_matrix is not None:
+            if self.mount_yaw_deg or self.sadm_angle_deg:
+                raise ValueError("give either mount_yaw_deg/sadm_angle_deg or mount_matrix")
+            R = np.array(self.mount_matrix, dtype=float)
+            if not np.allclose(R @ R.T, np.eye(3), atol=1e-9) or np.linalg.det(R) < 0.0:
+                raise ValueError("mount_matrix must be a rotation (orthonormal, det +1)")
+        if self.data is None:
+            raise ValueError("give the modal data: file = '<path>' or a data table")
+        self.modal()  # the scaled data must be valid too (effective masses, damping)
+        return self
+
+    def modal(self) -> ModalData:
+        """The modal data with the campaign scale factors applied."""
+        d = self.data
+        unscaled = (self.frequency_scale, self.damping_scale, self.participation_scale)
+        if unscaled == (1.0, 1.0, 1.0):
+            return d
+        p = self.participation_scale
+        return ModalData.model_validate({
+            **d.model_dump(),
+            "frequencies_hz": [f * self.frequency_scale for f in d.frequencies_hz],
+            "damping_ratios": [z * self.damping_scale for z in d.damping_ratios],
+            "participation": [[p * x for x in row] for row in d.participation],
+        })  # fmt: skip
+
+    def mount_rotation(self) -> np.ndarray:
+        """R_BM: ``mount_matrix``, else Rz(yaw) Ry(sadm) (intrinsic Z then Y, as for the
+        plate), shape (3, 3)."""
+        if self.mount_matrix is not None:
+            return np.array(self.mount_matrix, dtype=float)
+        angles = np.radians([self.mount_yaw_deg, self.sadm_angle_deg])
+        return Rotation.from_euler("ZY", angles).as_matrix()
+
+    def tip(self) -> int | None:
+        """Index of the output point called 'tip', else the first one; None: no points."""
+        points = self.data.output_points
+        names = [pt.name for pt in points]
+        return names.index("tip") if "tip" in names else (0 if points else None)
+
+
+@njit(cache=True, error_model="numpy")
+def _modal_sums(q, qd, o, p):
+    """s = L_t^T eta [kg m], s_dot = L_t^T eta_dot and h_r = L_r^T eta_dot (B)."""
+    s, s_dot, h_r = (0.0, 0.0, 0.0), (0.0, 0.0, 0.0), (0.0, 0.0, 0.0)
+    for k in range(int(p[P_N])):
+        b = P_MODES + MODE_SIZE * k
+        l_t, l_r = load_seg(p, b + MODE_LT), load_seg(p, b + MODE_LR)
+        s = add(s, scale(q[o + k], l_t))
+        s_dot = add(s_dot, scale(qd[o + k], l_t))
+        h_r = add(h_r, scale(qd[o + k], l_r))
+    return s, s_dot, h_r
+
+
+@njit(cache=True, error_model="numpy")
+def _madd(a, b, s):
+    """a + s b for 3 x 3 matrices."""
+    return (add(a[0], scale(s, b[0])), add(a[1], scale(s, b[1])), add(a[2], scale(s, b[2])))
+
+
+@njit(cache=True, error_model="numpy")
+def _block(p, r0, c0):
+    """Block [r0:r0+3, c0:c0+3] of the packed residual mass M_rr - L^T L."""
+    k = P_RES + 6 * r0 + c0
+    return (
+        (p[k], p[k + 1], p[k + 2]),
+        (p[k + 6], p[k + 7], p[k + 8]),
+        (p[k + 12], p[k + 13], p[k + 14]),
+    )
+
+
+@njit(cache=True, error_model="numpy")
+def _add_inertia(hub, r0, c0, A):
+    for a in range(3):
+        for b in range(3):
+            hub[HUB_INERTIA + 6 * (r0 + a) + c0 + b] += A[a][b]
+
+
+@njit(cache=True, error_model="numpy")
+def _inertia(q, qd, o, p):
+    """J(eta) = J_I + sum_k eta_k J'_k and its rate sum_k eta_dot_k J'_k (B)."""
+    J, J_dot = load_m33_at(p, P_J_I), ((0.0, 0.0, 0.0), (0.0, 0.0, 0.0), (0.0, 0.0, 0.0))
+    for k in range(int(p[P_N])):
+        dJ = load_m33_at(p, P_MODES + MODE_SIZE * k + MODE_DJ)
+        J = _madd(J, dJ, q[o + k])
+        J_dot = _madd(J_dot, dJ, qd[o + k])
+    return J, J_dot
+
+
+@njit(cache=True, error_model="numpy")
+def _centrifugal(p, k, omega):
+    """1/2 omega^T J'_k omega: the centrifugal generalized force on mode k (-dT/d eta_k)."""
+    return 0.5 * dot(omega, mv(load_m33_at(p, P_MODES + MODE_SIZE * k + MODE_DJ), omega))
+
+
+@njit(cache=True, error_model="numpy")
+def _inertia_about_hub(p, J, r, c1):
+    """Inertia about the hub centre of mass (at -r from the interface) of a body with
+    inertia J about the interface and first moment c1 there:
+    J - m [r]x [r]x - [r]x [c1]x - [c1]x [r]x (parallel axes)."""
+    R, C = skew(r), skew(c1)
+    J = _madd(J, mm(R, R), -p[P_MASS])
+    return _madd(_madd(J, mm(R, C), -1.0), mm(C, R), -1.0)
+
+
+@njit(PASS1_SIGNATURE, cache=True, error_model="numpy")
+def pass1(q, qd, Q, members, params, work, hub, qdd):
+    """Wrench on the hub at zero hub acceleration and the articulated inertia X^T M_I X.
+
+    Leaves the modal forces f_k in the member's rows of ``qdd`` for :func:`pass2`.
+    """
+    omega = load_seg(hub, HUB_OMEGA)
+    for j in range(members.shape[0]):
+        o, p = members[j, 1], params[j]
+        r = load_seg(p, P_MOUNT)
+        s, s_dot, h_r = _modal_sums(q, qd, o, p)
+        J, J_dot = _inertia(q, qd, o, p)
+        g_t, g_r = (0.0, 0.0, 0.0), (0.0, 0.0, 0.0)
+        for k in range(int(p[P_N])):
+            b = P_MODES + MODE_SIZE * k
+            f = Q[o + k] - p[b + MODE_K] * q[o + k] - p[b + MODE_C] * qd[o + k]
+            f += _centrifugal(p, k, omega)
+            qdd[o + k] = f
+            g_t = add(g_t, scale(f, load_seg(p, b + MODE_LT)))
+            g_r = add(g_r, scale(f, load_seg(p, b + MODE_LR)))
+            hub[HUB_DISSIPATION] += p[b + MODE_C] * qd[o + k] ** 2  # eq. 2.36
+        c1 = add(load_seg(p, P_FIRST), s)  # c~ = m c + L_t^T eta
+        # M_I = [[A, B], [C, D]] = M_res + [[0, -[s]x], [[s]x, J(eta) - J_I]], about I.
+        S = skew(s)
+        A = _block(p, 0, 0)
+        D = _madd(_madd(_block(p, 3, 3), J, 1.0), load_m33_at(p, P_J_I), -1.0)
+        B, C = _madd(_block(p, 0, 3), S, -1.0), _madd(_block(p, 3, 0), S, 1.0)
+        # Wrench on the appendage at a_hub = 0, alpha = 0: M_I [w x (w x r); 0] + b_a.
+        w2r = cross(omega, cross(omega, r))
+        F = add(add(cross(omega, cross(omega, c1)), scale(2.0, cross(omega, s_dot))), g_t)
+        F = add(F, mv(A, w2r))
+        N = add(add(cross(omega, mv(J, omega)), cross(omega, h_r)), g_r)
+        N = add(add(N, mv(C, w2r)), mv(J_dot, omega))
+        T = add(N, cross(r, F))
+        for a in range(3):
+            hub[HUB_FORCE + a] -= F[a]
+            hub[HUB_TORQUE + a] -= T[a]
+        # X^T M_I X with X = [[I, -[r]x], [0, I]]:
+        # [[A, B - A R], [R A + C, R (B - A R) + D - C R]], R = [r]x.
+        R = skew(r)
+        top_right = _madd(B, mm(A, R), -1.0)
+        _add_inertia(hub, 0, 0, A)
+        _add_inertia(hub, 0, 3, top_right)
+        _add_inertia(hub, 3, 0, _madd(C, mm(R, A), 1.0))
+        _add_inertia(hub, 3, 3, _madd(_madd(D, mm(R, top_right), 1.0), mm(C, R), -1.0))
+    return STATUS_OK
+
+
+@njit(PASS2_SIGNATURE, cache=True, error_model="numpy")
+def pass2(q, qd, members, params, work, hub, qdd):
+    """eta_ddot_k = f_k - l_t,k . a_I - l_r,k . alpha, a_I the interface acceleration."""
+    omega = load_seg(hub, HUB_OMEGA)
+    a_hub = load_seg(hub, HUB_ACC)
+    alpha = load_seg(hub, HUB_ALPHA)
+    for j in range(members.shape[0]):
+        o, p = members[j, 1], params[j]
+        r = load_seg(p, P_MOUNT)
+        a_I = add(add(a_hub, cross(alpha, r)), cross(omega, cross(omega, r)))
+        for k in range(int(p[P_N])):
+            b = P_MODES + MODE_SIZE * k
+            qdd[o + k] -= dot(load_seg(p, b + MODE_LT), a_I) + dot(load_seg(p, b + MODE_LR), alpha)
+    return STATUS_OK
+
+
+@njit(MASS_SIGNATURE, cache=True, error_model="numpy")
+def mass_matrix(q, members, params, M):
+    """The modal appendages' share of M(q), from T with v = R_BN r_dot - [r]x S Theta_dot
+    and omega = S Theta_dot (module notes)."""
+    R_NB = rot_zyx(q[3], q[4], q[5])
+    S = euler_rate_matrix(q[3], q[4])
+    identity = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
+    for j in range(members.shape[0]):
+        o, p = members[j, 1], params[j]
+        m, r = p[P_MASS], load_seg(p, P_MOUNT)
+        s, _, _ = _modal_sums(q, q, o, p)
+        c1 = add(load_seg(p, P_FIRST), s)
+        first_hub = add(scale(m, r), c1)  # first moment about the hub centre of mass
+        add_block(M, 0, 0, identity, m)
+        add_block(M, 0, 3, mm(R_NB, mm(skew(first_hub), S)), -1.0)
+        J, _ = _inertia(q, q, o, p)
+        add_block(M, 3, 3, mtm(S, mm(_inertia_about_hub(p, J, r, c1), S)), 1.0)
+        for k in range(int(p[P_N])):
+            b = P_MODES + MODE_SIZE * k
+            l_t, l_r = load_seg(p, b + MODE_LT), load_seg(p, b + MODE_LR)
+            row_r = mv(R_NB, l_t)
+            row_theta = mtv(S, add(cross(r, l_t), l_r))
+            for a in range(3):
+                M[o + k, a] += row_r[a]
+                M[a, o + k] += row_r[a]
+                M[o + k, 3 + a] += row_theta[a]
+                M[3 + a, o + k] += row_theta[a]
+            M[o + k, o + k] += 1.0
+
+
+@njit(BIAS_SIGNATURE, cache=True, error_model="numpy")
+def bias_forces(q, qd, members, params, hub, h):
+    """The modal appendages' share of h(q, q_dot): their inertia forces at q_ddot = 0
+    (a_hub = 0, alpha = S_dot Theta_dot, eta_ddot = 0)."""
+    R_NB = rot_zyx(q[3], q[4], q[5])
+    omega = load_seg(hub, HUB_OMEGA)
+    alpha = load_seg(hub, HUB_SBIAS)
+    for j in range(members.shape[0]):
+        o, p = members[j, 1], params[j]
+        m, r = p[P_MASS], load_seg(p, P_MOUNT)
+        s, s_dot, h_r = _modal_sums(q, qd, o, p)
+        c1 = add(load_seg(p, P_FIRST), s)
+        J, J_dot = _inertia(q, qd, o, p)
+        a_I = add(cross(alpha, r), cross(omega, cross(omega, r)))
+        F = add(add(scale(m, a_I), cross(alpha, c1)),
+                add(cross(omega, cross(omega, c1)), scale(2.0, cross(omega, s_dot))))
+        N = add(add(add(cross(c1, a_I), mv(J, alpha)), mv(J_dot, omega)),
+                add(cross(omega, mv(J, omega)), cross(omega, h_r)))  # fmt: skip
+        F_N = mv(R_NB, F)
+        T = add(N, cross(r, F))
+        for a in range(3):
+            hub[HUB_FORCE + a] += F_N[a]
+            hub[HUB_TORQUE + a] += T[a]
+        for k in range(int(p[P_N])):
+            b = P_MODES + MODE_SIZE * k
+            h[o + k] = (dot(load_seg(p, b + MODE_LT), a_I) + dot(load_seg(p, b + MODE_LR), alpha)
+                        - _centrifugal(p, k, omega))
+
+
+@njit(OBSERVE_SIGNATURE, cache=True, error_model="numpy")
+def observe(q, qd, members, params, out):
+    """Kinetic energy T, momentum about the inertial origin, locked inertia, U and 2 D."""
+    R_NB = rot_zyx(q[3], q[4], q[5])
+    omega = mv(euler_rate_matrix(q[3], q[4]), load_seg(qd, 3))
+    v_hub = mtv(R_NB, load_seg(qd, 0))
+    r_hub = load_seg(q, 0)
+    for j in range(members.shape[0]):
+        o, p = members[j, 1], params[j]
+        m, r = p[P_MASS], load_seg(p, P_MOUNT)
+        s, s_dot, h_r = _modal_sums(q, qd, o, p)
+        c1 = add(load_seg(p, P_FIRST), s)
+        J, _ = _inertia(q, qd, o, p)
+        v = add(v_hub, cross(omega, r))
+        kinetic = 0.5 * m * dot(v, v) + dot(v, cross(omega, c1)) + 0.5 * dot(omega, mv(J, omega))
+        kinetic += dot(v, s_dot) + dot(omega, h_r)
+        for k in range(int(p[P_N])):
+            b = P_MODES + MODE_SIZE * k
+            kinetic += 0.5 * qd[o + k] ** 2
+            out[OBS_ELASTIC] += 0.5 * p[b + MODE_K] * q[o + k] ** 2
+            out[OBS_DISSIPATION] += p[b + MODE_C] * qd[o + k] ** 2
+        out[OBS_KINETIC] += kinetic
+        # Momentum at the interface: P = m v + omega x c~ + s_dot, H_I = c~ x v + J_I omega
+        # + h_r; about the inertial origin: p_I x P + H_I (frame N).
+        P = add(add(scale(m, v), cross(omega, c1)), s_dot)
+        H_I = add(add(cross(c1, v), mv(J, omega)), h_r)
+        p_I = add(r_hub, mv(R_NB, r))
+        H = add(cross(p_I, mv(R_NB, P)), mv(R_NB, H_I))
+        J_O = _inertia_about_hub(p, J, r, c1)
+        for a in range(3):
+            out[OBS_MOMENTUM + a] += H[a]
+            for b in range(3):
+                out[OBS_LOCKED_INERTIA + 3 * a + b] += J_O[a][b]
+
+
+@njit(WRENCH_SIGNATURE, cache=True, error_model="numpy")
+def joint_wrench(q, qd, Q, members, params, out):
+    """Add the modes' elastic, damping and external forces transmitted to the hub:
+    sum_k l_k (omega_k^2 eta_k + 2 zeta_k omega_k eta_dot_k - Q_k) at the interface."""
+    for j in range(members.shape[0]):
+        o, p = members[j, 1], params[j]
+        r = load_seg(p, P_MOUNT)
+        F, N = (0.0, 0.0, 0.0), (0.0, 0.0, 0.0)
+        for k in range(int(p[P_N])):
+            b = P_MODES + MODE_SIZE * k
+            e = p[b + MODE_K] * q[o + k] + p[b + MODE_C] * qd[o + k] - Q[o + k]
+            F = add(F, scale(e, load_seg(p, b + MODE_LT)))
+            N = add(N, scale(e, load_seg(p, b + MODE_LR)))
+        T = add(N, cross(r, F))
+        for a in range(3):
+            out[a] += F[a]
+            out[3 + a] += T[a]
+    return STATUS_OK
+
+
+@njit(TIPS_SIGNATURE, cache=True, error_model="numpy")
+def tips(q, members, params, out):
+    """Tip displacement sum_k psi_tip,k eta_k, mount frame [m]."""
+    for j in range(members.shape[0]):
+        o, p = members[j, 1], params[j]
+        d = (0.0, 0.0, 0.0)
+        for k in range(int(p[P_N])):
+            d = add(d, scale(q[o + k], load_seg(p, P_MODES + MODE_SIZE * k + MODE_TIP)))
+        i = members[j, 0]
+        out[i, 0], out[i, 1], out[i, 2] = d
+
+
+class ModalModel(AppendageModel):
+    """A hybrid-coordinate appendage (:class:`ModalAppendageConfig`) rigidly mounted."""
+
+    name = "modal"
+    config_class = ModalAppendageConfig
+    kernels = AppendageKernels(pass1, pass2, mass_matrix, bias_forces, observe, joint_wrench, tips)
+    transmits_inertia = True
+
+    def coordinates(self, config: ModalAppendageConfig) -> tuple[Coordinate, ...]:
+        return tuple(Coordinate(f"q{k + 1}", "kg^0.5 m") for k in range(config.data.n_modes))
+
+    def pack(self, config: ModalAppendageConfig) -> np.ndarray:
+        data = config.modal()
+        n = data.n_modes
+        R = config.mount_rotation()
+        R6 = np.kron(np.eye(2), R)
+        L_M = data.participation_matrix()
+        row = np.zeros(P_MODES + MODE_SIZE * n)
+        row[P_MOUNT : P_MOUNT + 3] = config.mount_point_m
+        row[P_R_BM : P_R_BM + 9] = R.ravel()
+        row[P_MASS] = data.mass_kg
+        row[P_FIRST : P_FIRST + 3] = data.mass_kg * R @ np.asarray(data.center_of_mass_m)
+        row[P_J_I : P_J_I + 9] = (R @ np.asarray(data.inertia_interface_kg_m2) @ R.T).ravel()
+        residual = data.rigid_mass_matrix() - L_M.T @ L_M
+        row[P_RES : P_RES + 36] = (R6 @ residual @ R6.T).ravel()
+        row[P_N] = n
+        omega = 2.0 * np.pi * np.asarray(data.frequencies_hz, dtype=float)
+        modes = row[P_MODES:].reshape(n, MODE_SIZE)
+        modes[:, MODE_K] = omega**2
+        modes[:, MODE_C] = 2.0 * np.asarray(data.damping_ratios, dtype=float) * omega
+        modes[:, MODE_LT : MODE_LT + 3] = L_M[:, :3] @ R.T
+        modes[:, MODE_LR : MODE_LR + 3] = L_M[:, 3:] @ R.T
+        tip = config.tip()
+        if tip is not None:
+            modes[:, MODE_TIP : MODE_TIP + 3] = data.output_points[tip].mode_shapes
+        modes[:, MODE_DJ : MODE_DJ + 9] = (R @ data.inertia_derivative_array() @ R.T).reshape(n, 9)
+        return row
+
+    @staticmethod
+    def _modes(params: np.ndarray) -> np.ndarray:
+        n = int(params[P_N])
+        return params[P_MODES : P_MODES + MODE_SIZE * n].reshape(n, MODE_SIZE)
+
+    def rigid_body(self, params: np.ndarray) -> RigidBody:
+        m = float(params[P_MASS])
+        c = params[P_FIRST : P_FIRST + 3] / m
+        C = np.array(skew(tuple(c)))
+        J_cm = params[P_J_I : P_J_I + 9].reshape(3, 3) + m * C @ C
+        return RigidBody(m, params[P_MOUNT : P_MOUNT + 3] + c, J_cm)
+
+    def stiffness(self, params: np.ndarray) -> np.ndarray:
+        return self._modes(params)[:, MODE_K].copy()
+
+    def damping(self, params: np.ndarray) -> np.ndarray:
+        return self._modes(params)[:, MODE_C].copy()
+
+    def with_joints(self, params: np.ndarray, stiffness: np.ndarray, damping: np.ndarray
+                    ) -> np.ndarray:  # fmt: skip
+        row = params.copy()
+        modes = self._modes(row)
+        modes[:, MODE_K] = stiffness
+        modes[:, MODE_C] = damping
+        return row
+
+    def describe(self, config: ModalAppendageConfig, params: np.ndarray) -> dict:
+        data = config.modal()
+        return {
+            "mass_kg": data.mass_kg,
+            "n_modes": data.n_modes,
+            "frequencies_hz": list(data.frequencies_hz),
+            "damping_ratios": list(data.damping_ratios),
+        }
+
+    def shape_points(self, config: ModalAppendageConfig, params: np.ndarray,
+                     q_block: np.ndarray) -> np.ndarray:  # fmt: skip
+        # A segment from the interface to the tip output point (deformed), drawn as a
+        # degenerate outline; without output points, from the interface to twice the
+        # centre of mass.
+        R = params[P_R_BM : P_R_BM + 9].reshape(3, 3)
+        root = params[P_MOUNT : P_MOUNT + 3]
+        tip = config.tip()
+        if tip is None:
+            end = root + 2.0 * R @ np.asarray(config.data.center_of_mass_m)
+        else:
+            point = config.data.output_points[tip]
+            rows = self._modes(params)[:, MODE_TIP : MODE_TIP + 3]
+            moved = np.asarray(point.position_m) + rows.T @ q_block
+            end = root + R @ moved
+        return np.array([root, root, end, end, root, end])
+
+    def extent(self, config: ModalAppendageConfig) -> float:
+        tip = config.tip()
+        if tip is None:
+            return 2.0 * float(np.linalg.norm(config.data.center_of_mass_m))
+        return float(np.linalg.norm(config.data.output_points[tip].position_m))
+
+    @staticmethod
+    def mount_rotation(params: np.ndarray) -> np.ndarray:
+        """R_BM of a packed row, shape (3, 3)."""
+        return params[P_R_BM : P_R_BM + 9].reshape(3, 3)
+
+    def mode_kinds(self, config: ModalAppendageConfig) -> tuple[str, ...]:
+        return tuple(f"mode_{k + 1}" for k in range(config.data.n_modes))
