@@ -13,12 +13,14 @@ from flexsat.config.models import SatelliteConfig
 from flexsat.control.laws import get_law
 from flexsat.control.quaternion import pointing_errors, target_quaternion
 from flexsat.control.stages import ACTUATORS, SENSORS
+from flexsat.control.stages.registry import no_derivative
 from flexsat.dynamics.integrators import rk4_hold
 from flexsat.dynamics.plant import Plant
 from flexsat.dynamics.rigid import rigid_inertia
 from flexsat.dynamics.status import STATUS_CONTROL_FAILED
 from flexsat.errors import SimulationError
 from flexsat.simulate.common import PROGRESS_MIN_STEPS, chunk_steps, progress_bar, run_attributes
+from flexsat.simulate.coupled import LoopFlow, rk4_coupled_hold
 from flexsat.simulate.layout import LoopLayout
 from flexsat.simulate.loops import (
     LoopClock,
@@ -26,12 +28,14 @@ from flexsat.simulate.loops import (
     LoopRecords,
     LoopStages,
     rk4_closed_loop,
+    run_actuators,
+    run_sensors,
 )
 from flexsat.simulate.openloop import initial_state
 from flexsat.simulate.result import Result, build_dataset
 from flexsat.simulate.scenario import SlewScenario
 
-__all__ = ["Controller", "design_inertia", "run_slew", "slew_design_inertia"]
+__all__ = ["Controller", "design_inertia", "loop_layout", "run_slew", "slew_design_inertia"]
 
 
 class Controller(Protocol):
@@ -108,8 +112,7 @@ def run_slew(
         slew_design_inertia(plant, scenario) if design_J is None else design_J, dtype=float
     )
     law = get_law(scenario.controller.kind)
-    layout = LoopLayout(plant.layout, law, SENSORS.get(scenario.sensor.kind),
-                        ACTUATORS.get(scenario.actuator.kind))  # fmt: skip
+    layout = loop_layout(plant, scenario)
     q0, qd0 = initial_state(plant, scenario)
     steps, every = scenario.n_steps, scenario.record_every
     n_records = steps // every + 2  # + the last good state of a failed run
@@ -118,16 +121,21 @@ def run_slew(
     rec_ctrl = np.full((n_records, layout.record_size), np.nan)
     x = np.concatenate([q0, qd0, [0.0, 0.0]])
     data = _loop_data(layout, scenario, J)
-    stages = LoopStages((layout.sensor.step,), (law.step,), (layout.actuator.step,))
+    stages = LoopStages(
+        tuple(s.step for s in layout.sensors), (law.step,),
+        tuple(s.step for s in layout.actuators),
+        tuple(s.derivative or no_derivative for s in layout.actuators),
+    )  # fmt: skip
     show = steps >= PROGRESS_MIN_STEPS if progress is None else progress
     start = time.perf_counter()
     with progress_bar(show, scenario.duration_s) as (bar, task):
         if controller is None:
             status, done, rows = _compiled_loop(plant, scenario, x, stages, data, rec_t, rec_x,
-                                                rec_ctrl, bar, task)  # fmt: skip
+                                                rec_ctrl, bar, task, layout.continuous)  # fmt: skip
         else:
             status, done, rows = _python_loop(plant, scenario, x, stages, data, rec_t, rec_x,
-                                              rec_ctrl, bar, task, controller)  # fmt: skip
+                                              rec_ctrl, bar, task, controller,
+                                              layout.continuous)  # fmt: skip
     wall = time.perf_counter() - start
     t_fail = done * scenario.dt_s if status else -1.0
     if status:  # keep the last good state as the final record
@@ -137,14 +145,14 @@ def run_slew(
     attrs = run_attributes(plant, scenario, "closed-loop", status, t_fail, wall, done)
     attrs["controller"] = law.name if controller is None else "python"
     attrs["controller_label"] = law.label if controller is None else "Python law"
-    attrs["sensor"] = layout.sensor.name
-    attrs["actuator"] = layout.actuator.name
+    attrs["sensor"] = " > ".join(s.name for s in layout.sensors)
+    attrs["actuator"] = " > ".join(s.name for s in layout.actuators)
     if controller is None:
         attrs.update(scenario.controller.plot_attributes())
     attrs["design_inertia"] = J.ravel().tolist()
     attrs["target_quaternion"] = data.q_d.tolist()
     # gain (3), environment (3), sloshing ratio and Hz, residual (3), T_max
-    attrs["realised_disturbances"] = data.actuator_params.tolist()
+    attrs["realised_disturbances"] = data.actuator_params[-1].tolist()
     at = layout.plant  # where each piece of the plant state lives
     ds = build_dataset(
         plant, rec_t, rec_x[:, at.q], rec_x[:, at.qd], rec_x[:, at.work_in],
@@ -172,13 +180,37 @@ def run_slew(
     return Result(ds)
 
 
+def loop_layout(plant: Plant, scenario: SlewScenario) -> LoopLayout:
+    """Where a slew's states and records live: its law and its two stage chains."""
+    chain = scenario.stage_chain()
+    n_sensors = 1 + len(scenario.sensor_stages)
+    sensors = tuple(SENSORS.get(c.kind) for _, c in chain[:n_sensors])
+    actuators = tuple(ACTUATORS.get(c.kind) for _, c in chain[n_sensors:])
+    return LoopLayout(plant.layout, get_law(scenario.controller.kind), sensors, actuators)
+
+
 def _loop_data(layout: LoopLayout, scenario: SlewScenario, J: np.ndarray) -> LoopData:
     """The arrays of one run, record-row pieces as views into ``held``."""
     held = np.zeros(layout.record_size)
     state = np.zeros(layout.state_size)
+    chain = [c for _, c in scenario.stage_chain()]
+    n_sensors = len(layout.sensors)
 
     def packed(values) -> np.ndarray:
         return np.ascontiguousarray(values, dtype=float)
+
+    block = layout.actuator_state
+    m = block.stop - block.start
+    evaluation, rate = np.zeros(m), np.zeros(m)
+
+    def local(array: np.ndarray, pieces: tuple[slice, ...]) -> tuple:
+        return tuple(array[p.start - block.start : p.stop - block.start] for p in pieces)
+
+    flow = LoopFlow(
+        state=state[block], eval=evaluation, eval_views=local(evaluation, layout.actuator_states),
+        dot=rate, dot_views=local(rate, layout.actuator_states), k=np.zeros((4, m)),
+        wrench=np.zeros(3), held=np.zeros(3),
+    )  # fmt: skip
 
     return LoopData(
         J_design=J,
@@ -187,22 +219,25 @@ def _loop_data(layout: LoopLayout, scenario: SlewScenario, J: np.ndarray) -> Loo
         omega_dot_d=np.zeros(3),
         law_gains=packed(scenario.controller.gains(scenario.actuator)),
         law_state=state[layout.law_state],
-        sensor_params=packed(scenario.sensor.packed(scenario)),
-        sensor_state=state[layout.sensor_state],
-        actuator_params=packed(scenario.actuator.packed(scenario)),
-        actuator_state=state[layout.actuator_state],
+        sensor_params=tuple(packed(c.packed(scenario)) for c in chain[:n_sensors]),
+        sensor_state=tuple(state[p] for p in layout.sensor_states),
+        actuator_params=tuple(packed(c.packed(scenario)) for c in chain[n_sensors:]),
+        actuator_state=tuple(state[p] for p in layout.actuator_states),
         q_meas=np.zeros(4),
         omega_meas=np.zeros(3),
         held=held,
         tau_cmd=held[layout.tau_cmd],
         tau_applied=held[layout.tau_applied],
         law_diag=held[layout.law_diag],
-        sensor_record=held[layout.sensor_record],
-        actuator_record=held[layout.actuator_record],
+        sensor_record=tuple(held[p] for p in layout.sensor_records),
+        actuator_record=tuple(held[p] for p in layout.actuator_records),
+        tau_between=np.zeros(3),
+        flow=flow,
     )
 
 
-def _compiled_loop(plant, scenario, x, stages, data, rec_t, rec_x, rec_ctrl, bar, task):
+def _compiled_loop(plant, scenario, x, stages, data, rec_t, rec_x, rec_ctrl, bar, task,
+                   continuous):  # fmt: skip
     """The whole loop, stages and law included, in compiled chunks."""
     steps, every, control = scenario.n_steps, scenario.record_every, scenario.control_every
     chunk = chunk_steps(every, control)
@@ -210,7 +245,8 @@ def _compiled_loop(plant, scenario, x, stages, data, rec_t, rec_x, rec_ctrl, bar
     while status == 0:
         n_chunk = min(chunk, steps - done)
         final = done + n_chunk == steps
-        clock = LoopClock(done * scenario.dt_s, scenario.dt_s, n_chunk, final, control, every)
+        clock = LoopClock(done * scenario.dt_s, scenario.dt_s, n_chunk, final, control, every,
+                          continuous)  # fmt: skip
         status, ran, written = rk4_closed_loop(
             x, clock, stages, data, LoopRecords(rec_t, rec_x, rec_ctrl, rows), plant.packed
         )
@@ -223,7 +259,8 @@ def _compiled_loop(plant, scenario, x, stages, data, rec_t, rec_x, rec_ctrl, bar
     return status, done, rows
 
 
-def _python_loop(plant, scenario, x, stages, d, rec_t, rec_x, rec_ctrl, bar, task, controller):
+def _python_loop(plant, scenario, x, stages, d, rec_t, rec_x, rec_ctrl, bar, task, controller,
+                 continuous):  # fmt: skip
     """Python controller at each control instant between the compiled stages; the plant
     steps compiled in between."""
     n = plant.n_dof
@@ -236,16 +273,12 @@ def _python_loop(plant, scenario, x, stages, d, rec_t, rec_x, rec_ctrl, bar, tas
     while True:
         t = k * scenario.dt_s
         if k % control == 0:
-            status = stages.sensor[0](x, n, t, d.sensor_params, d.sensor_state, d.q_meas,
-                                      d.omega_meas, d.sensor_record)  # fmt: skip
+            status = run_sensors(x, n, t, stages, d)
             tau_cmd = np.asarray(controller(t, d.q_meas.copy(), d.omega_meas.copy()), dtype=float)
             if tau_cmd.shape != (3,) or not np.all(np.isfinite(tau_cmd)):
                 raise SimulationError(f"controller returned {tau_cmd!r} at t = {t:.6g} s")
             d.tau_cmd[:] = np.clip(tau_cmd, -limit, limit)
-            status |= stages.actuator[0](
-                d.tau_cmd, t, control_dt, d.actuator_params, d.actuator_state, d.tau_applied,
-                d.actuator_record,
-            )  # fmt: skip
+            status |= run_actuators(x, n, t, control_dt, continuous, stages, d)
             if status:
                 return STATUS_CONTROL_FAILED, k, rows
         if k % every == 0:
@@ -253,8 +286,12 @@ def _python_loop(plant, scenario, x, stages, d, rec_t, rec_x, rec_ctrl, bar, tas
             rows += 1
         if k == steps:
             return 0, k, rows
-        torque = (d.tau_applied[0], d.tau_applied[1], d.tau_applied[2])
-        status, ran = rk4_hold(x, scenario.dt_s, block, torque, plant.packed)
+        if continuous:
+            status, ran = rk4_coupled_hold(x, t, scenario.dt_s, block, stages.derivative,
+                                           d.actuator_params, d.flow, plant.packed)  # fmt: skip
+        else:
+            torque = (d.tau_applied[0], d.tau_applied[1], d.tau_applied[2])
+            status, ran = rk4_hold(x, scenario.dt_s, block, torque, plant.packed)
         k += ran
         if status:
             return status, k, rows

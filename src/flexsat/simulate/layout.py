@@ -24,34 +24,52 @@ class LoopLayout:
     Plant state ``x``: the plant's own :class:`~flexsat.dynamics.layout.StateLayout`
     (``plant``: q, q_dot, each appendage's block, work and dissipation).
 
-    Control state (``state_size``,): the law's ``[law_state]``, the sensor's
-    ``[sensor_state]`` and the actuator's ``[actuator_state]``, zero at t = 0.
+    Control state (``state_size``,): the law's ``[law_state]``, the sensing chain's
+    ``[sensor_state]`` (each stage's in chain order) and the actuation chain's
+    ``[actuator_state]`` (likewise), zero at t = 0. The actuation block is one
+    contiguous piece: the entries the stages' derivatives integrate live there.
 
     Control record row (``record_size``,), held between control instants:
     ``[tau_cmd]`` (3) and ``[tau_applied]`` (3) [N m], the law's diagnostics
-    ``[law_diag]``, the sensor's and the actuator's records.
+    ``[law_diag]``, the sensing chain's and the actuation chain's records.
+
+    ``sensors`` and ``actuators`` are the chains in order (a single
+    :class:`~flexsat.control.stages.StageSpec` is a chain of one).
     """
 
     plant: StateLayout
     law: LawSpec
-    sensor: StageSpec
-    actuator: StageSpec
+    sensors: tuple[StageSpec, ...]
+    actuators: tuple[StageSpec, ...]
 
     @property
     def law_state(self) -> slice:
         return slice(0, self.law.state_size)
 
     @property
+    def sensor_states(self) -> tuple[slice, ...]:
+        return _pieces(self.law_state.stop, [s.state_size for s in self.sensors])
+
+    @property
     def sensor_state(self) -> slice:
-        return _after(self.law_state, self.sensor.state_size)
+        return _span(self.law_state.stop, self.sensor_states)
+
+    @property
+    def actuator_states(self) -> tuple[slice, ...]:
+        return _pieces(self.sensor_state.stop, [s.state_size for s in self.actuators])
 
     @property
     def actuator_state(self) -> slice:
-        return _after(self.sensor_state, self.actuator.state_size)
+        return _span(self.sensor_state.stop, self.actuator_states)
 
     @property
     def state_size(self) -> int:
         return self.actuator_state.stop
+
+    @property
+    def continuous(self) -> bool:
+        """True if an actuation stage integrates states inside the RK4 steps."""
+        return any(s.derivative is not None for s in self.actuators)
 
     tau_cmd = slice(0, 3)
     tau_applied = slice(3, 6)
@@ -61,12 +79,20 @@ class LoopLayout:
         return _after(self.tau_applied, self.law.diag_size)
 
     @property
+    def sensor_records(self) -> tuple[slice, ...]:
+        return _pieces(self.law_diag.stop, [s.record_size for s in self.sensors])
+
+    @property
     def sensor_record(self) -> slice:
-        return _after(self.law_diag, self.sensor.record_size)
+        return _span(self.law_diag.stop, self.sensor_records)
+
+    @property
+    def actuator_records(self) -> tuple[slice, ...]:
+        return _pieces(self.sensor_record.stop, [s.record_size for s in self.actuators])
 
     @property
     def actuator_record(self) -> slice:
-        return _after(self.sensor_record, self.actuator.record_size)
+        return _span(self.sensor_record.stop, self.actuator_records)
 
     @property
     def record_size(self) -> int:
@@ -74,19 +100,37 @@ class LoopLayout:
 
     def channels(self) -> Iterator[tuple[Channel, slice]]:
         """Each declared channel of the law and the stages with its record columns."""
-        for block, channels in ((self.law_diag, self.law.diagnostics),
-                                (self.sensor_record, self.sensor.records),
-                                (self.actuator_record, self.actuator.records)):  # fmt: skip
+        stages = self.sensors + self.actuators
+        records = self.sensor_records + self.actuator_records
+        blocks = [(self.law_diag, self.law.diagnostics)]
+        blocks += [(r, s.records) for r, s in zip(records, stages, strict=True)]
+        for block, channels in blocks:
             start = block.start
             for channel in channels:
                 yield channel, slice(start, start + channel.size)
                 start += channel.size
 
     def __post_init__(self) -> None:
+        for chain in ("sensors", "actuators"):
+            value = getattr(self, chain)
+            object.__setattr__(self, chain, (value,) if isinstance(value, StageSpec)
+                               else tuple(value))  # fmt: skip
         names = [c.name for c, _ in self.channels()]
         clash = {n for n in names if names.count(n) > 1} | (set(names) & set(_LOOP_COLUMNS))
         if clash:
             raise ValueError(f"recorded channels named twice: {', '.join(sorted(clash))}")
+
+
+def _pieces(start: int, sizes: list[int]) -> tuple[slice, ...]:
+    out = []
+    for size in sizes:
+        out.append(slice(start, start + size))
+        start += size
+    return tuple(out)
+
+
+def _span(start: int, pieces: tuple[slice, ...]) -> slice:
+    return slice(start, pieces[-1].stop if pieces else start)
 
 
 def _after(previous: slice, size: int) -> slice:

@@ -9,6 +9,7 @@ from flexsat.control.stages.ideal_sensor import IDEAL_SENSOR
 from flexsat.control.stages.registry import (
     ACTUATOR_SIGNATURE,
     ACTUATORS,
+    DERIVATIVE_SIGNATURE,
     SENSOR_SIGNATURE,
     SENSORS,
     ActuatorStageConfig,
@@ -17,13 +18,16 @@ from flexsat.control.stages.registry import (
     register_actuator,
     register_sensor,
     validate_actuator_config,
+    validate_actuator_stage,
     validate_sensor_config,
+    validate_sensor_stage,
 )
 from flexsat.control.stages.static_actuator import STATIC_ACTUATOR
 
 __all__ = [
     "ACTUATORS",
     "ACTUATOR_SIGNATURE",
+    "DERIVATIVE_SIGNATURE",
     "SENSORS",
     "SENSOR_SIGNATURE",
     "ActuatorStageConfig",
@@ -32,7 +36,9 @@ __all__ = [
     "register_actuator",
     "register_sensor",
     "validate_actuator_config",
+    "validate_actuator_stage",
     "validate_sensor_config",
+    "validate_sensor_stage",
 ]
 
 register_sensor(IDEAL_SENSOR, default=True)
