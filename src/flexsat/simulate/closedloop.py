@@ -199,12 +199,15 @@ def _loop_data(layout: LoopLayout, scenario: SlewScenario, J: np.ndarray) -> Loo
     def packed(values) -> np.ndarray:
         return np.ascontiguousarray(values, dtype=float)
 
-    block = layout.actuator_state
+    block = layout.continuous_state
     m = block.stop - block.start
     evaluation, rate = np.zeros(m), np.zeros(m)
 
     def local(array: np.ndarray, pieces: tuple[slice, ...]) -> tuple:
-        return tuple(array[p.start - block.start : p.stop - block.start] for p in pieces)
+        """Each stage's piece of a flow array (empty for a stage outside the block)."""
+        within = [block.start <= p.start and p.stop <= block.stop for p in pieces]
+        return tuple(array[p.start - block.start : p.stop - block.start] if ok else array[:0]
+                     for p, ok in zip(pieces, within, strict=True))  # fmt: skip
 
     flow = LoopFlow(
         state=state[block], eval=evaluation, eval_views=local(evaluation, layout.actuator_states),

@@ -71,6 +71,16 @@ class LoopLayout:
         """True if an actuation stage integrates states inside the RK4 steps."""
         return any(s.derivative is not None for s in self.actuators)
 
+    @property
+    def continuous_state(self) -> slice:
+        """The piece of the actuation block the coupled RK4 step carries: from the first
+        stage with a derivative to the last (empty without one)."""
+        pieces = [p for p, s in zip(self.actuator_states, self.actuators, strict=True)
+                  if s.derivative is not None]  # fmt: skip
+        if not pieces:
+            return slice(self.actuator_state.stop, self.actuator_state.stop)
+        return slice(pieces[0].start, pieces[-1].stop)
+
     tau_cmd = slice(0, 3)
     tau_applied = slice(3, 6)
 

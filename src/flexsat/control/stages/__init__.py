@@ -5,6 +5,7 @@ your own file (see ``docs/control.md``): a parameter model, a compiled step of
 :data:`SENSOR_SIGNATURE` or :data:`ACTUATOR_SIGNATURE` and one registration line.
 """
 
+from flexsat.control.stages.delay import DELAY
 from flexsat.control.stages.ideal_sensor import IDEAL_SENSOR
 from flexsat.control.stages.registry import (
     ACTUATOR_SIGNATURE,
@@ -23,6 +24,7 @@ from flexsat.control.stages.registry import (
     validate_sensor_stage,
 )
 from flexsat.control.stages.static_actuator import STATIC_ACTUATOR
+from flexsat.control.stages.wheels import WHEELS
 
 __all__ = [
     "ACTUATORS",
@@ -43,3 +45,5 @@ __all__ = [
 
 register_sensor(IDEAL_SENSOR, default=True)
 register_actuator(STATIC_ACTUATOR, default=True)
+register_actuator(WHEELS)
+register_actuator(DELAY)
