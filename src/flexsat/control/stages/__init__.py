@@ -6,7 +6,9 @@ your own file (see ``docs/control.md``): a parameter model, a compiled step of
 """
 
 from flexsat.control.stages.delay import DELAY
+from flexsat.control.stages.gyro import GYRO
 from flexsat.control.stages.ideal_sensor import IDEAL_SENSOR
+from flexsat.control.stages.mekf import MEKF
 from flexsat.control.stages.registry import (
     ACTUATOR_SIGNATURE,
     ACTUATORS,
@@ -23,6 +25,7 @@ from flexsat.control.stages.registry import (
     validate_sensor_config,
     validate_sensor_stage,
 )
+from flexsat.control.stages.star_tracker import STAR_TRACKER
 from flexsat.control.stages.static_actuator import STATIC_ACTUATOR
 from flexsat.control.stages.wheels import WHEELS
 
@@ -44,6 +47,9 @@ __all__ = [
 ]
 
 register_sensor(IDEAL_SENSOR, default=True)
+register_sensor(GYRO)
+register_sensor(STAR_TRACKER)
+register_sensor(MEKF)
 register_actuator(STATIC_ACTUATOR, default=True)
 register_actuator(WHEELS)
 register_actuator(DELAY)
