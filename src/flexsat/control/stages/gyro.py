@@ -13,8 +13,9 @@ N / sqrt(tau) at short tau). The bias instability B is modelled as a first-order
 Gauss-Markov bias b_GM of correlation time T_c: its Allan deviation peaks at
 0.6174 sigma_b at tau = 1.89 T_c, and sigma_b = 0.664 B / 0.6174 puts that peak at
 0.664 B, the IEEE Std 952 plateau of a flicker bias of instability B: reading the
-bias plateau of the Allan deviation the standard way gives B. b_RW is a rate random walk of density K (Allan deviation
-K sqrt(tau / 3)). ``docs/control.md``, 'Sensors and estimation'.
+bias plateau of the Allan deviation the standard way gives B. b_RW is a rate
+random walk of density K (Allan deviation K sqrt(tau / 3)).
+``docs/control.md``, 'Sensors and estimation'.
 """
 
 from __future__ import annotations
