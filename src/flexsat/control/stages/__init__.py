@@ -9,6 +9,7 @@ from flexsat.control.stages.delay import DELAY
 from flexsat.control.stages.gyro import GYRO
 from flexsat.control.stages.ideal_sensor import IDEAL_SENSOR
 from flexsat.control.stages.mekf import MEKF
+from flexsat.control.stages.notch import NOTCH
 from flexsat.control.stages.registry import (
     ACTUATOR_SIGNATURE,
     ACTUATORS,
@@ -53,3 +54,4 @@ register_sensor(MEKF)
 register_actuator(STATIC_ACTUATOR, default=True)
 register_actuator(WHEELS)
 register_actuator(DELAY)
+register_actuator(NOTCH)
