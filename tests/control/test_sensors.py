@@ -143,3 +143,14 @@ def test_a_bad_stage_config_gives_one_message_naming_the_field(body, fragment, t
     assert outcome.code == 2, outcome.stderr
     assert fragment in outcome.stderr, outcome.stderr
     assert "Traceback" not in outcome.stderr
+
+
+def test_the_avionics_template_is_a_valid_slew_scenario():
+    from importlib import resources
+
+    from flexsat.simulate.scenario import load_slew
+
+    path = resources.files("flexsat.config") / "presets" / "avionics-slew.toml"
+    scenario = load_slew(str(path))
+    assert [s.kind for _, s in scenario.stage_chain()] == [
+        "ideal", "gyro", "star_tracker", "mekf", "wheels"]  # fmt: skip
