@@ -21,7 +21,8 @@ sample initializes q_hat. Outputs q_meas = q_hat, omega_meas = omega_gyro - b_ha
 Recorded against the true attitude (the sensor stage sees the plant state): the
 error e = 2 vec(q_hat^-1 (x) q_true) and its normalized estimation error squared
 NEES = e^T P_thetatheta^-1 e, chi-square with 3 degrees of freedom when the filter
-is consistent (``docs/control.md``, 'Sensors and estimation').
+is consistent, both at each new sample (held in between) (``docs/control.md``,
+'Sensors and estimation').
 """
 
 from __future__ import annotations
@@ -213,6 +214,8 @@ def mekf_step(x, n_dof, t, params, state, q_meas, omega_meas, record):
         omega_meas[i] = omega_meas[i] - s[_B + i]
     for j in range(4):
         q_meas[j] = s[_Q + j]
+    if not (new_rate or fresh):
+        return 0  # nothing new: estimate and records held
     e = _error(s, true_attitude(x, n_dof))
     Pi = _inverse3(P[0, 0], P[0, 1], P[0, 2], P[1, 0], P[1, 1], P[1, 2], P[2, 0], P[2, 1],
                    P[2, 2])  # fmt: skip
