@@ -130,51 +130,27 @@ def test_loop_of_an_unknown_axis_is_refused(plant, rest_model):
 
 
 def _pd_closed_loop_with_delay(plant, delay_s, duration_s=30.0, dt=2e-3):
-    """Nonlinear plant + the quaternion PD law tau = w x Jw - J (kp q_v + kd w), delayed.
+    """The nonlinear closed loop with the PD law and the computational-delay stage.
 
-    Written here independently of the compiled loop: RK4 at 2 ms on the plant's
-    accelerations (the 100 Hz joint modes need dt < 4.4 ms for RK4 stability), the
-    law sampled every step and applied ``delay_s`` later (a shift register).
-    Starts at rest with a 1e-3 rad/s yaw rate. Returns tau_z, one value per step.
+    RK4 at 2 ms (the 100 Hz joint modes need dt < 4.4 ms for RK4 stability), the
+    law every step, its command delayed by round(delay_s / dt) control periods
+    (``actuator_stages = [{kind = "delay"}]``), applied without gain error,
+    disturbance or saturation (T_max far away: the linear loop has none). Starts at
+    rest, holding the identity, with a 1e-3 rad/s yaw rate.
+    Returns tau_z, one value per step.
     """
-    from scipy.spatial.transform import Rotation
+    from flexsat.simulate import SlewScenario, run_slew
 
-    from flexsat.dynamics.rigid import rigid_inertia
-
-    J = rigid_inertia(plant)
-    wn, zeta = 0.3, 0.9  # PD defaults [rad/s], [-]
-    n = plant.n_dof
-
-    def law(q, qd):
-        quat = Rotation.from_euler("ZYX", q[5:2:-1]).as_quat()  # scalar last
-        q_v = quat[:3] * np.sign(quat[3])
-        phi, theta = q[3], q[4]
-        S = np.array([
-            [1.0, 0.0, -np.sin(theta)],
-            [0.0, np.cos(phi), np.cos(theta) * np.sin(phi)],
-            [0.0, -np.sin(phi), np.cos(theta) * np.cos(phi)],
-        ])  # fmt: skip
-        w = S @ qd[3:6]
-        return np.cross(w, J @ w) - J @ (2 * wn**2 * q_v + 2 * zeta * wn * w)
-
-    def f(q, qd, tau):
-        return qd, plant.accelerations(q, qd, plant.generalized_forces(q, tau))
-
-    q, qd = np.zeros(n), np.zeros(n)
-    qd[5] = 1e-3  # [rad/s]
-    pending = [np.zeros(3)] * round(delay_s / dt)
-    out = np.empty(round(duration_s / dt))
-    for k in range(out.size):
-        pending.append(law(q, qd))
-        tau = pending.pop(0)
-        k1 = f(q, qd, tau)
-        k2 = f(q + dt / 2 * k1[0], qd + dt / 2 * k1[1], tau)
-        k3 = f(q + dt / 2 * k2[0], qd + dt / 2 * k2[1], tau)
-        k4 = f(q + dt * k3[0], qd + dt * k3[1], tau)
-        q = q + dt / 6 * (k1[0] + 2 * k2[0] + 2 * k3[0] + k4[0])
-        qd = qd + dt / 6 * (k1[1] + 2 * k2[1] + 2 * k3[1] + k4[1])
-        out[k] = tau[2]
-    return out
+    scenario = SlewScenario.model_validate({
+        "duration_s": duration_s, "dt_s": dt, "control_dt_s": dt, "record_dt_s": dt,
+        "target_euler_deg": [0.0, 0.0, 0.0], "controller": {"kind": "pd"},
+        "initial": {"rate_deg_s": [0.0, 0.0, float(np.degrees(1e-3))]},
+        "actuator_stages": [{"kind": "delay", "periods": round(delay_s / dt)}],
+        "actuator": {"kind": "static", "gain": [1.0, 1.0, 1.0], "t_max_nm": 1e4},
+        "disturbances": {"environment_nm": [0.0, 0.0, 0.0], "sloshing_ratio": 0.0},
+    })  # fmt: skip
+    ds = run_slew(plant, scenario).dataset
+    return ds["tau_applied"].values[:-1, 2]
 
 
 def test_delay_margin_matches_the_nonlinear_closed_loop(plant, loops):

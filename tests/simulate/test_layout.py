@@ -52,3 +52,21 @@ def test_a_channel_named_twice_is_refused():
     law = dataclasses.replace(get_law("pd"), diagnostics=(Channel("tau_cmd", "N m", ""),))
     with pytest.raises(ValueError, match="named twice: tau_cmd"):
         LoopLayout(PLANT, law, SENSORS.get("ideal"), ACTUATORS.get("static"))
+
+
+def test_stage_chains_tile_the_state_and_the_record_row():
+    sensors = tuple(SENSORS.get(k) for k in ("ideal", "gyro", "star_tracker", "mekf"))
+    actuators = tuple(ACTUATORS.get(k) for k in ("notch", "delay", "wheels"))
+    layout = LoopLayout(PLANT, get_law("pd"), sensors, actuators)
+    pieces = [layout.law_state, *layout.sensor_states, *layout.actuator_states]
+    assert all(a.stop == b.start for a, b in itertools.pairwise(pieces))
+    assert pieces[-1].stop == layout.state_size
+    assert layout.sensor_state == slice(layout.sensor_states[0].start,
+                                        layout.sensor_states[-1].stop)  # fmt: skip
+    rows = [layout.law_diag, *layout.sensor_records, *layout.actuator_records]
+    assert all(a.stop == b.start for a, b in itertools.pairwise(rows))
+    # Only the wheels integrate states: the coupled RK4 step carries their piece alone,
+    # not the long delay buffer before them.
+    assert layout.continuous
+    assert layout.continuous_state == layout.actuator_states[-1]
+    assert not _layout().continuous

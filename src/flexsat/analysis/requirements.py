@@ -22,6 +22,7 @@ from flexsat.config.models import Positive, _Frozen
 __all__ = [
     "Requirements",
     "absolute_performance_error",
+    "actuator_saturation_times",
     "error_rotation_vector",
     "observation_window",
     "relative_performance_error",
@@ -197,6 +198,25 @@ def relative_performance_error(t: np.ndarray, error: np.ndarray, duration_s: flo
     return worst
 
 
+def actuator_saturation_times(ds: xr.Dataset) -> dict[str, float]:
+    """When each unit of the actuator first saturated [s], by unit number (from 1).
+
+    Read from the ``actuator_saturated`` record an actuator stage may declare (bit
+    i set: unit i + 1 could not deliver, e.g. a reaction wheel at its momentum
+    limit; ``docs/control.md``, 'Reaction wheels'); empty without it or if none did.
+    """
+    if "actuator_saturated" not in ds:
+        return {}
+    t = ds["time"].values
+    mask = np.nan_to_num(ds["actuator_saturated"].values).astype(np.int64)
+    times = {}
+    for unit in range(int(mask.max()).bit_length()):
+        hit = np.nonzero(mask & (1 << unit))[0]
+        if hit.size:
+            times[str(unit + 1)] = float(t[hit[0]])
+    return times
+
+
 def _stored_scenario(ds: xr.Dataset) -> dict:
     text = ds.attrs.get("scenario")
     return json.loads(text) if text else {}
@@ -233,7 +253,8 @@ def slew_metrics(
         at every record of ``observation_window_s`` (start, end); R2: the residual
         rate stays below ``jitter_deg_s`` there; both fail when the records do not
         reach the window's end (a run shorter than the deadline, or stopped). R3:
-        ‖applied torque‖ <= T_max on every axis at every record. ``ape_deg`` and
+        ‖applied torque‖ <= T_max on every axis at every record and no actuator
+        unit saturated (``actuator_saturation_s``: when each first did). ``ape_deg`` and
         ``rpe_deg`` are the APE and RPE over the window (RPE over windows of
         ``rpe_window_s``), ``max_rate_error_deg_s`` the largest residual rate there.
         Settling times are when each quantity enters its band for good (NaN if not
@@ -266,6 +287,7 @@ def slew_metrics(
     lam = ds["lambda_act"].values if "lambda_act" in ds else np.zeros(t.size)
     applied = np.abs(ds["tau_applied"].values)
     commanded = np.abs(ds["tau_cmd"].values)
+    saturation = actuator_saturation_times(ds)
     leaves = np.nonzero(lam > lam[0] * (1 + 1e-9))[0]
     return {
         "controller": str(ds.attrs.get("controller", "")),
@@ -282,7 +304,8 @@ def slew_metrics(
         "max_rate_error_deg_s": max_rate,
         "max_abs_torque_nm": applied.max(axis=0).tolist(),
         "max_commanded_torque_nm": commanded.max(axis=0).tolist(),
-        "r3_pass": bool(np.all(applied <= t_max_nm * (1 + 1e-12))),
+        "r3_pass": bool(np.all(applied <= t_max_nm * (1 + 1e-12))) and not saturation,
+        "actuator_saturation_s": saturation,
         "lambda_switch_time_s": float(t[leaves[0]]) if leaves.size else float("nan"),
         "final_euler_deg": ds["euler_deg"].values[-1].tolist(),
         "peak_flex_torque_nm": np.abs(ds["tau_flex"].values).max(axis=0).tolist(),

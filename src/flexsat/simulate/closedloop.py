@@ -13,12 +13,14 @@ from flexsat.config.models import SatelliteConfig
 from flexsat.control.laws import get_law
 from flexsat.control.quaternion import pointing_errors, target_quaternion
 from flexsat.control.stages import ACTUATORS, JOINT_ACTUATORS, REFERENCES, SENSORS
+from flexsat.control.stages.registry import no_derivative
 from flexsat.dynamics.integrators import rk4_hold
 from flexsat.dynamics.plant import Plant
 from flexsat.dynamics.rigid import rigid_inertia
 from flexsat.dynamics.status import STATUS_CONTROL_FAILED
 from flexsat.errors import ConfigError, SimulationError
 from flexsat.simulate.common import PROGRESS_MIN_STEPS, chunk_steps, progress_bar, run_attributes
+from flexsat.simulate.coupled import LoopFlow, rk4_coupled_hold
 from flexsat.simulate.layout import LoopLayout
 from flexsat.simulate.loops import (
     LoopClock,
@@ -26,12 +28,14 @@ from flexsat.simulate.loops import (
     LoopRecords,
     LoopStages,
     rk4_closed_loop,
+    run_actuators,
+    run_sensors,
 )
 from flexsat.simulate.openloop import initial_state
 from flexsat.simulate.result import Result, build_dataset
 from flexsat.simulate.scenario import SlewScenario
 
-__all__ = ["Controller", "design_inertia", "run_slew", "slew_design_inertia"]
+__all__ = ["Controller", "design_inertia", "loop_layout", "run_slew", "slew_design_inertia"]
 
 
 class Controller(Protocol):
@@ -120,10 +124,7 @@ def run_slew(
         slew_design_inertia(plant, scenario) if design_J is None else design_J, dtype=float
     )
     law = get_law(scenario.controller.kind)
-    layout = LoopLayout(plant.layout, law, SENSORS.get(scenario.sensor.kind),
-                        ACTUATORS.get(scenario.actuator.kind),
-                        REFERENCES.get(scenario.reference.kind),
-                        JOINT_ACTUATORS.get(scenario.joint_actuator.kind))  # fmt: skip
+    layout = loop_layout(plant, scenario)
     if controller is not None and (layout.reference.name != REFERENCES.default
                                    or layout.joint_actuator.name != JOINT_ACTUATORS.default):
         raise ConfigError("a Python controller flies the step reference without joint "
@@ -136,17 +137,22 @@ def run_slew(
     rec_ctrl = np.full((n_records, layout.record_size), np.nan)
     x = np.concatenate([q0, qd0, [0.0, 0.0]])
     data = _loop_data(layout, scenario, J, plant)
-    stages = LoopStages((layout.sensor.step,), (law.step,), (layout.actuator.step,),
-                        (layout.reference.step,), (layout.joint_actuator.step,))  # fmt: skip
+    stages = LoopStages(
+        tuple(s.step for s in layout.sensors), (law.step,),
+        tuple(s.step for s in layout.actuators),
+        tuple(s.derivative or no_derivative for s in layout.actuators),
+        (layout.reference.step,), (layout.joint_actuator.step,),
+    )  # fmt: skip
     show = steps >= PROGRESS_MIN_STEPS if progress is None else progress
     start = time.perf_counter()
     with progress_bar(show, scenario.duration_s) as (bar, task):
         if controller is None:
             status, done, rows = _compiled_loop(plant, scenario, x, stages, data, rec_t, rec_x,
-                                                rec_ctrl, bar, task)  # fmt: skip
+                                                rec_ctrl, bar, task, layout.continuous)  # fmt: skip
         else:
             status, done, rows = _python_loop(plant, scenario, x, stages, data, rec_t, rec_x,
-                                              rec_ctrl, bar, task, controller)  # fmt: skip
+                                              rec_ctrl, bar, task, controller,
+                                              layout.continuous)  # fmt: skip
     wall = time.perf_counter() - start
     t_fail = done * scenario.dt_s if status else -1.0
     if status:  # keep the last good state as the final record
@@ -156,8 +162,8 @@ def run_slew(
     attrs = run_attributes(plant, scenario, "closed-loop", status, t_fail, wall, done)
     attrs["controller"] = law.name if controller is None else "python"
     attrs["controller_label"] = law.label if controller is None else "Python law"
-    attrs["sensor"] = layout.sensor.name
-    attrs["actuator"] = layout.actuator.name
+    attrs["sensor"] = " > ".join(s.name for s in layout.sensors)
+    attrs["actuator"] = " > ".join(s.name for s in layout.actuators)
     if controller is None:
         attrs.update(scenario.controller.plot_attributes())
         attrs["law_diagnostics"] = [channel.name for channel in law.diagnostics]
@@ -167,7 +173,7 @@ def run_slew(
     target = target_quaternion(scenario.target_euler_deg)
     attrs["target_quaternion"] = target.tolist()
     # gain (3), environment (3), sloshing ratio and Hz, residual (3), T_max
-    attrs["realised_disturbances"] = data.actuator_params.tolist()
+    attrs["realised_disturbances"] = data.actuator_params[-1].tolist()
     at = layout.plant  # where each piece of the plant state lives
     ds = build_dataset(
         plant, rec_t, rec_x[:, at.q], rec_x[:, at.qd], rec_x[:, at.work_in],
@@ -195,14 +201,44 @@ def run_slew(
     return Result(ds)
 
 
+def loop_layout(plant: Plant, scenario: SlewScenario) -> LoopLayout:
+    """Where a slew's states and records live: its law, its two stage chains, its
+    reference generator and its joint actuator."""
+    chain = scenario.stage_chain()
+    n_sensors = 1 + len(scenario.sensor_stages)
+    sensors = tuple(SENSORS.get(c.kind) for _, c in chain[:n_sensors])
+    actuators = tuple(ACTUATORS.get(c.kind) for _, c in chain[n_sensors:])
+    return LoopLayout(plant.layout, get_law(scenario.controller.kind), sensors, actuators,
+                      REFERENCES.get(scenario.reference.kind),
+                      JOINT_ACTUATORS.get(scenario.joint_actuator.kind))  # fmt: skip
+
+
 def _loop_data(layout: LoopLayout, scenario: SlewScenario, J: np.ndarray,
                plant: Plant) -> LoopData:  # fmt: skip
     """The arrays of one run, record-row pieces as views into ``held``."""
     held = np.zeros(layout.record_size)
     state = np.zeros(layout.state_size)
+    chain = [c for _, c in scenario.stage_chain()]
+    n_sensors = len(layout.sensors)
 
     def packed(values) -> np.ndarray:
         return np.ascontiguousarray(values, dtype=float)
+
+    block = layout.continuous_state
+    m = block.stop - block.start
+    evaluation, rate = np.zeros(m), np.zeros(m)
+
+    def local(array: np.ndarray, pieces: tuple[slice, ...]) -> tuple:
+        """Each stage's piece of a flow array (empty for a stage outside the block)."""
+        within = [block.start <= p.start and p.stop <= block.stop for p in pieces]
+        return tuple(array[p.start - block.start : p.stop - block.start] if ok else array[:0]
+                     for p, ok in zip(pieces, within, strict=True))  # fmt: skip
+
+    flow = LoopFlow(
+        state=state[block], eval=evaluation, eval_views=local(evaluation, layout.actuator_states),
+        dot=rate, dot_views=local(rate, layout.actuator_states), k=np.zeros((4, m)),
+        wrench=np.zeros(3), held=np.zeros(3),
+    )  # fmt: skip
 
     return LoopData(
         J_design=J,
@@ -211,18 +247,20 @@ def _loop_data(layout: LoopLayout, scenario: SlewScenario, J: np.ndarray,
         omega_dot_d=np.zeros(3),
         law_gains=packed(scenario.controller.gains(scenario.actuator)),
         law_state=state[layout.law_state],
-        sensor_params=packed(scenario.sensor.packed(scenario)),
-        sensor_state=state[layout.sensor_state],
-        actuator_params=packed(scenario.actuator.packed(scenario)),
-        actuator_state=state[layout.actuator_state],
+        sensor_params=tuple(packed(c.packed(scenario)) for c in chain[:n_sensors]),
+        sensor_state=tuple(state[p] for p in layout.sensor_states),
+        actuator_params=tuple(packed(c.packed(scenario)) for c in chain[n_sensors:]),
+        actuator_state=tuple(state[p] for p in layout.actuator_states),
         q_meas=np.zeros(4),
         omega_meas=np.zeros(3),
         held=held,
         tau_cmd=held[layout.tau_cmd],
         tau_applied=held[layout.tau_applied],
         law_diag=held[layout.law_diag],
-        sensor_record=held[layout.sensor_record],
-        actuator_record=held[layout.actuator_record],
+        sensor_record=tuple(held[p] for p in layout.sensor_records),
+        actuator_record=tuple(held[p] for p in layout.actuator_records),
+        tau_between=np.zeros(3),
+        flow=flow,
         reference_params=packed(scenario.reference.packed(scenario, plant)),
         reference_state=state[layout.reference_state],
         reference_record=held[layout.reference_record],
@@ -233,7 +271,8 @@ def _loop_data(layout: LoopLayout, scenario: SlewScenario, J: np.ndarray,
     )
 
 
-def _compiled_loop(plant, scenario, x, stages, data, rec_t, rec_x, rec_ctrl, bar, task):
+def _compiled_loop(plant, scenario, x, stages, data, rec_t, rec_x, rec_ctrl, bar, task,
+                   continuous):  # fmt: skip
     """The whole loop, stages and law included, in compiled chunks."""
     steps, every, control = scenario.n_steps, scenario.record_every, scenario.control_every
     chunk = chunk_steps(every, control)
@@ -241,7 +280,8 @@ def _compiled_loop(plant, scenario, x, stages, data, rec_t, rec_x, rec_ctrl, bar
     while status == 0:
         n_chunk = min(chunk, steps - done)
         final = done + n_chunk == steps
-        clock = LoopClock(done * scenario.dt_s, scenario.dt_s, n_chunk, final, control, every)
+        clock = LoopClock(done * scenario.dt_s, scenario.dt_s, n_chunk, final, control, every,
+                          continuous)  # fmt: skip
         status, ran, written = rk4_closed_loop(
             x, clock, stages, data, LoopRecords(rec_t, rec_x, rec_ctrl, rows), plant.packed
         )
@@ -254,7 +294,8 @@ def _compiled_loop(plant, scenario, x, stages, data, rec_t, rec_x, rec_ctrl, bar
     return status, done, rows
 
 
-def _python_loop(plant, scenario, x, stages, d, rec_t, rec_x, rec_ctrl, bar, task, controller):
+def _python_loop(plant, scenario, x, stages, d, rec_t, rec_x, rec_ctrl, bar, task, controller,
+                 continuous):  # fmt: skip
     """Python controller at each control instant between the compiled stages; the plant
     steps compiled in between."""
     n = plant.n_dof
@@ -267,16 +308,12 @@ def _python_loop(plant, scenario, x, stages, d, rec_t, rec_x, rec_ctrl, bar, tas
     while True:
         t = k * scenario.dt_s
         if k % control == 0:
-            status = stages.sensor[0](x, n, t, d.sensor_params, d.sensor_state, d.q_meas,
-                                      d.omega_meas, d.sensor_record)  # fmt: skip
+            status = run_sensors(x, n, t, stages, d)
             tau_cmd = np.asarray(controller(t, d.q_meas.copy(), d.omega_meas.copy()), dtype=float)
             if tau_cmd.shape != (3,) or not np.all(np.isfinite(tau_cmd)):
                 raise SimulationError(f"controller returned {tau_cmd!r} at t = {t:.6g} s")
             d.tau_cmd[:] = np.clip(tau_cmd, -limit, limit)
-            status |= stages.actuator[0](
-                d.tau_cmd, t, control_dt, d.actuator_params, d.actuator_state, d.tau_applied,
-                d.actuator_record,
-            )  # fmt: skip
+            status |= run_actuators(x, n, t, control_dt, continuous, stages, d)
             if status:
                 return STATUS_CONTROL_FAILED, k, rows
         if k % every == 0:
@@ -284,8 +321,12 @@ def _python_loop(plant, scenario, x, stages, d, rec_t, rec_x, rec_ctrl, bar, tas
             rows += 1
         if k == steps:
             return 0, k, rows
-        torque = (d.tau_applied[0], d.tau_applied[1], d.tau_applied[2])
-        status, ran = rk4_hold(x, scenario.dt_s, block, torque, plant.packed)
+        if continuous:
+            status, ran = rk4_coupled_hold(x, t, scenario.dt_s, block, stages.derivative,
+                                           d.actuator_params, d.flow, plant.packed)  # fmt: skip
+        else:
+            torque = (d.tau_applied[0], d.tau_applied[1], d.tau_applied[2])
+            status, ran = rk4_hold(x, scenario.dt_s, block, torque, plant.packed)
         k += ran
         if status:
             return status, k, rows

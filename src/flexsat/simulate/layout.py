@@ -26,20 +26,25 @@ class LoopLayout:
     Plant state ``x``: the plant's own :class:`~flexsat.dynamics.layout.StateLayout`
     (``plant``: q, q_dot, each appendage's block, work and dissipation).
 
-    Control state (``state_size``,): the law's ``[law_state]``, the sensor's
-    ``[sensor_state]``, the actuator's ``[actuator_state]``, then the reference's and
-    the joint actuator's, zero at t = 0.
+    Control state (``state_size``,): the law's ``[law_state]``, the sensing chain's
+    ``[sensor_state]`` (each stage's in chain order) and the actuation chain's
+    ``[actuator_state]`` (likewise), then the reference's and the joint actuator's,
+    zero at t = 0. The actuation block is one contiguous piece: the entries the
+    stages' derivatives integrate live there.
 
     Control record row (``record_size``,), held between control instants:
     ``[tau_cmd]`` (3) and ``[tau_applied]`` (3) [N m], the law's diagnostics
-    ``[law_diag]``, the sensor's and the actuator's records, then the reference's
-    and the joint actuator's.
+    ``[law_diag]``, the sensing chain's and the actuation chain's records, then the
+    reference's and the joint actuator's.
+
+    ``sensors`` and ``actuators`` are the chains in order (a single
+    :class:`~flexsat.control.stages.StageSpec` is a chain of one).
     """
 
     plant: StateLayout
     law: LawSpec
-    sensor: StageSpec
-    actuator: StageSpec
+    sensors: tuple[StageSpec, ...]
+    actuators: tuple[StageSpec, ...]
     reference: StageSpec = STEP_REFERENCE
     joint_actuator: StageSpec = NO_JOINT_ACTUATOR
 
@@ -48,12 +53,20 @@ class LoopLayout:
         return slice(0, self.law.state_size)
 
     @property
+    def sensor_states(self) -> tuple[slice, ...]:
+        return _pieces(self.law_state.stop, [s.state_size for s in self.sensors])
+
+    @property
     def sensor_state(self) -> slice:
-        return _after(self.law_state, self.sensor.state_size)
+        return _span(self.law_state.stop, self.sensor_states)
+
+    @property
+    def actuator_states(self) -> tuple[slice, ...]:
+        return _pieces(self.sensor_state.stop, [s.state_size for s in self.actuators])
 
     @property
     def actuator_state(self) -> slice:
-        return _after(self.sensor_state, self.actuator.state_size)
+        return _span(self.sensor_state.stop, self.actuator_states)
 
     @property
     def reference_state(self) -> slice:
@@ -67,6 +80,21 @@ class LoopLayout:
     def state_size(self) -> int:
         return self.joint_state.stop
 
+    @property
+    def continuous(self) -> bool:
+        """True if an actuation stage integrates states inside the RK4 steps."""
+        return any(s.derivative is not None for s in self.actuators)
+
+    @property
+    def continuous_state(self) -> slice:
+        """The piece of the actuation block the coupled RK4 step carries: from the first
+        stage with a derivative to the last (empty without one)."""
+        pieces = [p for p, s in zip(self.actuator_states, self.actuators, strict=True)
+                  if s.derivative is not None]  # fmt: skip
+        if not pieces:
+            return slice(self.actuator_state.stop, self.actuator_state.stop)
+        return slice(pieces[0].start, pieces[-1].stop)
+
     tau_cmd = slice(0, 3)
     tau_applied = slice(3, 6)
 
@@ -75,12 +103,20 @@ class LoopLayout:
         return _after(self.tau_applied, self.law.diag_size)
 
     @property
+    def sensor_records(self) -> tuple[slice, ...]:
+        return _pieces(self.law_diag.stop, [s.record_size for s in self.sensors])
+
+    @property
     def sensor_record(self) -> slice:
-        return _after(self.law_diag, self.sensor.record_size)
+        return _span(self.law_diag.stop, self.sensor_records)
+
+    @property
+    def actuator_records(self) -> tuple[slice, ...]:
+        return _pieces(self.sensor_record.stop, [s.record_size for s in self.actuators])
 
     @property
     def actuator_record(self) -> slice:
-        return _after(self.sensor_record, self.actuator.record_size)
+        return _span(self.sensor_record.stop, self.actuator_records)
 
     @property
     def reference_record(self) -> slice:
@@ -96,21 +132,39 @@ class LoopLayout:
 
     def channels(self) -> Iterator[tuple[Channel, slice]]:
         """Each declared channel of the law and the stages with its record columns."""
-        for block, channels in ((self.law_diag, self.law.diagnostics),
-                                (self.sensor_record, self.sensor.records),
-                                (self.actuator_record, self.actuator.records),
-                                (self.reference_record, self.reference.records),
-                                (self.joint_record, self.joint_actuator.records)):  # fmt: skip
+        stages = self.sensors + self.actuators
+        records = self.sensor_records + self.actuator_records
+        blocks = [(self.law_diag, self.law.diagnostics)]
+        blocks += [(r, s.records) for r, s in zip(records, stages, strict=True)]
+        blocks += [(self.reference_record, self.reference.records),
+                   (self.joint_record, self.joint_actuator.records)]  # fmt: skip
+        for block, channels in blocks:
             start = block.start
             for channel in channels:
                 yield channel, slice(start, start + channel.size)
                 start += channel.size
 
     def __post_init__(self) -> None:
+        for chain in ("sensors", "actuators"):
+            value = getattr(self, chain)
+            object.__setattr__(self, chain, (value,) if isinstance(value, StageSpec)
+                               else tuple(value))  # fmt: skip
         names = [c.name for c, _ in self.channels()]
         clash = {n for n in names if names.count(n) > 1} | (set(names) & set(_LOOP_COLUMNS))
         if clash:
             raise ValueError(f"recorded channels named twice: {', '.join(sorted(clash))}")
+
+
+def _pieces(start: int, sizes: list[int]) -> tuple[slice, ...]:
+    out = []
+    for size in sizes:
+        out.append(slice(start, start + size))
+        start += size
+    return tuple(out)
+
+
+def _span(start: int, pieces: tuple[slice, ...]) -> slice:
+    return slice(start, pieces[-1].stop if pieces else start)
 
 
 def _after(previous: slice, size: int) -> slice:

@@ -1,10 +1,14 @@
-"""Compiled closed loop: reference, sensor -> law -> actuator, joint actuator -> RK4 plant.
+"""Compiled closed loop: reference, sensing chain, law, actuation chain, joint actuator.
+
+Each control instant runs them in that order; the RK4 plant steps in between (numba).
 
 The stages and the law are numba first-class functions handed over in tuples
-(:class:`LoopStages`), typed by their signatures: the loop is compiled once, cached
-across processes, and runs any law or stage of those signatures, a user's own
-included. They run every ``control_every`` plant steps and their outputs are held
-in between (zero-order hold). Nothing is allocated inside the loop.
+(:class:`LoopStages`), typed by their signatures: the loop is compiled once per
+chain length, cached across processes, and runs any law or stage of those
+signatures, a user's own included. They run every ``control_every`` plant steps and
+their outputs are held in between (zero-order hold). An actuation stage with a
+derivative integrates its states with the plant inside each RK4 step
+(:mod:`flexsat.simulate.coupled`). Nothing is allocated inside the loop.
 """
 
 from __future__ import annotations
@@ -16,6 +20,7 @@ from numba import njit
 
 from flexsat.dynamics.integrators import rk4_step
 from flexsat.dynamics.status import STATUS_CONTROL_FAILED, STATUS_OK
+from flexsat.simulate.coupled import LoopFlow, chain_wrench, rk4_coupled_step
 
 __all__ = [
     "LoopClock",
@@ -23,8 +28,9 @@ __all__ = [
     "LoopRecords",
     "LoopStages",
     "rk4_closed_loop",
+    "run_actuators",
+    "run_sensors",
 ]
-
 
 
 class LoopClock(NamedTuple):
@@ -36,14 +42,16 @@ class LoopClock(NamedTuple):
     final: bool  # also control and record at t0 + n_steps dt (the run's last record)
     control_every: int  # plant steps per control period
     record_every: int  # plant steps per record
+    continuous: bool  # an actuation stage integrates states in the RK4 steps
 
 
 class LoopStages(NamedTuple):
-    """The compiled steps, each a 1-tuple holding a first-class function."""
+    """The compiled steps, tuples of first-class functions (chains in order)."""
 
-    sensor: tuple  # (SENSOR_SIGNATURE,)
+    sensor: tuple  # (SENSOR_SIGNATURE, ...): the sensing chain
     law: tuple  # (LAW_SIGNATURE,)
-    actuator: tuple  # (ACTUATOR_SIGNATURE,)
+    actuator: tuple  # (ACTUATOR_SIGNATURE, ...): the actuation chain
+    derivative: tuple  # (DERIVATIVE_SIGNATURE, ...): one per actuation stage
     reference: tuple  # (REFERENCE_SIGNATURE,)
     joint_actuator: tuple  # (JOINT_ACTUATOR_SIGNATURE,)
 
@@ -53,7 +61,8 @@ class LoopData(NamedTuple):
 
     The record-row pieces are views into ``held`` at the offsets of a
     :class:`~flexsat.simulate.layout.LoopLayout`; the states are views into one
-    control-state vector.
+    control-state vector. Stage parameters, states and records are tuples with one
+    array per stage of the chain.
     """
 
     J_design: np.ndarray  # (3, 3) [kg m^2]
@@ -62,18 +71,20 @@ class LoopData(NamedTuple):
     omega_dot_d: np.ndarray  # (3,) [rad/s^2]
     law_gains: np.ndarray
     law_state: np.ndarray
-    sensor_params: np.ndarray
-    sensor_state: np.ndarray
-    actuator_params: np.ndarray
-    actuator_state: np.ndarray
+    sensor_params: tuple
+    sensor_state: tuple
+    actuator_params: tuple
+    actuator_state: tuple
     q_meas: np.ndarray  # (4,) sensor output
     omega_meas: np.ndarray  # (3,) sensor output [rad/s]
     held: np.ndarray  # (record_size,) the control record row held between instants
     tau_cmd: np.ndarray  # views into held ...
     tau_applied: np.ndarray
     law_diag: np.ndarray
-    sensor_record: np.ndarray
-    actuator_record: np.ndarray
+    sensor_record: tuple
+    actuator_record: tuple
+    tau_between: np.ndarray  # (3,) a stage's input inside the actuation chain [N m]
+    flow: LoopFlow  # work arrays of the coupled RK4 step
     reference_params: np.ndarray
     reference_state: np.ndarray
     reference_record: np.ndarray  # view into held
@@ -93,12 +104,51 @@ class LoopRecords(NamedTuple):
 
 
 @njit(cache=True)
+def run_sensors(x, n, t, stages, d):
+    """The sensing chain at one control instant: each stage refines q_meas, omega_meas."""
+    status = 0
+    for i in range(len(stages.sensor)):
+        status |= stages.sensor[i](x, n, t, d.sensor_params[i], d.sensor_state[i], d.q_meas,
+                                   d.omega_meas, d.sensor_record[i])  # fmt: skip
+    return status
+
+
+@njit(cache=True)
+def run_actuators(x, n, t, control_dt, continuous, stages, d):
+    """The actuation chain at one control instant, from ``tau_cmd`` to ``tau_applied``.
+
+    Each stage after the first reads the previous one's output. With continuous
+    stages the chain's output is held for the RK4 steps and ``tau_applied`` records
+    the total torque on the hub at this instant (held output plus the stages' wrench).
+    """
+    status = stages.actuator[0](
+        d.tau_cmd, t, control_dt, d.actuator_params[0], d.actuator_state[0], d.tau_applied,
+        d.actuator_record[0],
+    )  # fmt: skip
+    for i in range(1, len(stages.actuator)):
+        d.tau_between[:] = d.tau_applied
+        status |= stages.actuator[i](
+            d.tau_between, t, control_dt, d.actuator_params[i], d.actuator_state[i],
+            d.tau_applied, d.actuator_record[i],
+        )  # fmt: skip
+    if continuous:
+        flow = d.flow
+        flow.held[:] = d.tau_applied
+        flow.eval[:] = flow.state
+        status |= chain_wrench(x, n, t, stages.derivative, d.actuator_params, flow)
+        for a in range(3):
+            d.tau_applied[a] += flow.wrench[a]
+    return status
+
+
+@njit(cache=True)
 def rk4_closed_loop(x, clock, stages, d, records, plant):
     """Run ``clock.n_steps`` closed-loop steps from ``clock.t0``; ``x`` advanced in place.
 
-    At each step k (time t0 + k dt): run the reference, sensor, law, actuator and
-    joint actuator if k is a control instant, record if k is a record instant, then
-    take one RK4 step under the held torque and joint forces ``d.Q``. Chunk
+    At each step k (time t0 + k dt): run the reference, the sensing chain, the law,
+    the actuation chain and the joint actuator if k is a control instant, record if
+    k is a record instant, then take one RK4 step under the held torque and joint
+    forces ``d.Q`` (coupled with the chain's continuous states if any). Chunk
     boundaries must be multiples of ``control_every`` and ``record_every``.
     ``plant`` is the plant's named structure (``Plant.packed``), passed to ``rk4_step``.
 
@@ -115,16 +165,12 @@ def rk4_closed_loop(x, clock, stages, d, records, plant):
         if k % clock.control_every == 0:
             status = stages.reference[0](t, d.reference_params, d.reference_state, d.q_d,
                                          d.omega_d, d.omega_dot_d, d.reference_record)  # fmt: skip
-            status |= stages.sensor[0](x, n, t, d.sensor_params, d.sensor_state, d.q_meas,
-                                      d.omega_meas, d.sensor_record)  # fmt: skip
+            status |= run_sensors(x, n, t, stages, d)
             status |= stages.law[0](
                 d.q_d, d.omega_d, d.omega_dot_d, d.q_meas, d.omega_meas, d.J_design,
                 d.law_gains, d.law_state, t, control_dt, d.tau_cmd, d.law_diag,
             )  # fmt: skip
-            status |= stages.actuator[0](
-                d.tau_cmd, t, control_dt, d.actuator_params, d.actuator_state, d.tau_applied,
-                d.actuator_record,
-            )  # fmt: skip
+            status |= run_actuators(x, n, t, control_dt, clock.continuous, stages, d)
             status |= stages.joint_actuator[0](x, n, t, control_dt, d.q_d, d.joint_params,
                                                d.joint_state, d.Q, d.joint_record)  # fmt: skip
             if status != 0:
@@ -136,8 +182,12 @@ def rk4_closed_loop(x, clock, stages, d, records, plant):
             row += 1
         if k == clock.n_steps:
             break
-        torque = (d.tau_applied[0], d.tau_applied[1], d.tau_applied[2])
-        status = rk4_step(x, clock.dt, torque, n, d.Q, scratch, plant)
+        if clock.continuous:
+            status = rk4_coupled_step(x, t, clock.dt, n, d.Q, scratch, stages.derivative,
+                                      d.actuator_params, d.flow, plant)  # fmt: skip
+        else:
+            torque = (d.tau_applied[0], d.tau_applied[1], d.tau_applied[2])
+            status = rk4_step(x, clock.dt, torque, n, d.Q, scratch, plant)
         if status != STATUS_OK:
             return status, k, row - records.start
     return STATUS_OK, clock.n_steps, row - records.start

@@ -10,7 +10,14 @@ from pathlib import Path
 from typing import Annotated, ClassVar, Literal
 
 import numpy as np
-from pydantic import Field, SerializeAsAny, Strict, field_validator, model_validator
+from pydantic import (
+    BeforeValidator,
+    Field,
+    SerializeAsAny,
+    Strict,
+    field_validator,
+    model_validator,
+)
 
 from flexsat.analysis.requirements import Requirements
 from flexsat.config.load import read_toml, validate_config
@@ -27,9 +34,11 @@ from flexsat.control.stages import (
     PlantStageConfig,
     StageConfig,
     validate_actuator_config,
+    validate_actuator_stage,
     validate_joint_actuator_config,
     validate_reference_config,
     validate_sensor_config,
+    validate_sensor_stage,
 )
 
 __all__ = [
@@ -248,6 +257,13 @@ class SlewScenario(_TimedRun):
         default_factory=lambda: ACTUATORS.get(ACTUATORS.default).config(),
         description="the actuator stage, by its kind",
     )
+    sensor_stages: tuple[
+        Annotated[SerializeAsAny[StageConfig], BeforeValidator(validate_sensor_stage)], ...
+    ] = Field((), description="sensing stages run after [sensor], in order ([[sensor_stages]])")
+    actuator_stages: tuple[
+        Annotated[SerializeAsAny[StageConfig], BeforeValidator(validate_actuator_stage)], ...
+    ] = Field((), description="actuation stages run before [actuator], in order "
+              "([[actuator_stages]])")  # fmt: skip
     disturbances: DisturbanceConfig = Field(
         default_factory=DisturbanceConfig, description="disturbance torques"
     )
@@ -309,6 +325,26 @@ class SlewScenario(_TimedRun):
         if np.linalg.eigvalsh(J).min() <= 0.0:
             raise ValueError("must be positive definite (every eigenvalue > 0 kg m^2)")
         return value
+
+    @model_validator(mode="after")
+    def _stages_fit_the_run(self) -> SlewScenario:
+        for field, stage in self.stage_chain():
+            try:
+                stage.check(self)
+            except ValueError as error:
+                raise ValueError(f"{field}.{error}") from None
+        return self
+
+    def stage_chain(self) -> list[tuple[str, StageConfig]]:
+        """Every stage in loop order with its field path: the sensing chain
+        (``sensor``, ``sensor_stages[i]``), then the actuation chain
+        (``actuator_stages[i]``, ``actuator``)."""
+        return (
+            [("sensor", self.sensor)]
+            + [(f"sensor_stages[{i}]", s) for i, s in enumerate(self.sensor_stages)]
+            + [(f"actuator_stages[{i}]", s) for i, s in enumerate(self.actuator_stages)]
+            + [("actuator", self.actuator)]
+        )
 
     @property
     def control_every(self) -> int:

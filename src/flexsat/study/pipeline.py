@@ -172,6 +172,14 @@ def _laws(ctx: StudyContext) -> dict:
     return {"json": _relative(ctx, [ctx.out / "laws" / "laws.json"])[0]}
 
 
+def _avionics(ctx: StudyContext) -> dict:
+    from flexsat.study.avionics import avionics_study
+
+    written = avionics_study(ctx.plant, ctx.out / "avionics", quick=ctx.quick)
+    return {"json": _relative(ctx, [written["json"]])[0],
+            "figures": _relative(ctx, written["figures"])}  # fmt: skip
+
+
 PARTS = (
     Part("configuration", "Configuration", _configuration),
     Part("modal", "Modal analysis", _modal),
@@ -179,6 +187,7 @@ PARTS = (
     Part("slew", f"Nominal slew with {LAWS.get(LAWS.default).label}", _slew),
     Part("comparison", "Controller comparison", _comparison, needs=("slew",)),
     Part("animation", "Slew animation", _animation, needs=("slew",)),
+    Part("avionics", "Avionics in the loop: what the thesis could not say", _avionics),
     Part("campaigns", "Robustness campaigns", _campaigns, full_only=True),
     Part("laws", "Law comparison over the campaigns", _laws),
 )

@@ -430,6 +430,25 @@ def _laws(root: Path, outputs: dict, context: dict) -> str:
     return "".join(parts)
 
 
+def _avionics(root: Path, outputs: dict, context: dict) -> str:
+    from flexsat.study.avionics import render_avionics
+
+    def cell(relative, *path):
+        return _Source(root, relative).cell(*path)
+
+    side, sweep, sentence = render_avionics(root, outputs, cell)
+    return "".join([
+        "<p>The thesis's slew with a gyro, a star tracker, the MEKF and four reaction "
+        "wheels beside the ideal loop, then the ideal loop with a computational delay "
+        "(docs/control.md, 'Avionics in the loop').</p>",
+        _table(["metric", "ideal", "avionics"], side, "Ideal loop and realistic avionics"),
+        _table(["delay [s]", "R1", "R2", "APE [deg]", "max rate error [deg/s]", "unstable"],
+               sweep, "Sweep over the computational delay"),
+        f"<p>{_esc(sentence)}</p>",
+        _figures(root, outputs["figures"]),
+    ])  # fmt: skip
+
+
 _SECTIONS: dict[str, Callable[[Path, dict, dict], str]] = {
     "configuration": _configuration,
     "model": _model,
@@ -438,6 +457,7 @@ _SECTIONS: dict[str, Callable[[Path, dict, dict], str]] = {
     "slew": _slew,
     "comparison": _comparison,
     "animation": _animation,
+    "avionics": _avionics,
     "campaigns": _campaigns,
     "laws": _laws,
 }

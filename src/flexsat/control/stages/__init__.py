@@ -7,13 +7,18 @@ damping). Write your own stage in your own file (see ``docs/control.md``): a
 parameter model, a compiled step of its role's signature and one registration line.
 """
 
+from flexsat.control.stages.delay import DELAY
 from flexsat.control.stages.eigenaxis_reference import EIGENAXIS_REFERENCE
+from flexsat.control.stages.gyro import GYRO
 from flexsat.control.stages.ideal_sensor import IDEAL_SENSOR
 from flexsat.control.stages.joint_rate_feedback import JOINT_RATE_FEEDBACK
+from flexsat.control.stages.mekf import MEKF
 from flexsat.control.stages.no_joint_actuator import NO_JOINT_ACTUATOR
+from flexsat.control.stages.notch import NOTCH
 from flexsat.control.stages.registry import (
     ACTUATOR_SIGNATURE,
     ACTUATORS,
+    DERIVATIVE_SIGNATURE,
     JOINT_ACTUATOR_SIGNATURE,
     JOINT_ACTUATORS,
     REFERENCE_SIGNATURE,
@@ -30,16 +35,21 @@ from flexsat.control.stages.registry import (
     register_reference,
     register_sensor,
     validate_actuator_config,
+    validate_actuator_stage,
     validate_joint_actuator_config,
     validate_reference_config,
     validate_sensor_config,
+    validate_sensor_stage,
 )
+from flexsat.control.stages.star_tracker import STAR_TRACKER
 from flexsat.control.stages.static_actuator import STATIC_ACTUATOR
 from flexsat.control.stages.step_reference import STEP_REFERENCE
+from flexsat.control.stages.wheels import WHEELS
 
 __all__ = [
     "ACTUATORS",
     "ACTUATOR_SIGNATURE",
+    "DERIVATIVE_SIGNATURE",
     "JOINT_ACTUATORS",
     "JOINT_ACTUATOR_SIGNATURE",
     "REFERENCES",
@@ -56,14 +66,22 @@ __all__ = [
     "register_reference",
     "register_sensor",
     "validate_actuator_config",
+    "validate_actuator_stage",
     "validate_joint_actuator_config",
     "validate_reference_config",
     "validate_sensor_config",
+    "validate_sensor_stage",
 ]
 
 register_sensor(IDEAL_SENSOR, default=True)
+register_sensor(GYRO)
+register_sensor(STAR_TRACKER)
+register_sensor(MEKF)
 register_actuator(STATIC_ACTUATOR, default=True)
 register_reference(STEP_REFERENCE, default=True)
 register_reference(EIGENAXIS_REFERENCE)
 register_joint_actuator(NO_JOINT_ACTUATOR, default=True)
 register_joint_actuator(JOINT_RATE_FEEDBACK)
+register_actuator(WHEELS)
+register_actuator(DELAY)
+register_actuator(NOTCH)

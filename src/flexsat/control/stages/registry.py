@@ -51,6 +51,25 @@ derives :class:`JointActuatorConfig` and packs against the plant's state layout
 For all: ``params`` are the stage's packed parameters (:meth:`StageConfig.packed`),
 ``state`` (state_size,) its own state, zero at t = 0, ``record`` receives its
 declared records in order. Return 0, or non-zero to stop the run.
+
+Chains: the scenario's ``sensor_stages`` run after ``[sensor]``, in order, on the
+same ``q_meas``/``omega_meas`` (each reads what the previous wrote and refines it:
+gyro, star tracker, estimator); its ``actuator_stages`` run before ``[actuator]``,
+in order, each reading the previous stage's output as its ``tau_cmd`` (filter,
+delay). Only the final ``[actuator]`` carries the limits (``ActuatorStageConfig``).
+
+Continuous states, optional ``derivative`` of an actuator stage,
+``@njit(DERIVATIVE_SIGNATURE, cache=True)``::
+
+    status = derivative(x, n_dof, t, params, state, state_dot, wrench)
+
+is evaluated at every RK4 stage of every plant step, with the plant state ``x``
+and the stage's ``state`` at that RK4 stage: it writes ``state_dot`` (state_size,)
+for the entries it integrates (the loop zeroes it first: entries left at zero are
+held, i.e. discrete) and adds the torque the stage exerts on the hub to
+``wrench`` (3,) [N m], hub frame B (on top of the held ``tau_applied``). The
+stage's discrete ``step`` still runs at every control instant and sees the
+integrated entries in ``state``.
 """
 
 from __future__ import annotations
@@ -59,7 +78,7 @@ from dataclasses import dataclass
 from typing import Annotated, Any, Literal
 
 import numpy as np
-from numba import types
+from numba import njit, types
 from pydantic import Field
 
 from flexsat.config.models import Positive, _Frozen
@@ -68,6 +87,7 @@ from flexsat.control.registry import Channel, Registry
 __all__ = [
     "ACTUATORS",
     "ACTUATOR_SIGNATURE",
+    "DERIVATIVE_SIGNATURE",
     "JOINT_ACTUATORS",
     "JOINT_ACTUATOR_SIGNATURE",
     "REFERENCES",
@@ -79,14 +99,17 @@ __all__ = [
     "PlantStageConfig",
     "StageConfig",
     "StageSpec",
+    "no_derivative",
     "register_actuator",
     "register_joint_actuator",
     "register_reference",
     "register_sensor",
     "validate_actuator_config",
+    "validate_actuator_stage",
     "validate_joint_actuator_config",
     "validate_reference_config",
     "validate_sensor_config",
+    "validate_sensor_stage",
 ]
 
 _vec = types.float64[::1]
@@ -100,6 +123,14 @@ JOINT_ACTUATOR_SIGNATURE = types.int64(
     _vec, types.int64, types.float64, types.float64, _vec, _vec, _vec, _vec, _vec
 )
 """x, n_dof, t, dt, q_d, params, state, Q (out), record (out)."""
+DERIVATIVE_SIGNATURE = types.int64(_vec, types.int64, types.float64, _vec, _vec, _vec, _vec)
+"""x, n_dof, t, params, state, state_dot (out), wrench (in/out, added to)."""
+
+
+@njit(DERIVATIVE_SIGNATURE, cache=True)
+def no_derivative(x, n_dof, t, params, state, state_dot, wrench):
+    """The derivative of a stage without continuous states: nothing integrated."""
+    return 0
 
 
 class StageConfig(_Frozen):
@@ -114,6 +145,10 @@ class StageConfig(_Frozen):
         the static actuator reads ``[disturbances]``).
         """
         return np.zeros(0)
+
+    def check(self, scenario: Any) -> None:
+        """Refuse a setting inconsistent with the rest of ``scenario`` (ValueError whose
+        message starts with the field's name); default: nothing to check."""
 
 
 class ActuatorStageConfig(StageConfig):
@@ -159,6 +194,9 @@ class StageSpec:
         What ``record`` holds, in order; each becomes a variable of the result.
     description : str
         One line for listings.
+    derivative : numba dispatcher, optional
+        Actuators only: compiled with :data:`DERIVATIVE_SIGNATURE`; its entries of
+        ``state`` are integrated with the plant inside each RK4 step.
     """
 
     role: Literal["sensor", "actuator", "reference", "joint_actuator"]
@@ -168,6 +206,7 @@ class StageSpec:
     state_size: int = 0
     records: tuple[Channel, ...] = ()
     description: str = ""
+    derivative: Any = None
 
     @property
     def record_size(self) -> int:
@@ -211,6 +250,9 @@ def register_sensor(spec: StageSpec, default: bool = False) -> StageSpec:
 def register_actuator(spec: StageSpec, default: bool = False) -> StageSpec:
     """Register an actuator stage under ``spec.name`` (replacing one of that name).
 
+    Only a stage whose config derives :class:`ActuatorStageConfig` (the limits) can
+    be the final ``[actuator]``; any can be one of the ``actuator_stages``.
+
     Parameters
     ----------
     spec : StageSpec
@@ -223,7 +265,7 @@ def register_actuator(spec: StageSpec, default: bool = False) -> StageSpec:
     StageSpec
         ``spec``, so a module can keep it: ``X = register_actuator(StageSpec(...))``.
     """
-    if not issubclass(spec.config, ActuatorStageConfig):
+    if default and not issubclass(spec.config, ActuatorStageConfig):
         raise ValueError(f"actuator {spec.name!r}: its config must derive ActuatorStageConfig")
     return _register("actuator", spec, default)
 
@@ -293,6 +335,40 @@ def validate_actuator_config(value: Any) -> ActuatorStageConfig:
     Returns
     -------
     ActuatorStageConfig
+    """
+    config = ACTUATORS.validate_table(value, lambda spec: spec.config)
+    if not isinstance(config, ActuatorStageConfig):
+        raise ValueError(f"kind {config.kind!r} carries no actuator limits: it can only be "
+                         "one of the actuator_stages, before the final [actuator]")
+    return config
+
+
+def validate_sensor_stage(value: Any) -> StageConfig:
+    """One table of ``sensor_stages``: any registered sensor stage, by its kind.
+
+    Parameters
+    ----------
+    value : dict or StageConfig
+        The table, or an already validated model.
+
+    Returns
+    -------
+    StageConfig
+    """
+    return SENSORS.validate_table(value, lambda spec: spec.config)
+
+
+def validate_actuator_stage(value: Any) -> StageConfig:
+    """One table of ``actuator_stages``: any registered actuator stage, by its kind.
+
+    Parameters
+    ----------
+    value : dict or StageConfig
+        The table, or an already validated model.
+
+    Returns
+    -------
+    StageConfig
     """
     return ACTUATORS.validate_table(value, lambda spec: spec.config)
 

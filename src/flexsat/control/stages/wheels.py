@@ -1,0 +1,233 @@
+"""Reaction-wheel cluster: N wheels whose momenta are integrated with the plant.
+
+Wheel i spins about a_i (unit, hub frame B) with axial inertia I_s; its state is
+its axial angular momentum h_i = I_s (a_i . omega + Omega_i), Omega_i its speed
+relative to the hub. With J_rest the satellite's inertia without the wheels' axial
+spin inertia (the configured hub inertia is read as J_rest: the wheels' housings
+and transverse inertia are part of the hub), the total angular momentum is
+H_B = J_rest omega + sum a_i h_i (+ the appendages'), and (``docs/control.md``,
+'Reaction wheels')::
+
+    h_i_dot = u_i - f_i                                 (wheel axis, net torque)
+    J_rest omega_dot + omega x (J_rest omega + sum a_i h_i) = tau_ext - sum a_i h_i_dot
+
+so the wheels exert on the hub the wrench -sum a_i (u_i - f_i) - omega x sum a_i h_i,
+evaluated inside every RK4 stage (it depends on omega within the step). u_i is the
+motor torque, a first-order response u_i_dot = (u_cmd,i - u_i) / tau_m to the
+command; it is cut to zero while it would drive |h_i| beyond I_s Omega_max
+(momentum saturation: the speed limit on the wheel's axial spin rate h_i / I_s,
+within a . omega ~ 1e-5 Omega_max of its rate relative to the hub at slew rates).
+A wheel is reported saturated at records where |h_i| >= 0.999 I_s Omega_max (the
+drive holds it there, friction pulling it just below).
+f_i = c_v Omega_i + c_c tanh(Omega_i / omega_c): viscous and Coulomb friction (the
+Coulomb sign smoothed over omega_c). The motor work sum u_i Omega_i and the
+friction loss sum f_i Omega_i are integrated as states: with no other torque,
+E(t) - E(0) = W_motor - W_friction.
+
+At every control instant the body-torque command is allocated by the
+pseudo-inverse, u_cmd = -A^+ tau_cmd - k_null (I - A^+ A)(h - I_s Omega_bias),
+A = [a_1 ... a_N] (3 x N): the null-space term drives the wheels towards their
+bias speed without torquing the hub; each u_cmd,i is clipped to the motor limit.
+"""
+
+from __future__ import annotations
+
+from math import tanh
+from typing import Annotated, Literal
+
+import numpy as np
+from numba import njit
+from pydantic import Field, model_validator
+
+from flexsat.config.models import Positive, Real
+from flexsat.control.registry import Channel
+from flexsat.control.stages._truth import true_body_rate
+from flexsat.control.stages.registry import (
+    ACTUATOR_SIGNATURE,
+    DERIVATIVE_SIGNATURE,
+    ActuatorStageConfig,
+    StageSpec,
+)
+
+__all__ = ["MAX_WHEELS", "WHEELS", "WheelsConfig", "wheel_axes"]
+
+MAX_WHEELS = 6
+"""Most wheels in one cluster (the stage's state is sized for them)."""
+_N, _IS, _UMAX, _WMAX, _CV, _CC, _WC, _TAU, _KNULL, _WBIAS, _W0 = range(11)
+_A = 11  # A, row-major (3, MAX_WHEELS)
+_PINV = _A + 3 * MAX_WHEELS  # A^+, row-major (MAX_WHEELS, 3)
+_NULL = _PINV + 3 * MAX_WHEELS  # I - A^+ A, row-major (MAX_WHEELS, MAX_WHEELS)
+_SIZE = _NULL + MAX_WHEELS * MAX_WHEELS
+# state: h (N), motor torque u (N), command u_cmd (N), motor work, friction loss
+_H, _U, _UCMD = 0, MAX_WHEELS, 2 * MAX_WHEELS
+_WM, _WF = 3 * MAX_WHEELS, 3 * MAX_WHEELS + 1
+_RPM = 2.0 * np.pi / 60.0  # [rad/s per rpm]
+_SATURATED = 0.999  # |h_i| / (I_s Omega_max) reported as saturated
+
+NonNegative = Annotated[float, Field(ge=0.0, allow_inf_nan=False)]
+
+
+def wheel_axes(preset: str, pyramid_half_angle_deg: float = 54.7356) -> np.ndarray:
+    """Spin axes of a preset cluster, hub frame B, shape (N, 3).
+
+    ``"orthogonal3"``: the body axes. ``"pyramid4"``: four axes at the half-angle
+    from +Z_B, spread 90 deg apart in azimuth from 45 deg (54.7356 deg: equal
+    torque capability on the three axes).
+    """
+    if preset == "orthogonal3":
+        return np.eye(3)
+    beta = np.radians(pyramid_half_angle_deg)
+    phi = np.radians(45.0 + 90.0 * np.arange(4))
+    return np.column_stack([np.sin(beta) * np.cos(phi), np.sin(beta) * np.sin(phi),
+                            np.full(4, np.cos(beta))])  # fmt: skip
+
+
+class WheelsConfig(ActuatorStageConfig):
+    """A reaction-wheel cluster (module docstring); ``t_max_nm`` is the body-torque
+    limit the law clips its command to."""
+
+    kind: Literal["wheels"] = "wheels"
+    preset: Literal["orthogonal3", "pyramid4"] = Field(
+        "pyramid4", description="spin-axis layout when ``axes`` is not given"
+    )
+    pyramid_half_angle_deg: Annotated[float, Field(gt=0.0, lt=90.0)] = 54.7356
+    axes: tuple[tuple[Real, Real, Real], ...] | None = Field(
+        None, description="spin axes a_i, hub frame B (normalized); overrides the preset"
+    )
+    spin_inertia_kg_m2: Positive = Field(0.1, description="I_s, axial inertia of each wheel")
+    max_torque_nm: Positive = Field(2.0, description="motor torque limit per wheel [N m]")
+    max_speed_rpm: Positive = Field(6000.0, description="speed limit |Omega_i| [rpm]")
+    viscous_nm_s_rad: NonNegative = Field(1e-5, description="c_v [N m s/rad]")
+    coulomb_nm: NonNegative = Field(1e-3, description="c_c [N m]")
+    coulomb_smoothing_rad_s: Positive = Field(0.1, description="omega_c [rad/s]")
+    motor_time_constant_s: Positive = Field(0.01, description="tau_m [s]")
+    null_space_gain_1_s: NonNegative = Field(0.0, description="k_null [1/s]")
+    bias_speed_rpm: Real = Field(0.0, description="Omega_bias, null-space target [rpm]")
+    initial_speed_rpm: Real = Field(0.0, description="Omega_i at t = 0, hub at rest [rpm]")
+
+    @model_validator(mode="after")
+    def _spanning(self) -> WheelsConfig:
+        A = self.spin_axes().T
+        if A.shape[1] > MAX_WHEELS:
+            raise ValueError(f"axes: at most {MAX_WHEELS} wheels, got {A.shape[1]}")
+        if np.linalg.matrix_rank(A, tol=1e-6) < 3:
+            raise ValueError("axes: the spin axes must span 3D (rank 3), they do not")
+        return self
+
+    def spin_axes(self) -> np.ndarray:
+        """a_i, shape (N, 3), unit."""
+        if self.axes is None:
+            return wheel_axes(self.preset, self.pyramid_half_angle_deg)
+        axes = np.array(self.axes, dtype=float).reshape(-1, 3)
+        norms = np.linalg.norm(axes, axis=1)
+        if np.any(norms < 1e-9):
+            raise ValueError("axes: every spin axis needs a non-zero length")
+        return axes / norms[:, None]
+
+    def check(self, scenario) -> None:
+        if self.motor_time_constant_s < scenario.dt_s:
+            raise ValueError(f"motor_time_constant_s must be at least dt_s ({scenario.dt_s} s) "
+                             f"for the RK4 step to follow it, got {self.motor_time_constant_s}")
+
+    def packed(self, scenario) -> np.ndarray:
+        axes = self.spin_axes()
+        n = axes.shape[0]
+        A = np.zeros((3, MAX_WHEELS))
+        A[:, :n] = axes.T
+        pinv = np.zeros((MAX_WHEELS, 3))
+        pinv[:n] = np.linalg.pinv(axes.T)
+        null = np.zeros((MAX_WHEELS, MAX_WHEELS))
+        null[:n, :n] = np.eye(n) - pinv[:n] @ axes.T
+        head = [n, self.spin_inertia_kg_m2, self.max_torque_nm, self.max_speed_rpm * _RPM,
+                self.viscous_nm_s_rad, self.coulomb_nm, self.coulomb_smoothing_rad_s,
+                self.motor_time_constant_s, self.null_space_gain_1_s,
+                self.bias_speed_rpm * _RPM, self.initial_speed_rpm * _RPM]  # fmt: skip
+        return np.concatenate([head, A.ravel(), pinv.ravel(), null.ravel()])
+
+
+@njit(cache=True, inline="always")
+def _momentum(p, s, i):
+    """h_i: the state holds its change from I_s Omega_0."""
+    return p[_IS] * p[_W0] + s[_H + i]
+
+
+@njit(DERIVATIVE_SIGNATURE, cache=True)
+def wheels_derivative(x, n_dof, t, params, state, state_dot, wrench):
+    """h_dot, u_dot, motor power, friction power; the wheels' wrench on the hub."""
+    p, s = params, state
+    n = int(p[_N])
+    w = true_body_rate(x, n_dof)
+    hx, hy, hz = 0.0, 0.0, 0.0
+    for i in range(n):
+        ax, ay, az = p[_A + i], p[_A + MAX_WHEELS + i], p[_A + 2 * MAX_WHEELS + i]
+        h = _momentum(p, s, i)
+        speed = h / p[_IS] - (ax * w[0] + ay * w[1] + az * w[2])  # Omega_i
+        u = s[_U + i]
+        if abs(h) >= p[_IS] * p[_WMAX] and u * h > 0.0:
+            u = 0.0  # the drive cuts the torque that would pass the momentum limit
+        friction = p[_CV] * speed + p[_CC] * tanh(speed / p[_WC])
+        h_dot = u - friction
+        state_dot[_H + i] = h_dot
+        state_dot[_U + i] = (s[_UCMD + i] - s[_U + i]) / p[_TAU]
+        state_dot[_WM] += u * speed
+        state_dot[_WF] += friction * speed
+        wrench[0] -= ax * h_dot
+        wrench[1] -= ay * h_dot
+        wrench[2] -= az * h_dot
+        hx += ax * h
+        hy += ay * h
+        hz += az * h
+    # - omega x sum a_i h_i
+    wrench[0] -= w[1] * hz - w[2] * hy
+    wrench[1] -= w[2] * hx - w[0] * hz
+    wrench[2] -= w[0] * hy - w[1] * hx
+    return 0
+
+
+@njit(ACTUATOR_SIGNATURE, cache=True)
+def wheels_step(tau_cmd, t, dt, params, state, tau_applied, record):
+    """Allocate the body torque to the motors (module docstring); nothing held on the
+    hub: the wheels act through their derivative."""
+    p, s = params, state
+    n = int(p[_N])
+    bias = p[_IS] * p[_WBIAS]
+    hx, hy, hz, energy, ratio, saturated = 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
+    for i in range(n):
+        u = 0.0
+        for a in range(3):
+            u -= p[_PINV + 3 * i + a] * tau_cmd[a]
+        for j in range(n):
+            u -= p[_KNULL] * p[_NULL + MAX_WHEELS * i + j] * (_momentum(p, s, j) - bias)
+        s[_UCMD + i] = min(p[_UMAX], max(-p[_UMAX], u))
+        h = _momentum(p, s, i)
+        hx += p[_A + i] * h
+        hy += p[_A + MAX_WHEELS + i] * h
+        hz += p[_A + 2 * MAX_WHEELS + i] * h
+        energy += 0.5 * h * h / p[_IS]
+        r = abs(h / p[_IS]) / p[_WMAX]
+        ratio = max(ratio, r)
+        if r >= _SATURATED:
+            saturated += 2.0**i
+    tau_applied[0], tau_applied[1], tau_applied[2] = 0.0, 0.0, 0.0
+    record[0], record[1], record[2] = hx, hy, hz
+    record[3] = energy
+    record[4] = s[_WM]
+    record[5] = s[_WF]
+    record[6] = ratio
+    record[7] = saturated
+    return 0
+
+
+WHEELS = StageSpec(
+    role="actuator", name="wheels", config=WheelsConfig, step=wheels_step,
+    derivative=wheels_derivative, state_size=3 * MAX_WHEELS + 2,
+    records=(
+        Channel("wheel_momentum_B", "N m s", "sum a_i h_i, hub frame B", per_axis=True),
+        Channel("wheel_kinetic_energy", "J", "sum h_i^2 / (2 I_s)"),
+        Channel("wheel_motor_work", "J", "integral of sum u_i Omega_i"),
+        Channel("wheel_friction_loss", "J", "integral of sum f_i Omega_i"),
+        Channel("wheel_speed_ratio", "1", "max |h_i| / (I_s Omega_max)"),
+        Channel("actuator_saturated", "1", "bit i set: wheel i at its momentum limit"),
+    ),
+    description="reaction-wheel cluster, momenta integrated with the plant",
+)  # fmt: skip

@@ -1,0 +1,123 @@
+"""RK4 step of the plant coupled with the actuation chain's continuous states (numba).
+
+An actuation stage with a ``derivative`` (``DERIVATIVE_SIGNATURE``, contract in
+:mod:`flexsat.control.stages.registry`) integrates entries of its own state with
+the plant inside each RK4 step: at every RK4 stage the derivatives are evaluated
+with the plant state and the chain's state at that stage, they return the state
+rates and the wrench on the hub, and the plant sees the held torque plus that
+wrench. A reaction wheel's momentum, whose reaction torque depends on the body
+rate within the step, is integrated this way (``docs/control.md``, 'Continuous
+actuator states'). The ideal loop (no derivative) never calls this module: its
+plant step is :func:`flexsat.dynamics.integrators.rk4_step`, bit for bit.
+"""
+
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import numpy as np
+from numba import njit
+
+from flexsat.dynamics.integrators import augmented_derivative
+from flexsat.dynamics.status import STATUS_NOT_FINITE, STATUS_OK
+
+__all__ = ["LoopFlow", "chain_wrench", "rk4_coupled_hold", "rk4_coupled_step"]
+
+
+class LoopFlow(NamedTuple):
+    """Work arrays of the coupled step (float64, C order), allocated once per run.
+
+    ``state`` is the actuation chain's state block (a view into the control state),
+    ``state_views`` each stage's piece of it; ``eval``/``dot`` (same length) hold the
+    chain's state at an RK4 stage and its rate, ``eval_views``/``dot_views`` each
+    stage's piece of them; ``k`` (4, m) the four rates; ``wrench`` (3,) the stages'
+    torque on the hub [N m]; ``held`` (3,) the chain's held output [N m].
+    """
+
+    state: np.ndarray
+    eval: np.ndarray
+    eval_views: tuple
+    dot: np.ndarray
+    dot_views: tuple
+    k: np.ndarray
+    wrench: np.ndarray
+    held: np.ndarray
+
+
+@njit(cache=True)
+def chain_wrench(x, n, t, derivatives, params, flow):
+    """Evaluate every stage's derivative at (x, flow.eval): flow.dot and flow.wrench."""
+    flow.dot[:] = 0.0
+    flow.wrench[:] = 0.0
+    status = 0
+    for i in range(len(derivatives)):
+        status |= derivatives[i](x, n, t, params[i], flow.eval_views[i], flow.dot_views[i],
+                                 flow.wrench)  # fmt: skip
+    return status
+
+
+@njit(cache=True, inline="always")
+def _rates(x, n, t, derivatives, params, flow, Q, k, kc, packed):
+    status = chain_wrench(x, n, t, derivatives, params, flow)
+    h, w = flow.held, flow.wrench
+    torque = (h[0] + w[0], h[1] + w[1], h[2] + w[2])
+    status |= augmented_derivative(x, torque, n, Q, k, packed)
+    kc[:] = flow.dot
+    return status
+
+
+@njit(cache=True)
+def rk4_coupled_step(x, t, dt, n, Q, scratch, derivatives, params, flow, packed):
+    """One RK4 step of the plant state ``x`` and the chain state ``flow.state``, in place.
+
+    The held torque is ``flow.held``; ``scratch`` (5, len(x)) and ``Q`` (n,) as for
+    :func:`~flexsat.dynamics.integrators.rk4_step`. On a non-zero status both states
+    are left unchanged.
+    """
+    size, m = x.shape[0], flow.state.shape[0]
+    c, ce, kc = flow.state, flow.eval, flow.k
+    k1, k2, k3, k4, stage = scratch[0], scratch[1], scratch[2], scratch[3], scratch[4]
+    ce[:] = c
+    status = _rates(x, n, t, derivatives, params, flow, Q, k1, kc[0], packed)
+    for j in range(size):
+        stage[j] = x[j] + 0.5 * dt * k1[j]
+    for j in range(m):
+        ce[j] = c[j] + 0.5 * dt * kc[0, j]
+    status |= _rates(stage, n, t + 0.5 * dt, derivatives, params, flow, Q, k2, kc[1], packed)
+    for j in range(size):
+        stage[j] = x[j] + 0.5 * dt * k2[j]
+    for j in range(m):
+        ce[j] = c[j] + 0.5 * dt * kc[1, j]
+    status |= _rates(stage, n, t + 0.5 * dt, derivatives, params, flow, Q, k3, kc[2], packed)
+    for j in range(size):
+        stage[j] = x[j] + dt * k3[j]
+    for j in range(m):
+        ce[j] = c[j] + dt * kc[2, j]
+    status |= _rates(stage, n, t + dt, derivatives, params, flow, Q, k4, kc[3], packed)
+    if status != STATUS_OK:
+        return status
+    for j in range(size):
+        stage[j] = x[j] + dt / 6.0 * (k1[j] + 2.0 * k2[j] + 2.0 * k3[j] + k4[j])
+        if not np.isfinite(stage[j]):
+            return STATUS_NOT_FINITE
+    for j in range(m):
+        ce[j] = c[j] + dt / 6.0 * (kc[0, j] + 2.0 * kc[1, j] + 2.0 * kc[2, j] + kc[3, j])
+        if not np.isfinite(ce[j]):
+            return STATUS_NOT_FINITE
+    x[:] = stage
+    c[:] = ce
+    return STATUS_OK
+
+
+@njit(cache=True)
+def rk4_coupled_hold(x, t0, dt, n_steps, derivatives, params, flow, packed):
+    """``n_steps`` coupled RK4 steps under the held ``flow.held``. Returns (status, done)."""
+    n = packed.n_dof
+    scratch = np.empty((5, x.shape[0]))
+    Q = np.empty(n)
+    for k in range(n_steps):
+        status = rk4_coupled_step(x, t0 + k * dt, dt, n, Q, scratch, derivatives, params, flow,
+                                  packed)  # fmt: skip
+        if status != STATUS_OK:
+            return status, k
+    return STATUS_OK, n_steps
