@@ -9,8 +9,9 @@ Cases come from any combination of:
   per case spawned from ``root_seed`` (``numpy.random.SeedSequence(root).spawn``).
 
 ``plant`` modifiers act on the satellite config, ``scenario`` modifiers on the slew
-scenario. Expansion happens once, in the parent process: every backend and worker
-count runs the very same resolved cases.
+scenario. Cases are resolved in the parent process, one at a time as the runner
+consumes them (:class:`CaseStream`): every backend and worker count runs the very
+same resolved cases, and a 1e6-case campaign starts at once with flat memory.
 """
 
 from __future__ import annotations
@@ -18,6 +19,8 @@ from __future__ import annotations
 import hashlib
 import itertools
 import json
+import re
+from collections.abc import Iterator
 from dataclasses import dataclass
 from importlib import resources
 from pathlib import Path
@@ -35,7 +38,10 @@ from flexsat.simulate.scenario import SlewScenario
 
 __all__ = [
     "CAMPAIGN_PRESETS",
+    "HEAD_CASES",
     "CampaignDefinition",
+    "CaseDigest",
+    "CaseStream",
     "ResolvedCase",
     "campaign_fingerprint",
     "load_campaign",
@@ -103,7 +109,11 @@ class CampaignDefinition(_Frozen):
 
 @dataclass(frozen=True)
 class ResolvedCase:
-    """A case ready to run anywhere: validated plant config and scenario as plain dicts."""
+    """A case ready to run anywhere: validated plant config and scenario as plain dicts.
+
+    ``error`` is empty, or why the case's inputs were refused (a random draw out of
+    range met while streaming): such a case is stored as failed without running.
+    """
 
     case_id: str
     root_seed: int
@@ -111,6 +121,7 @@ class ResolvedCase:
     plant: dict
     scenario: dict
     parameters: dict
+    error: str = ""
 
     @property
     def digest(self) -> str:
@@ -122,8 +133,148 @@ def _digest(data) -> str:
     return hashlib.sha256(json.dumps(data, sort_keys=True).encode()).hexdigest()[:16]
 
 
+HEAD_CASES = 100
+"""Cases resolved before a campaign starts: their digest is the store's ``case_inputs``."""
+
+_RANDOM_ID = re.compile(r"random-(\d{5,})")
+
+
+class CaseStream:
+    """The cases of a campaign, resolved one at a time as they are consumed.
+
+    Preparing a case (applying its modifiers, validating its plant and scenario)
+    takes a few milliseconds; a 1e6-case campaign is never held in memory nor
+    prepared up front. What can be checked without resolving every case is checked
+    on construction, before any case runs: the case count, unique ids, every
+    explicit and grid case and the first :data:`HEAD_CASES` cases (resolved,
+    validated and their run sizes estimated, strictly).
+
+    Iterating resolves the cases in order; a later case whose draws are refused is
+    yielded with its ``error`` set (stored as a failed row), not raised, unless
+    ``strict``.
+
+    Raises
+    ------
+    ConfigError
+        On construction: a bad count, duplicate ids, a bad modifier or value in
+        the checked cases.
+    """
+
+    def __init__(
+        self,
+        definition: CampaignDefinition,
+        satellite: SatelliteConfig,
+        n_random: int | None = None,
+        strict: bool = False,
+    ) -> None:
+        from flexsat.dynamics.plant import Plant
+
+        self.definition, self.strict = definition, strict
+        self._plant_base = satellite.model_dump(mode="json")
+        scenario_base = SlewScenario.model_validate(definition.base).model_dump(
+            mode="json", by_alias=True
+        )
+        if scenario_base["design_inertia_kg_m2"] is None:  # the base configuration's design
+            scenario_base["design_inertia_kg_m2"] = design_inertia(satellite).tolist()
+        self._scenario_base = scenario_base
+        self._n_dof = Plant.from_config(satellite).n_dof  # modifiers change values only
+        self._sized: set[tuple] = set()
+        self._fixed = self._fixed_specs()
+        self.n_random = 0
+        if definition.random is not None:
+            self.n_random = definition.random.n if n_random is None else n_random
+            if self.n_random < 1:
+                raise ConfigError(f"--cases must be >= 1, got {self.n_random}")
+        ids = [spec[0] for spec in self._fixed]
+        clash = [i for i in ids if (m := _RANDOM_ID.fullmatch(i)) and int(m[1]) < self.n_random]
+        if len(set(ids)) != len(ids) or clash:
+            raise ConfigError(f"campaign {definition.name}: duplicate case ids")
+        self.head = [self._resolve(spec) for spec in self._fixed]
+        n_head = min(self.n_random, max(1, HEAD_CASES - len(self.head)))
+        self.head += [self._resolve(self._random_spec(i)) for i in range(n_head)]
+
+    def __len__(self) -> int:
+        return len(self._fixed) + self.n_random
+
+    def __iter__(self) -> Iterator[ResolvedCase]:
+        yield from self.head
+        for i in range(len(self.head) - len(self._fixed), self.n_random):
+            spec = self._random_spec(i)
+            try:
+                yield self._resolve(spec)
+            except ConfigError as exc:
+                if self.strict:
+                    raise
+                yield ResolvedCase(spec[0], *spec[1], plant={}, scenario={}, parameters={},
+                                   error=str(exc))  # fmt: skip
+
+    def head_digest(self) -> str:
+        """Digest over the ids and inputs of the first :data:`HEAD_CASES` cases."""
+        return _digest([[case.case_id, case.digest] for case in self.head[:HEAD_CASES]])
+
+    def _fixed_specs(self) -> list[tuple[str, tuple[int, int], list, list]]:
+        """(id, (root seed, index) of its random stream, plant and scenario modifiers)."""
+        definition = self.definition
+        specs: list[tuple[str, tuple[int, int], list[Modifier], list[Modifier]]] = []
+        if definition.include_nominal:
+            specs.append(("nominal", (0, 0), [], []))
+        specs += [(c.id, (0, k), c.plant, c.scenario) for k, c in enumerate(definition.cases)]
+        if definition.grid is not None:
+            grid = definition.grid
+            for k, levels in enumerate(itertools.product(*(axis.levels for axis in grid.axes))):
+                case_id = "+".join(level.label for level in levels)
+                plant = [*grid.common.plant, *(m for lv in levels for m in lv.plant)]
+                scenario = [*grid.common.scenario, *(m for lv in levels for m in lv.scenario)]
+                specs.append((case_id, (grid.seed, k), plant, scenario))
+        return specs
+
+    def _random_spec(self, i: int) -> tuple[str, tuple[int, int], list, list]:
+        rnd = self.definition.random
+        return (f"random-{i:05d}", (rnd.root_seed, i), rnd.plant, rnd.scenario)
+
+    def _resolve(self, spec) -> ResolvedCase:
+        from flexsat.simulate.common import check_run_size
+
+        case_id, (root, index), plant_mods, scenario_mods = spec
+        # The stream SeedSequence(root).spawn(n)[index] would give, built directly.
+        rng = np.random.default_rng(np.random.SeedSequence(root, spawn_key=(index,)))
+        realised: dict = {}
+        try:
+            plant = apply_modifiers(self._plant_base, plant_mods, rng, realised)
+            scenario = apply_modifiers(self._scenario_base, scenario_mods, rng, realised)
+        except KeyError as exc:
+            raise ConfigError(f"campaign case {case_id!r}: {exc.args[0]}") from None
+        validate_config(plant, source=f"campaign case {case_id!r} (plant)")
+        source = f"campaign case {case_id!r} (scenario)"
+        model = validate_config(scenario, source=source, model=SlewScenario)
+        timing = (model.duration_s, model.dt_s, model.record_dt_s)
+        if timing not in self._sized:  # the records must fit in a worker
+            try:
+                check_run_size(self._n_dof, model)
+            except ConfigError as exc:
+                name = self.definition.name
+                raise ConfigError(f"campaign {name}, case {case_id!r}: {exc}") from None
+            self._sized.add(timing)
+        return ResolvedCase(case_id, root, index, plant, scenario, realised)
+
+
+class CaseDigest:
+    """The digest over every case's id and inputs, built as the cases stream by."""
+
+    def __init__(self) -> None:
+        self._hash = hashlib.sha256()
+        self.count = 0
+
+    def add(self, case: ResolvedCase) -> None:
+        self._hash.update(f"{case.case_id}:{case.digest};".encode())
+        self.count += 1
+
+    def hexdigest(self) -> str:
+        return self._hash.hexdigest()[:16]
+
+
 def campaign_fingerprint(
-    definition: CampaignDefinition, satellite: SatelliteConfig, cases: list[ResolvedCase]
+    definition: CampaignDefinition, satellite: SatelliteConfig, cases: CaseStream
 ) -> dict:
     """What a store's results depend on, part by part, to refuse a mixed resume.
 
@@ -131,13 +282,16 @@ def campaign_fingerprint(
     -------
     dict
         ``definition`` and ``satellite`` (digests), ``cases`` (count) and
-        ``case_inputs`` (a digest over every case's id and inputs).
+        ``case_inputs`` (a digest over the ids and inputs of the first
+        :data:`HEAD_CASES` cases). Every later case's inputs are checked against
+        its stored digest as the cases stream by, and the digest over all of them
+        (:class:`CaseDigest`) is recorded when the stream ends.
     """
     return {
         "definition": definition.fingerprint(),
         "satellite": _digest(satellite.model_dump(mode="json")),
         "cases": len(cases),
-        "case_inputs": _digest([[case.case_id, case.digest] for case in cases]),
+        "case_inputs": cases.head_digest(),
     }
 
 
@@ -160,51 +314,12 @@ def resolve_cases(
 ) -> list[ResolvedCase]:
     """Expand and validate every case; any bad modifier is refused before a case runs.
 
+    The whole list, in memory: for small campaigns and analyses. Campaign runs
+    stream them (:class:`CaseStream`).
+
     Raises
     ------
     ConfigError
         Naming the case and the problem (unknown path, invalid resulting value).
     """
-    plant_base = satellite.model_dump(mode="json")
-    scenario_base = SlewScenario.model_validate(definition.base).model_dump(
-        mode="json", by_alias=True
-    )
-    if scenario_base["design_inertia_kg_m2"] is None:  # the base configuration's design model
-        scenario_base["design_inertia_kg_m2"] = design_inertia(satellite).tolist()
-    # (id, (root seed, case index) of its random stream, plant and scenario modifiers)
-    specs: list[tuple[str, tuple[int, int], list[Modifier], list[Modifier]]] = []
-    if definition.include_nominal:
-        specs.append(("nominal", (0, 0), [], []))
-    specs += [(c.id, (0, k), c.plant, c.scenario) for k, c in enumerate(definition.cases)]
-    if definition.grid is not None:
-        grid = definition.grid
-        for k, levels in enumerate(itertools.product(*(axis.levels for axis in grid.axes))):
-            case_id = "+".join(level.label for level in levels)
-            plant = [*grid.common.plant, *(m for lv in levels for m in lv.plant)]
-            scenario = [*grid.common.scenario, *(m for lv in levels for m in lv.scenario)]
-            specs.append((case_id, (grid.seed, k), plant, scenario))
-    if definition.random is not None:
-        rnd = definition.random
-        n = rnd.n if n_random is None else n_random
-        if n < 1:
-            raise ConfigError(f"--cases must be >= 1, got {n}")
-        for i in range(n):
-            specs.append((f"random-{i:05d}", (rnd.root_seed, i), rnd.plant, rnd.scenario))
-    ids = [spec[0] for spec in specs]
-    if len(set(ids)) != len(ids):
-        raise ConfigError(f"campaign {definition.name}: duplicate case ids")
-    resolved = []
-    for case_id, (root, index), plant_mods, scenario_mods in specs:
-        # The stream SeedSequence(root).spawn(n)[index] would give, built directly.
-        rng = np.random.default_rng(np.random.SeedSequence(root, spawn_key=(index,)))
-        realised: dict = {}
-        try:
-            plant = apply_modifiers(plant_base, plant_mods, rng, realised)
-            scenario = apply_modifiers(scenario_base, scenario_mods, rng, realised)
-        except KeyError as exc:
-            raise ConfigError(f"campaign case {case_id!r}: {exc.args[0]}") from None
-        validate_config(plant, source=f"campaign case {case_id!r} (plant)")
-        source = f"campaign case {case_id!r} (scenario)"
-        validate_config(scenario, source=source, model=SlewScenario)
-        resolved.append(ResolvedCase(case_id, root, index, plant, scenario, realised))
-    return resolved
+    return list(CaseStream(definition, satellite, n_random, strict=True))

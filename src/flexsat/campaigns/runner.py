@@ -1,7 +1,8 @@
 """Running campaign cases: a local process pool (default) or a Dask cluster.
 
-Cases are resolved in the parent (:func:`resolve_cases`), so every backend and
-worker count runs the same inputs and the stored rows are identical bit for bit.
+Cases are resolved in the parent, streamed as the backend consumes them
+(:class:`~flexsat.campaigns.definition.CaseStream`), so every backend and worker
+count runs the same inputs and the stored rows are identical bit for bit.
 A case that raises or diverges is stored as failed with its message; the campaign
 goes on. Ctrl-C or SIGTERM stops the run at once (pending cases cancelled, workers
 stopped) and says how many cases are stored and how to resume.
@@ -10,6 +11,7 @@ stopped) and says how many cases are stored and how to resume.
 from __future__ import annotations
 
 import contextlib
+import itertools
 import os
 import re
 import signal
@@ -22,9 +24,10 @@ from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, T
 
 from flexsat.campaigns.definition import (
     CampaignDefinition,
+    CaseDigest,
+    CaseStream,
     ResolvedCase,
     campaign_fingerprint,
-    resolve_cases,
 )
 from flexsat.campaigns.pool import LocalPool
 from flexsat.campaigns.store import HISTORY_UNITS, CampaignStore
@@ -38,6 +41,7 @@ __all__ = [
     "CampaignInterrupted",
     "case_history",
     "replay_case",
+    "run_batch",
     "run_campaign",
     "run_case",
     "summarize",
@@ -161,6 +165,9 @@ def run_case(case: ResolvedCase) -> dict:
         "inputs": {"plant": case.plant, "scenario": case.scenario},  # for replay
     }
     start = time.perf_counter()
+    if case.error:  # refused while streaming: a failed row, nothing to run
+        row.update(status="failed", error=case.error, metrics={}, case_wall_time_s=0.0)
+        return row
     try:
         plant = Plant.from_config(SatelliteConfig.model_validate(case.plant))
         scenario = SlewScenario.model_validate(case.scenario)
@@ -223,8 +230,7 @@ def run_campaign(
     FlexsatError
         When the store cannot be written (full disk...), after stopping the workers.
     """
-    cases = resolve_cases(definition, satellite, n_random)
-    _check_sizes(definition, satellite, cases)
+    cases = CaseStream(definition, satellite, n_random)  # checks what it can up front
     store = CampaignStore(out)
     if store.root.exists() and not store.root.is_dir():
         raise ConfigError(f"--out {store.root}: exists and is not a folder")
@@ -233,13 +239,12 @@ def run_campaign(
     with _backend(workers, scheduler, dask_local) as execute, store.opened(
         campaign_fingerprint(definition, satellite, cases), definition.name, resume
     ):
-        done = store.finished({case.case_id: case.digest for case in cases})
-        todo = [case for case in cases if case.case_id not in done]
+        todo = _Todo(cases, store)
         columns = (TextColumn(f"campaign {definition.name}"), BarColumn(), MofNCompleteColumn(),
                    TextColumn("failed {task.fields[failed]}"), TimeRemainingColumn())  # fmt: skip
         interrupts = _Interrupts()
         with Progress(*columns, disable=not progress, transient=True) as bar, interrupts:
-            task = bar.add_task("cases", total=len(cases), completed=len(done), failed=0)
+            task = bar.add_task("cases", total=len(cases), completed=0, failed=0)
             try:
                 for row in execute(todo):
                     history = row.pop(HISTORY_KEY, None)
@@ -248,11 +253,11 @@ def run_campaign(
                             store.write_history(row["case_id"], history, status=row["status"])
                         store.write_case(row)
                     failed += row["status"] != "ok"
-                    bar.update(task, advance=1, failed=failed)
+                    bar.update(task, completed=todo.skipped + todo.ran_done(), failed=failed)
             except _Interrupted as stop:
                 interrupted = CampaignInterrupted(
                     f"campaign {definition.name} interrupted ({stop.name}): "
-                    f"{_stored(store, cases)} of {len(cases)} cases are stored in {store.root}; "
+                    f"{store.finished()} of {len(cases)} cases are stored in {store.root}; "
                     "run the same command with --resume to finish it",
                 )
                 interrupted.exit_code = 128 + stop.signum  # the shell's convention
@@ -260,13 +265,14 @@ def run_campaign(
             except OSError as exc:
                 raise _write_error(store, cases, exc) from None
         try:
+            store.record_case_inputs(todo.digest.hexdigest())
             parquet, csv = store.write_tables()
         except OSError as exc:
             raise _write_error(store, cases, exc) from None
     return {
         "campaign": definition.name,
         "cases": len(cases),
-        "ran": len(todo),
+        "ran": todo.ran,
         "failed": sum(row["status"] != "ok" for row in store.rows()),
         "wall_time_s": time.perf_counter() - start,
         "parquet": str(parquet),
@@ -274,36 +280,46 @@ def run_campaign(
     }
 
 
-def _check_sizes(definition, satellite: SatelliteConfig, cases: list[ResolvedCase]) -> None:
-    """Refuse, before any case runs, a case whose records would not fit in a worker."""
-    from flexsat.dynamics.plant import Plant
-    from flexsat.simulate import SlewScenario
-    from flexsat.simulate.common import check_run_size
+class _Todo:
+    """The cases still to run, streamed: stored ones are skipped after checking that
+    they were made from the same inputs; the digest over every case is built on the way.
+    """
 
-    n_dof = Plant.from_config(satellite).n_dof  # modifiers change values, not coordinates
-    timing = ("duration_s", "dt_s", "record_dt_s")
-    seen = set()
-    for case in cases:
-        key = tuple(case.scenario.get(name) for name in timing)
-        if key in seen:
-            continue
-        seen.add(key)
-        try:
-            check_run_size(n_dof, SlewScenario.model_validate(case.scenario))
-        except ConfigError as exc:
-            raise ConfigError(f"campaign {definition.name}, case {case.case_id!r}: {exc}") from None
+    def __init__(self, cases: CaseStream, store: CampaignStore) -> None:
+        self.cases, self.store = cases, store
+        self.stored = store.stored_ids()
+        self.digest = CaseDigest()
+        self.skipped = self.ran = 0
+        self._results = 0
+
+    def ran_done(self) -> int:
+        self._results += 1
+        return self._results
+
+    def __iter__(self) -> Iterator[ResolvedCase]:
+        for case in self.cases:
+            self.digest.add(case)
+            if case.case_id in self.stored:
+                digest = self.store.stored_digest(case.case_id)
+                if digest == case.digest:
+                    self.skipped += 1
+                    continue
+                if digest is not None:
+                    raise ConfigError(
+                        f"{self.store.root}: case {case.case_id!r} is stored with other "
+                        f"inputs (stored {digest!r}, given {case.digest!r}); refusing to "
+                        "resume into it. Use another --out"
+                    )
+            self.ran += 1
+            yield case
 
 
-def _write_error(store: CampaignStore, cases: list[ResolvedCase], exc: OSError) -> FlexsatError:
+def _write_error(store: CampaignStore, cases: CaseStream, exc: OSError) -> FlexsatError:
     return FlexsatError(
         f"cannot write to the campaign store {store.root}: {exc.strerror or exc}; "
-        f"{_stored(store, cases)} of {len(cases)} cases are stored; fix it and "
+        f"{store.finished()} of {len(cases)} cases are stored; fix it and "
         "run the same command with --resume to finish"
     )
-
-
-def _stored(store: CampaignStore, cases: list[ResolvedCase]) -> int:
-    return len(store.finished({case.case_id: case.digest for case in cases}))
 
 
 class _Interrupted(BaseException):
@@ -380,13 +396,16 @@ def _backend(workers, scheduler, dask_local):
         return
     workers = workers or os.cpu_count() or 1
 
-    def execute(todo) -> Iterator[dict]:
-        if workers == 1 or len(todo) <= 1:
-            for case in todo:
+    def execute(todo: _Todo) -> Iterator[dict]:
+        source = iter(todo)
+        first = list(itertools.islice(source, 2))  # no workers for one case or none
+        if workers == 1 or len(first) <= 1:
+            for case in itertools.chain(first, source):
                 yield run_case(case)
             return
-        with LocalPool(run_case, min(workers, len(todo)), _lost_case) as pool:
-            yield from pool.map_unordered(todo)
+        n = min(workers, len(todo.cases))
+        with LocalPool(run_case, n, _lost_case) as pool:
+            yield from pool.map_unordered(itertools.chain(first, source))
 
     yield execute
 
@@ -415,12 +434,36 @@ def _dask_client(scheduler, dask_local):
             cluster.close()
 
 
+DASK_BATCH = 8
+"""Cases per Dask task: a task's overhead (a few ms) is paid once per batch."""
+
+
+def run_batch(cases: list[ResolvedCase]) -> list[dict]:
+    """Rows of :func:`run_case` for each case, in one task (never raises)."""
+    return [run_case(case) for case in cases]
+
+
 def _dask(client, todo) -> Iterator[dict]:
+    """Batches of cases submitted as they are streamed, a few per worker in flight."""
     from dask.distributed import as_completed as dask_completed
 
-    futures = client.map(run_case, todo, pure=False)
+    source = iter(todo)
+    window = 2 * max(1, sum(client.nthreads().values()))
+
+    def submit(completed) -> bool:
+        batch = list(itertools.islice(source, DASK_BATCH))
+        if batch:
+            completed.add(client.submit(run_batch, batch, pure=False))
+        return bool(batch)
+
+    completed = dask_completed([])
     try:
-        for future in dask_completed(futures):
-            yield future.result()
+        for _ in range(window):
+            if not submit(completed):
+                break
+        for future in completed:
+            yield from future.result()
+            future.release()
+            submit(completed)
     finally:
-        client.cancel(futures)
+        client.cancel(list(completed.futures))
