@@ -208,10 +208,6 @@ class CaseStream:
                 yield ResolvedCase(spec[0], *spec[1], plant={}, scenario={}, parameters={},
                                    error=str(exc))  # fmt: skip
 
-    def head_digest(self) -> str:
-        """Digest over the ids and inputs of the first :data:`HEAD_CASES` cases."""
-        return _digest([[case.case_id, case.digest] for case in self.head[:HEAD_CASES]])
-
     def _fixed_specs(self) -> list[tuple[str, tuple[int, int], list, list]]:
         """(id, (root seed, index) of its random stream, plant and scenario modifiers)."""
         definition = self.definition
@@ -274,7 +270,9 @@ class CaseDigest:
 
 
 def campaign_fingerprint(
-    definition: CampaignDefinition, satellite: SatelliteConfig, cases: CaseStream
+    definition: CampaignDefinition,
+    satellite: SatelliteConfig,
+    cases: CaseStream | list[ResolvedCase],
 ) -> dict:
     """What a store's results depend on, part by part, to refuse a mixed resume.
 
@@ -287,11 +285,12 @@ def campaign_fingerprint(
         its stored digest as the cases stream by, and the digest over all of them
         (:class:`CaseDigest`) is recorded when the stream ends.
     """
+    head = cases.head if isinstance(cases, CaseStream) else cases
     return {
         "definition": definition.fingerprint(),
         "satellite": _digest(satellite.model_dump(mode="json")),
         "cases": len(cases),
-        "case_inputs": cases.head_digest(),
+        "case_inputs": _digest([[c.case_id, c.digest] for c in head[:HEAD_CASES]]),
     }
 
 
