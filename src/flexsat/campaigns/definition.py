@@ -40,6 +40,7 @@ __all__ = [
     "CAMPAIGN_PRESETS",
     "HEAD_CASES",
     "CampaignDefinition",
+    "Reduced",
     "CaseDigest",
     "CaseStream",
     "ResolvedCase",
@@ -81,6 +82,25 @@ class RandomCases(_Frozen):
     scenario: list[Modifier] = Field(default_factory=list)
 
 
+class Reduced(_Frozen):
+    """A reduced model for every case: joint DOFs locked, a longer step.
+
+    The controller's rate is its own setting (``control_dt_s``, a whole multiple of
+    ``dt_s``). See docs/campaigns.md, 'Reduced models'.
+    """
+
+    locked_dofs: list[str] = Field(
+        default_factory=lambda: ["eta_x", "eta_y", "eta_z"],
+        description="coordinates locked on every appendage whose model has them",
+    )
+    dt_s: Annotated[float, Field(gt=0.0, le=0.1, allow_inf_nan=False)] = Field(
+        0.01, description="RK4 step of the reduced model [s]"
+    )
+    control_dt_s: Annotated[float, Field(gt=0.0, le=10.0, allow_inf_nan=False)] = Field(
+        0.01, description="control period [s] (a whole multiple of dt_s)"
+    )
+
+
 class CampaignDefinition(_Frozen):
     """A campaign: the satellite, the base slew, and how the cases vary them."""
 
@@ -93,6 +113,7 @@ class CampaignDefinition(_Frozen):
     cases: list[CaseSpec] = Field(default_factory=list)
     grid: Grid | None = None
     random: RandomCases | None = None
+    reduced: Reduced | None = Field(None, description="fly every case on a reduced model")
 
     @model_validator(mode="after")
     def _has_cases(self) -> CampaignDefinition:
@@ -174,6 +195,8 @@ class CaseStream:
         scenario_base = SlewScenario.model_validate(definition.base).model_dump(
             mode="json", by_alias=True
         )
+        if definition.reduced is not None:
+            _reduce(self._plant_base, scenario_base, definition.reduced)
         if scenario_base["design_inertia_kg_m2"] is None:  # the base configuration's design
             scenario_base["design_inertia_kg_m2"] = design_inertia(satellite).tolist()
         self._scenario_base = scenario_base
@@ -252,6 +275,17 @@ class CaseStream:
                 raise ConfigError(f"campaign {name}, case {case_id!r}: {exc}") from None
             self._sized.add(timing)
         return ResolvedCase(case_id, root, index, plant, scenario, realised)
+
+
+def _reduce(plant: dict, scenario: dict, reduced: Reduced) -> None:
+    """Apply a :class:`Reduced` model to the base plant and scenario (plain dicts)."""
+    from flexsat.config.models import APPENDAGE_CONFIGS
+
+    for appendage in plant["appendages"]:
+        fields = APPENDAGE_CONFIGS[appendage.get("model", "plate")].model_fields
+        if "locked_dofs" in fields:  # a model that can lock coordinates
+            appendage["locked_dofs"] = list(reduced.locked_dofs)
+    scenario["dt_s"], scenario["control_dt_s"] = reduced.dt_s, reduced.control_dt_s
 
 
 class CaseDigest:
