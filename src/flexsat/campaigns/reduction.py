@@ -112,7 +112,10 @@ def compare_reduction(
     tables: dict[str, list[pd.DataFrame]] = {"full": [], "reduced": []}
     wall = {"full": 0.0, "reduced": 0.0}
     for definition in definitions:
-        variants = {"full": definition, "reduced": definition.model_copy(update={"reduced": reduced})}
+        variants = {
+            "full": definition,
+            "reduced": definition.model_copy(update={"reduced": reduced}),
+        }
         for kind, variant in variants.items():
             store = Path(out) / kind / definition.name
             run = run_campaign(variant, satellite, store, workers=workers, resume=True,
