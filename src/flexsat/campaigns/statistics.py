@@ -25,6 +25,7 @@ from scipy import stats
 from flexsat.campaigns.modifiers import _targets
 
 __all__ = [
+    "PERCENTILES",
     "REQUIREMENTS",
     "cases_needed",
     "metric_columns",
@@ -44,6 +45,7 @@ REQUIREMENTS = {
 """The verdict columns of a campaign (``metrics.<key>``) and what each requirement is."""
 
 PERCENTILES = (5.0, 50.0, 95.0)
+"""The percentiles reported beside the minimum and maximum [%]."""
 
 # Units of a config path, from the suffix of its last name (SI, degrees at the boundary).
 _UNITS = (("_hz", "Hz"), ("_kg_m2", "kg m^2"), ("_kg", "kg"), ("_deg_s", "deg/s"),
