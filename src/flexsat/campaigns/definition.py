@@ -24,7 +24,7 @@ from collections.abc import Iterator
 from dataclasses import dataclass
 from importlib import resources
 from pathlib import Path
-from typing import Annotated
+from typing import Annotated, Literal
 
 import numpy as np
 from pydantic import Field, model_validator
@@ -42,11 +42,15 @@ __all__ = [
     "CampaignDefinition",
     "CaseDigest",
     "CaseStream",
+    "Dispersed",
     "Reduced",
     "ResolvedCase",
+    "SobolCases",
     "campaign_fingerprint",
     "load_campaign",
     "resolve_cases",
+    "sobol_problem",
+    "sobol_samples",
 ]
 
 CAMPAIGN_PRESETS = ("sensitivity", "montecarlo-critical", "deployment-shock", "montecarlo-random")
@@ -82,6 +86,40 @@ class RandomCases(_Frozen):
     scenario: list[Modifier] = Field(default_factory=list)
 
 
+class Dispersed(_Frozen):
+    """One parameter of a Sobol or worst-case campaign: a path and its range."""
+
+    path: Annotated[str, Field(min_length=1)]
+    op: Literal["set", "scale"] = "set"
+    bounds: tuple[float, float] = Field(description="[low, high] of the value or factor")
+
+    @model_validator(mode="after")
+    def _ordered(self) -> Dispersed:
+        if not self.bounds[0] < self.bounds[1]:
+            raise ValueError(f"{self.path}: bounds must satisfy low < high")
+        return self
+
+    def modifier(self, value: float) -> Modifier:
+        return Modifier(path=self.path, op=self.op, value=float(value))
+
+
+class SobolCases(_Frozen):
+    """Saltelli's sampling of the parameters for first and total Sobol indices (SALib):
+    ``n`` (D + 2) cases for D parameters."""
+
+    n: Annotated[int, Field(ge=2, le=65536)] = Field(
+        64, description="base sample size N, a power of 2"
+    )
+    seed: Annotated[int, Field(ge=0)] = 0
+    parameters: Annotated[list[Dispersed], Field(min_length=1, max_length=64)]
+
+    @model_validator(mode="after")
+    def _power_of_two(self) -> SobolCases:
+        if self.n & (self.n - 1):
+            raise ValueError(f"n must be a power of 2 (Sobol' sequence), got {self.n}")
+        return self
+
+
 class Reduced(_Frozen):
     """A reduced model for every case: joint DOFs locked, a longer step.
 
@@ -113,12 +151,13 @@ class CampaignDefinition(_Frozen):
     cases: list[CaseSpec] = Field(default_factory=list)
     grid: Grid | None = None
     random: RandomCases | None = None
+    sobol: SobolCases | None = None
     reduced: Reduced | None = Field(None, description="fly every case on a reduced model")
 
     @model_validator(mode="after")
     def _has_cases(self) -> CampaignDefinition:
-        if not (self.cases or self.grid or self.random or self.include_nominal):
-            raise ValueError("a campaign needs cases, a grid, random cases or the nominal")
+        if not (self.cases or self.grid or self.random or self.sobol or self.include_nominal):
+            raise ValueError("a campaign needs cases, a grid, random or Sobol cases or the nominal")
         validate_config(self.base, source="base", model=SlewScenario)
         return self
 
@@ -157,7 +196,7 @@ def _digest(data) -> str:
 HEAD_CASES = 100
 """Cases resolved before a campaign starts: their digest is the store's ``case_inputs``."""
 
-_RANDOM_ID = re.compile(r"random-(\d{5,})")
+_STREAMED_ID = re.compile(r"(random|sobol)-(\d{5,})")
 
 
 class CaseStream:
@@ -208,21 +247,32 @@ class CaseStream:
             self.n_random = definition.random.n if n_random is None else n_random
             if self.n_random < 1:
                 raise ConfigError(f"--cases must be >= 1, got {self.n_random}")
+        self._sobol = None if definition.sobol is None else sobol_samples(definition.sobol)
+        # the streamed sources: (case count, spec of its k-th case)
+        self._sources = [(self.n_random, self._random_spec)]
+        if self._sobol is not None:
+            self._sources.append((len(self._sobol), self._sobol_spec))
         ids = [spec[0] for spec in self._fixed]
-        clash = [i for i in ids if (m := _RANDOM_ID.fullmatch(i)) and int(m[1]) < self.n_random]
+        counts = {"random": self.n_random, "sobol": self._sources[-1][0] if self._sobol
+                  is not None else 0}  # fmt: skip
+        clash = [i for i in ids if (m := _STREAMED_ID.fullmatch(i)) and int(m[2]) < counts[m[1]]]
         if len(set(ids)) != len(ids) or clash:
             raise ConfigError(f"campaign {definition.name}: duplicate case ids")
         self.head = [self._resolve(spec) for spec in self._fixed]
-        n_head = min(self.n_random, max(1, HEAD_CASES - len(self.head)))
-        self.head += [self._resolve(self._random_spec(i)) for i in range(n_head)]
+        n_head = min(self._n_streamed, max(1, HEAD_CASES - len(self.head)))
+        self.head += [self._resolve(self._streamed_spec(i)) for i in range(n_head)]
+
+    @property
+    def _n_streamed(self) -> int:
+        return sum(n for n, _ in self._sources)
 
     def __len__(self) -> int:
-        return len(self._fixed) + self.n_random
+        return len(self._fixed) + self._n_streamed
 
     def __iter__(self) -> Iterator[ResolvedCase]:
         yield from self.head
-        for i in range(len(self.head) - len(self._fixed), self.n_random):
-            spec = self._random_spec(i)
+        for i in range(len(self.head) - len(self._fixed), self._n_streamed):
+            spec = self._streamed_spec(i)
             try:
                 yield self._resolve(spec)
             except ConfigError as exc:
@@ -230,6 +280,13 @@ class CaseStream:
                     raise
                 yield ResolvedCase(spec[0], *spec[1], plant={}, scenario={}, parameters={},
                                    error=str(exc))  # fmt: skip
+
+    def _streamed_spec(self, i: int) -> tuple[str, tuple[int, int], list, list]:
+        for n, spec in self._sources:
+            if i < n:
+                return spec(i)
+            i -= n
+        raise IndexError(i)
 
     def _fixed_specs(self) -> list[tuple[str, tuple[int, int], list, list]]:
         """(id, (root seed, index) of its random stream, plant and scenario modifiers)."""
@@ -250,6 +307,16 @@ class CaseStream:
     def _random_spec(self, i: int) -> tuple[str, tuple[int, int], list, list]:
         rnd = self.definition.random
         return (f"random-{i:05d}", (rnd.root_seed, i), rnd.plant, rnd.scenario)
+
+    def _sobol_spec(self, i: int) -> tuple[str, tuple[int, int], list, list]:
+        """The i-th row of Saltelli's sample, each parameter a modifier of the plant
+        (paths under ``hub`` and ``appendages``) or of the scenario (the others)."""
+        sobol = self.definition.sobol
+        plant, scenario = [], []
+        for parameter, value in zip(sobol.parameters, self._sobol[i], strict=True):
+            root = parameter.path.split(".")[0].split("[")[0]
+            (plant if root in ("hub", "appendages") else scenario).append(parameter.modifier(value))
+        return (f"sobol-{i:05d}", (sobol.seed, i), plant, scenario)
 
     def _resolve(self, spec) -> ResolvedCase:
         from flexsat.simulate.common import check_run_size
@@ -275,6 +342,28 @@ class CaseStream:
                 raise ConfigError(f"campaign {name}, case {case_id!r}: {exc}") from None
             self._sized.add(timing)
         return ResolvedCase(case_id, root, index, plant, scenario, realised)
+
+
+def sobol_problem(sobol: SobolCases) -> dict:
+    """SALib's problem dictionary of a Sobol campaign (names are the paths)."""
+    return {
+        "num_vars": len(sobol.parameters),
+        "names": [p.path for p in sobol.parameters],
+        "bounds": [list(p.bounds) for p in sobol.parameters],
+    }
+
+
+def sobol_samples(sobol: SobolCases) -> np.ndarray:
+    """Saltelli's sample (SALib, scrambled Sobol' sequence, seeded), shape
+    (n (D + 2), D): first and total indices, no second order."""
+    try:
+        from SALib.sample import sobol as sampler
+    except ImportError:
+        raise ConfigError(
+            "a Sobol campaign needs SALib: pip install 'flexsat[sensitivity]'"
+        ) from None
+    return sampler.sample(sobol_problem(sobol), sobol.n, calc_second_order=False,
+                          seed=sobol.seed)  # fmt: skip
 
 
 def _reduce(plant: dict, scenario: dict, reduced: Reduced) -> None:

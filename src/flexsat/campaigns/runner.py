@@ -85,7 +85,20 @@ def replay_case(store: str | Path, case_id: str):
 
 
 def summarize(store: str | Path) -> dict:
-    """Pass rates and the worst cases of a stored campaign."""
+    """Pass rates and the worst cases of a stored campaign.
+
+    Also ``requirements`` (per requirement: passes, the exact 95 % interval of the
+    pass rate and the failing case ids), ``metrics`` (per metric: min, 5/50/95 %,
+    max) and ``cases_for_3sigma_at_95`` (the cases needed, with no failure, to
+    claim 99.73 % at 95 % confidence); see :mod:`flexsat.campaigns.statistics`.
+    """
+    from flexsat.campaigns.statistics import (
+        cases_needed,
+        metric_statistics,
+        requirement_statistics,
+    )
+
+    table = CampaignStore(store).table()
     rows = CampaignStore(store).rows()
     n = len(rows)
 
@@ -106,6 +119,9 @@ def summarize(store: str | Path) -> dict:
         "r3_pass_rate": rate("r3_pass"),
         "worst_final_pointing_error_deg": worst[0][0] if worst else float("nan"),
         "worst_cases": [{"case_id": c, "final_pointing_error_deg": e} for e, c in worst],
+        "requirements": requirement_statistics(table).to_dict("records") if n else [],
+        "metrics": metric_statistics(table).to_dict("records") if n else [],
+        "cases_for_3sigma_at_95": cases_needed(0.9973, 0.95),
     }
 
 
