@@ -46,7 +46,9 @@ __all__ = [
     "Reduced",
     "ResolvedCase",
     "SobolCases",
+    "WorstCaseSearch",
     "campaign_fingerprint",
+    "dispersed_modifiers",
     "load_campaign",
     "resolve_cases",
     "sobol_problem",
@@ -103,6 +105,16 @@ class Dispersed(_Frozen):
         return Modifier(path=self.path, op=self.op, value=float(value))
 
 
+def dispersed_modifiers(parameters: list[Dispersed], values) -> tuple[list, list]:
+    """(plant, scenario) modifiers setting each parameter to its value: paths under
+    ``hub`` and ``appendages`` are the plant's, the others the scenario's."""
+    plant, scenario = [], []
+    for parameter, value in zip(parameters, values, strict=True):
+        root = parameter.path.split(".")[0].split("[")[0]
+        (plant if root in ("hub", "appendages") else scenario).append(parameter.modifier(value))
+    return plant, scenario
+
+
 class SobolCases(_Frozen):
     """Saltelli's sampling of the parameters for first and total Sobol indices (SALib):
     ``n`` (D + 2) cases for D parameters."""
@@ -118,6 +130,18 @@ class SobolCases(_Frozen):
         if self.n & (self.n - 1):
             raise ValueError(f"n must be a power of 2 (Sobol' sequence), got {self.n}")
         return self
+
+
+class WorstCaseSearch(_Frozen):
+    """Differential evolution over the parameters' box, maximizing ``metric``."""
+
+    metric: str = Field("final_pointing_error_deg", description="a numeric slew metric")
+    parameters: Annotated[list[Dispersed], Field(min_length=1, max_length=32)]
+    seed: Annotated[int, Field(ge=0)] = 0
+    maxiter: Annotated[int, Field(ge=1, le=1000)] = Field(10, description="generations")
+    popsize: Annotated[int, Field(ge=2, le=100)] = Field(
+        5, description="population = popsize x number of parameters"
+    )
 
 
 class Reduced(_Frozen):
@@ -152,10 +176,15 @@ class CampaignDefinition(_Frozen):
     grid: Grid | None = None
     random: RandomCases | None = None
     sobol: SobolCases | None = None
+    worst_case: WorstCaseSearch | None = Field(
+        None, description="search the parameters' box for the worst case (runs alone)"
+    )
     reduced: Reduced | None = Field(None, description="fly every case on a reduced model")
 
     @model_validator(mode="after")
     def _has_cases(self) -> CampaignDefinition:
+        if self.worst_case is not None and (self.cases or self.grid or self.random or self.sobol):
+            raise ValueError("a worst_case search runs alone: no cases, grid, random or sobol")
         if not (self.cases or self.grid or self.random or self.sobol or self.include_nominal):
             raise ValueError("a campaign needs cases, a grid, random or Sobol cases or the nominal")
         validate_config(self.base, source="base", model=SlewScenario)
@@ -258,9 +287,9 @@ class CaseStream:
         clash = [i for i in ids if (m := _STREAMED_ID.fullmatch(i)) and int(m[2]) < counts[m[1]]]
         if len(set(ids)) != len(ids) or clash:
             raise ConfigError(f"campaign {definition.name}: duplicate case ids")
-        self.head = [self._resolve(spec) for spec in self._fixed]
+        self.head = [self.resolve(spec) for spec in self._fixed]
         n_head = min(self._n_streamed, max(1, HEAD_CASES - len(self.head)))
-        self.head += [self._resolve(self._streamed_spec(i)) for i in range(n_head)]
+        self.head += [self.resolve(self._streamed_spec(i)) for i in range(n_head)]
 
     @property
     def _n_streamed(self) -> int:
@@ -274,7 +303,7 @@ class CaseStream:
         for i in range(len(self.head) - len(self._fixed), self._n_streamed):
             spec = self._streamed_spec(i)
             try:
-                yield self._resolve(spec)
+                yield self.resolve(spec)
             except ConfigError as exc:
                 if self.strict:
                     raise
@@ -312,13 +341,11 @@ class CaseStream:
         """The i-th row of Saltelli's sample, each parameter a modifier of the plant
         (paths under ``hub`` and ``appendages``) or of the scenario (the others)."""
         sobol = self.definition.sobol
-        plant, scenario = [], []
-        for parameter, value in zip(sobol.parameters, self._sobol[i], strict=True):
-            root = parameter.path.split(".")[0].split("[")[0]
-            (plant if root in ("hub", "appendages") else scenario).append(parameter.modifier(value))
-        return (f"sobol-{i:05d}", (sobol.seed, i), plant, scenario)
+        return (f"sobol-{i:05d}", (sobol.seed, i), *dispersed_modifiers(sobol.parameters,
+                                                                       self._sobol[i]))
 
-    def _resolve(self, spec) -> ResolvedCase:
+    def resolve(self, spec) -> ResolvedCase:
+        """Resolve one case from ``(id, (root seed, index), plant mods, scenario mods)``."""
         from flexsat.simulate.common import check_run_size
 
         case_id, (root, index), plant_mods, scenario_mods = spec

@@ -17,7 +17,7 @@ import re
 import signal
 import time
 import traceback
-from collections.abc import Iterator
+from collections.abc import Iterable, Iterator
 from pathlib import Path
 
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
@@ -246,6 +246,11 @@ def run_campaign(
     FlexsatError
         When the store cannot be written (full disk...), after stopping the workers.
     """
+    if definition.worst_case is not None:  # a search, not a fixed set of cases
+        from flexsat.campaigns.worstcase import run_worst_case
+
+        return run_worst_case(definition, definition.worst_case, satellite, out,
+                              workers=workers, resume=resume)  # fmt: skip
     cases = CaseStream(definition, satellite, n_random)  # checks what it can up front
     store = CampaignStore(out)
     if store.root.exists() and not store.root.is_dir():
@@ -262,7 +267,7 @@ def run_campaign(
         with Progress(*columns, disable=not progress, transient=True) as bar, interrupts:
             task = bar.add_task("cases", total=len(cases), completed=0, failed=0)
             try:
-                for row in execute(todo):
+                for row in execute(todo, len(cases)):
                     history = row.pop(HISTORY_KEY, None)
                     with interrupts.deferred():  # a signal never cuts a write in half
                         if history is not None:  # before the case: a stored case has its history
@@ -405,21 +410,22 @@ def _lost_case(case: ResolvedCase, exitcode: int | None) -> dict:
 
 @contextlib.contextmanager
 def _backend(workers, scheduler, dask_local):
-    """Connect to (or start) the backend, then yield ``execute(todo) -> rows``."""
+    """Connect to (or start) the backend, then yield ``execute(cases, size) -> rows``
+    (``size``: at most how many cases will come, to size the pool)."""
     if scheduler or dask_local:
         with _dask_client(scheduler, dask_local) as client:
-            yield lambda todo: _dask(client, todo)
+            yield lambda todo, size: _dask(client, todo)
         return
     workers = workers or os.cpu_count() or 1
 
-    def execute(todo: _Todo) -> Iterator[dict]:
+    def execute(todo: Iterable[ResolvedCase], size: int) -> Iterator[dict]:
         source = iter(todo)
         first = list(itertools.islice(source, 2))  # no workers for one case or none
         if workers == 1 or len(first) <= 1:
             for case in itertools.chain(first, source):
                 yield run_case(case)
             return
-        n = min(workers, len(todo.cases))
+        n = min(workers, size)
         with LocalPool(run_case, n, _lost_case) as pool:
             yield from pool.map_unordered(itertools.chain(first, source))
 
