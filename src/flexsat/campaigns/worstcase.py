@@ -109,7 +109,7 @@ def run_worst_case(
         )
     worst = max(values, key=values.get)
     summary = {
-        "campaign": definition.name, "case_id": worst, "metric": search.metric,
+        "campaign": definition.name, "worst_case": True, "case_id": worst, "metric": search.metric,
         "value": values[worst], "parameters": store.row(worst)["parameters"],
         "cases": state["evaluations"], "ran": state["ran"], "failed": len(state["failed"]),
         "failed_cases": state["failed"], "generations": int(result.nit),
