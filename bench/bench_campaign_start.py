@@ -31,7 +31,7 @@ def main(argv: list[str] | None = None) -> dict:
     parser.add_argument("--cases", type=int, default=1_000_000)
     parser.add_argument("--watch", type=int, default=50, help="stored cases to watch")
     args = parser.parse_args(argv)
-    console = Console()
+    console = Console(width=150)
     with tempfile.TemporaryDirectory(prefix="flexsat-bench-start-") as tmp:
         store = Path(tmp) / "big"
         command = [sys.executable, "-m", "flexsat", "campaign", "montecarlo-random",

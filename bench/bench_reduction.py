@@ -39,7 +39,7 @@ def main(argv: list[str] | None = None) -> dict:
     parser.add_argument("--duration", type=float, default=None, help="slew length [s]")
     parser.add_argument("--workers", type=int, default=2)
     args = parser.parse_args(argv)
-    console = Console()
+    console = Console(width=150)
     results = {}
     with tempfile.TemporaryDirectory(prefix="flexsat-bench-reduction-") as tmp:
         for label, names in SETS.items():

@@ -46,7 +46,7 @@ def main(argv: list[str] | None = None) -> dict:
     parser.add_argument("--only", choices=("full", "reduced"), default=None)
     parser.add_argument("--backends", default="local,dask")
     args = parser.parse_args(argv)
-    console = Console()
+    console = Console(width=150)
     models = [args.only] if args.only else ["reduced", "full"]
     backends = args.backends.split(",")
     n = args.cases + 1

@@ -58,7 +58,7 @@ def main(argv: list[str] | None = None) -> dict:
     parser.add_argument("--workers", type=int, default=2)
     parser.add_argument("--out", type=Path, default=None)
     args = parser.parse_args(argv)
-    console = Console()
+    console = Console(width=150)
     with tempfile.TemporaryDirectory(prefix="flexsat-bench-worst-") as tmp:
         out = args.out or Path(tmp)
         stores, found = {}, {}

@@ -282,8 +282,7 @@ class CaseStream:
         if self._sobol is not None:
             self._sources.append((len(self._sobol), self._sobol_spec))
         ids = [spec[0] for spec in self._fixed]
-        counts = {"random": self.n_random, "sobol": self._sources[-1][0] if self._sobol
-                  is not None else 0}  # fmt: skip
+        counts = {"random": self.n_random, "sobol": 0 if self._sobol is None else len(self._sobol)}
         clash = [i for i in ids if (m := _STREAMED_ID.fullmatch(i)) and int(m[2]) < counts[m[1]]]
         if len(set(ids)) != len(ids) or clash:
             raise ConfigError(f"campaign {definition.name}: duplicate case ids")
