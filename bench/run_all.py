@@ -2,7 +2,8 @@
 
 ``python bench/run_all.py`` (what ``make bench`` runs) prints, in this order, the
 tables of bench_dynamics, bench_openloop, bench_slew, bench_laws, bench_scaling, bench_startup,
-bench_campaigns, bench_figures and bench_basilisk (skipped with a line when Basilisk or the script
+bench_campaigns, bench_scale, bench_reduction, bench_campaign_start, bench_figures and
+bench_basilisk (skipped with a line when Basilisk or the script
 is missing), then one table of the performance targets: each target, the measured
 value, and met / not met. A benchmark that fails is reported and the others still
 run; the exit status is then 1.
@@ -39,6 +40,9 @@ BENCHMARKS = (
     "bench_scaling",
     "bench_startup",
     "bench_campaigns",
+    "bench_scale",
+    "bench_reduction",
+    "bench_campaign_start",
     "bench_figures",
     "bench_modal",
     "bench_basilisk",
@@ -51,6 +55,8 @@ OPENLOOP_MAX_S = 0.6
 SLEW_MAX_S = 0.7
 STARTUP_MAX_S = 2.0
 CAMPAIGNS_MAX_S = 30.0
+SCALE_MAX_S = 30.0  # 1000 random Monte Carlo cases, reduced model, 2 cores
+SCALE_EFFICIENCY = 0.9
 
 
 def cpu_model() -> str:
@@ -175,6 +181,23 @@ def targets(results: dict) -> list[tuple[str, str, bool | None, str]]:
         if "dask" in campaigns["scaling"]:
             note += f" (Dask {campaigns['scaling']['dask']['efficiency']:.0%})"
         rows.append((target, f"{value:.1f} s", value <= CAMPAIGNS_MAX_S, note))
+
+    scale = results.get("bench_scale")
+    target = f"1000 random MC cases, reduced model, 2 workers <= {SCALE_MAX_S:g} s"
+    reduced = (scale or {}).get("results", {}).get("reduced local")
+    if reduced is None:
+        rows.append((target, "-", None, "bench_scale not run"))
+    else:
+        full = scale["results"].get("full local")
+        note = f"{reduced['cases_per_s_2']:.2f} cases/s"
+        if full is not None:
+            note += f"; full model {full['per_1000_cases_2_s']:.0f} s"
+        value = reduced["per_1000_cases_2_s"]
+        rows.append((target, f"{value:.0f} s", value <= SCALE_MAX_S, note))
+    for key, run in (scale or {}).get("results", {}).items():
+        target = f"{key}: 1 -> 2 workers efficiency >= {SCALE_EFFICIENCY:.0%}"
+        rows.append((target, f"{run['efficiency']:.0%}", run["efficiency"] >= SCALE_EFFICIENCY,
+                     f"{scale['cases']} cases of {scale['duration_s']:g} s"))  # fmt: skip
     return rows
 
 

@@ -102,3 +102,22 @@ def test_envelope_contains_the_nominal_line(store, name, axis):
     assert (lo <= line).all() and (line <= hi).all()
     if name != "lambda_act":  # Λ_act has not adapted yet within 5 s
         assert (lo < hi).any()  # the cases do differ
+
+
+def test_envelope_percentiles_lie_inside_the_min_max_band(store):
+    from flexsat.plots.campaign import campaign_percentiles
+
+    histories = CampaignStore(store).histories()
+    t = np.asarray(next(iter(histories.values()))["time"].values)
+    lo, hi = campaign_envelope(histories, "pointing_error_deg", t)
+    p5, p50, p95 = campaign_percentiles(histories, "pointing_error_deg", t)
+    assert np.all(lo <= p5) and np.all(p5 <= p50) and np.all(p50 <= p95) and np.all(p95 <= hi)
+
+
+def test_statistics_figures_are_written(store, tmp_path):
+    from flexsat.plots.campaign_statistics import STATISTICS_FIGURES, write_statistics_figures
+
+    paths = write_statistics_figures(store, tmp_path)
+    assert [p.stem for p in paths] == list(STATISTICS_FIGURES)
+    for path in paths:
+        assert path.read_bytes()[:8] == PNG_MAGIC

@@ -9,8 +9,9 @@ Cases come from any combination of:
   per case spawned from ``root_seed`` (``numpy.random.SeedSequence(root).spawn``).
 
 ``plant`` modifiers act on the satellite config, ``scenario`` modifiers on the slew
-scenario. Expansion happens once, in the parent process: every backend and worker
-count runs the very same resolved cases.
+scenario. Cases are resolved in the parent process, one at a time as the runner
+consumes them (:class:`CaseStream`): every backend and worker count runs the very
+same resolved cases, and a 1e6-case campaign starts at once with flat memory.
 """
 
 from __future__ import annotations
@@ -18,10 +19,12 @@ from __future__ import annotations
 import hashlib
 import itertools
 import json
+import re
+from collections.abc import Iterator
 from dataclasses import dataclass
 from importlib import resources
 from pathlib import Path
-from typing import Annotated
+from typing import Annotated, Literal
 
 import numpy as np
 from pydantic import Field, model_validator
@@ -35,11 +38,21 @@ from flexsat.simulate.scenario import SlewScenario
 
 __all__ = [
     "CAMPAIGN_PRESETS",
+    "HEAD_CASES",
     "CampaignDefinition",
+    "CaseDigest",
+    "CaseStream",
+    "Dispersed",
+    "Reduced",
     "ResolvedCase",
+    "SobolCases",
+    "WorstCaseSearch",
     "campaign_fingerprint",
+    "dispersed_modifiers",
     "load_campaign",
     "resolve_cases",
+    "sobol_problem",
+    "sobol_samples",
 ]
 
 CAMPAIGN_PRESETS = ("sensitivity", "montecarlo-critical", "deployment-shock", "montecarlo-random")
@@ -75,6 +88,81 @@ class RandomCases(_Frozen):
     scenario: list[Modifier] = Field(default_factory=list)
 
 
+class Dispersed(_Frozen):
+    """One parameter of a Sobol or worst-case campaign: a path and its range."""
+
+    path: Annotated[str, Field(min_length=1)]
+    op: Literal["set", "scale"] = "set"
+    bounds: tuple[float, float] = Field(description="[low, high] of the value or factor")
+
+    @model_validator(mode="after")
+    def _ordered(self) -> Dispersed:
+        if not self.bounds[0] < self.bounds[1]:
+            raise ValueError(f"{self.path}: bounds must satisfy low < high")
+        return self
+
+    def modifier(self, value: float) -> Modifier:
+        return Modifier(path=self.path, op=self.op, value=float(value))
+
+
+def dispersed_modifiers(parameters: list[Dispersed], values) -> tuple[list, list]:
+    """(plant, scenario) modifiers setting each parameter to its value: paths under
+    ``hub`` and ``appendages`` are the plant's, the others the scenario's."""
+    plant, scenario = [], []
+    for parameter, value in zip(parameters, values, strict=True):
+        root = parameter.path.split(".")[0].split("[")[0]
+        (plant if root in ("hub", "appendages") else scenario).append(parameter.modifier(value))
+    return plant, scenario
+
+
+class SobolCases(_Frozen):
+    """Saltelli's sampling of the parameters for first and total Sobol indices (SALib):
+    ``n`` (D + 2) cases for D parameters."""
+
+    n: Annotated[int, Field(ge=2, le=65536)] = Field(
+        64, description="base sample size N, a power of 2"
+    )
+    seed: Annotated[int, Field(ge=0)] = 0
+    parameters: Annotated[list[Dispersed], Field(min_length=1, max_length=64)]
+
+    @model_validator(mode="after")
+    def _power_of_two(self) -> SobolCases:
+        if self.n & (self.n - 1):
+            raise ValueError(f"n must be a power of 2 (Sobol' sequence), got {self.n}")
+        return self
+
+
+class WorstCaseSearch(_Frozen):
+    """Differential evolution over the parameters' box, maximizing ``metric``."""
+
+    metric: str = Field("final_pointing_error_deg", description="a numeric slew metric")
+    parameters: Annotated[list[Dispersed], Field(min_length=1, max_length=32)]
+    seed: Annotated[int, Field(ge=0)] = 0
+    maxiter: Annotated[int, Field(ge=1, le=1000)] = Field(10, description="generations")
+    popsize: Annotated[int, Field(ge=2, le=100)] = Field(
+        5, description="population = popsize x number of parameters"
+    )
+
+
+class Reduced(_Frozen):
+    """A reduced model for every case: joint DOFs locked, a longer step.
+
+    The controller's rate is its own setting (``control_dt_s``, a whole multiple of
+    ``dt_s``). See docs/campaigns.md, 'Reduced models'.
+    """
+
+    locked_dofs: list[str] = Field(
+        default_factory=lambda: ["eta_x", "eta_y", "eta_z"],
+        description="coordinates locked on every appendage whose model has them",
+    )
+    dt_s: Annotated[float, Field(gt=0.0, le=0.1, allow_inf_nan=False)] = Field(
+        0.01, description="RK4 step of the reduced model [s]"
+    )
+    control_dt_s: Annotated[float, Field(gt=0.0, le=10.0, allow_inf_nan=False)] = Field(
+        0.01, description="control period [s] (a whole multiple of dt_s)"
+    )
+
+
 class CampaignDefinition(_Frozen):
     """A campaign: the satellite, the base slew, and how the cases vary them."""
 
@@ -87,11 +175,20 @@ class CampaignDefinition(_Frozen):
     cases: list[CaseSpec] = Field(default_factory=list, description="cases listed one by one")
     grid: Grid | None = Field(None, description="cases crossed from levels of several axes")
     random: RandomCases | None = Field(None, description="cases drawn from distributions")
+    sobol: SobolCases | None = Field(
+        None, description="Saltelli's sample for Sobol indices (SALib)"
+    )
+    worst_case: WorstCaseSearch | None = Field(
+        None, description="search the parameters' box for the worst case (runs alone)"
+    )
+    reduced: Reduced | None = Field(None, description="fly every case on a reduced model")
 
     @model_validator(mode="after")
     def _has_cases(self) -> CampaignDefinition:
-        if not (self.cases or self.grid or self.random or self.include_nominal):
-            raise ValueError("a campaign needs cases, a grid, random cases or the nominal")
+        if self.worst_case is not None and (self.cases or self.grid or self.random or self.sobol):
+            raise ValueError("a worst_case search runs alone: no cases, grid, random or sobol")
+        if not (self.cases or self.grid or self.random or self.sobol or self.include_nominal):
+            raise ValueError("a campaign needs cases, a grid, random or Sobol cases or the nominal")
         validate_config(self.base, source="base", model=SlewScenario)
         return self
 
@@ -104,6 +201,9 @@ class CampaignDefinition(_Frozen):
 @dataclass(frozen=True)
 class ResolvedCase:
     """A case ready to run anywhere: validated plant config and scenario as plain dicts.
+
+    ``error`` is empty, or why the case's inputs were refused (a random draw out of
+    range met while streaming): such a case is stored as failed without running.
 
     Attributes
     ----------
@@ -119,6 +219,8 @@ class ResolvedCase:
         The case's slew scenario, validated, as plain data.
     parameters : dict
         The realised value of each modifier, by config path (SI or the path's unit).
+    error : str
+        Empty, or why the case's inputs were refused.
     """
 
     case_id: str
@@ -127,6 +229,7 @@ class ResolvedCase:
     plant: dict
     scenario: dict
     parameters: dict
+    error: str = ""
 
     @property
     def digest(self) -> str:
@@ -138,8 +241,206 @@ def _digest(data) -> str:
     return hashlib.sha256(json.dumps(data, sort_keys=True).encode()).hexdigest()[:16]
 
 
+HEAD_CASES = 100
+"""Cases resolved before a campaign starts: their digest is the store's ``case_inputs``."""
+
+_STREAMED_ID = re.compile(r"(random|sobol)-(\d{5,})")
+
+
+class CaseStream:
+    """The cases of a campaign, resolved one at a time as they are consumed.
+
+    Preparing a case (applying its modifiers, validating its plant and scenario)
+    takes a few milliseconds; a 1e6-case campaign is never held in memory nor
+    prepared up front. What can be checked without resolving every case is checked
+    on construction, before any case runs: the case count, unique ids, every
+    explicit and grid case and the first :data:`HEAD_CASES` cases (resolved,
+    validated and their run sizes estimated, strictly).
+
+    Iterating resolves the cases in order; a later case whose draws are refused is
+    yielded with its ``error`` set (stored as a failed row), not raised, unless
+    ``strict``.
+
+    Raises
+    ------
+    ConfigError
+        On construction: a bad count, duplicate ids, a bad modifier or value in
+        the checked cases.
+    """
+
+    def __init__(
+        self,
+        definition: CampaignDefinition,
+        satellite: SatelliteConfig,
+        n_random: int | None = None,
+        strict: bool = False,
+    ) -> None:
+        from flexsat.dynamics.plant import Plant
+
+        self.definition, self.strict = definition, strict
+        self._plant_base = satellite.model_dump(mode="json")
+        scenario_base = SlewScenario.model_validate(definition.base).model_dump(
+            mode="json", by_alias=True
+        )
+        if definition.reduced is not None:
+            _reduce(self._plant_base, scenario_base, definition.reduced)
+        if scenario_base["design_inertia_kg_m2"] is None:  # the base configuration's design
+            scenario_base["design_inertia_kg_m2"] = design_inertia(satellite).tolist()
+        self._scenario_base = scenario_base
+        self._n_dof = Plant.from_config(satellite).n_dof  # modifiers change values only
+        self._sized: set[tuple] = set()
+        self._fixed = self._fixed_specs()
+        self.n_random = 0
+        if definition.random is not None:
+            self.n_random = definition.random.n if n_random is None else n_random
+            if self.n_random < 1:
+                raise ConfigError(f"--cases must be >= 1, got {self.n_random}")
+        self._sobol = None if definition.sobol is None else sobol_samples(definition.sobol)
+        # the streamed sources: (case count, spec of its k-th case)
+        self._sources = [(self.n_random, self._random_spec)]
+        if self._sobol is not None:
+            self._sources.append((len(self._sobol), self._sobol_spec))
+        ids = [spec[0] for spec in self._fixed]
+        counts = {"random": self.n_random, "sobol": 0 if self._sobol is None else len(self._sobol)}
+        clash = [i for i in ids if (m := _STREAMED_ID.fullmatch(i)) and int(m[2]) < counts[m[1]]]
+        if len(set(ids)) != len(ids) or clash:
+            raise ConfigError(f"campaign {definition.name}: duplicate case ids")
+        self.head = [self.resolve(spec) for spec in self._fixed]
+        n_head = min(self._n_streamed, max(1, HEAD_CASES - len(self.head)))
+        self.head += [self.resolve(self._streamed_spec(i)) for i in range(n_head)]
+
+    @property
+    def _n_streamed(self) -> int:
+        return sum(n for n, _ in self._sources)
+
+    def __len__(self) -> int:
+        return len(self._fixed) + self._n_streamed
+
+    def __iter__(self) -> Iterator[ResolvedCase]:
+        yield from self.head
+        for i in range(len(self.head) - len(self._fixed), self._n_streamed):
+            spec = self._streamed_spec(i)
+            try:
+                yield self.resolve(spec)
+            except ConfigError as exc:
+                if self.strict:
+                    raise
+                yield ResolvedCase(spec[0], *spec[1], plant={}, scenario={}, parameters={},
+                                   error=str(exc))  # fmt: skip
+
+    def _streamed_spec(self, i: int) -> tuple[str, tuple[int, int], list, list]:
+        for n, spec in self._sources:
+            if i < n:
+                return spec(i)
+            i -= n
+        raise IndexError(i)
+
+    def _fixed_specs(self) -> list[tuple[str, tuple[int, int], list, list]]:
+        """(id, (root seed, index) of its random stream, plant and scenario modifiers)."""
+        definition = self.definition
+        specs: list[tuple[str, tuple[int, int], list[Modifier], list[Modifier]]] = []
+        if definition.include_nominal:
+            specs.append(("nominal", (0, 0), [], []))
+        specs += [(c.id, (0, k), c.plant, c.scenario) for k, c in enumerate(definition.cases)]
+        if definition.grid is not None:
+            grid = definition.grid
+            for k, levels in enumerate(itertools.product(*(axis.levels for axis in grid.axes))):
+                case_id = "+".join(level.label for level in levels)
+                plant = [*grid.common.plant, *(m for lv in levels for m in lv.plant)]
+                scenario = [*grid.common.scenario, *(m for lv in levels for m in lv.scenario)]
+                specs.append((case_id, (grid.seed, k), plant, scenario))
+        return specs
+
+    def _random_spec(self, i: int) -> tuple[str, tuple[int, int], list, list]:
+        rnd = self.definition.random
+        return (f"random-{i:05d}", (rnd.root_seed, i), rnd.plant, rnd.scenario)
+
+    def _sobol_spec(self, i: int) -> tuple[str, tuple[int, int], list, list]:
+        """The i-th row of Saltelli's sample, each parameter a modifier of the plant
+        (paths under ``hub`` and ``appendages``) or of the scenario (the others)."""
+        sobol = self.definition.sobol
+        return (f"sobol-{i:05d}", (sobol.seed, i), *dispersed_modifiers(sobol.parameters,
+                                                                       self._sobol[i]))
+
+    def resolve(self, spec) -> ResolvedCase:
+        """Resolve one case from ``(id, (root seed, index), plant mods, scenario mods)``."""
+        from flexsat.simulate.common import check_run_size
+
+        case_id, (root, index), plant_mods, scenario_mods = spec
+        # The stream SeedSequence(root).spawn(n)[index] would give, built directly.
+        rng = np.random.default_rng(np.random.SeedSequence(root, spawn_key=(index,)))
+        realised: dict = {}
+        try:
+            plant = apply_modifiers(self._plant_base, plant_mods, rng, realised)
+            scenario = apply_modifiers(self._scenario_base, scenario_mods, rng, realised)
+        except KeyError as exc:
+            raise ConfigError(f"campaign case {case_id!r}: {exc.args[0]}") from None
+        validate_config(plant, source=f"campaign case {case_id!r} (plant)")
+        source = f"campaign case {case_id!r} (scenario)"
+        model = validate_config(scenario, source=source, model=SlewScenario)
+        timing = (model.duration_s, model.dt_s, model.record_dt_s)
+        if timing not in self._sized:  # the records must fit in a worker
+            try:
+                check_run_size(self._n_dof, model)
+            except ConfigError as exc:
+                name = self.definition.name
+                raise ConfigError(f"campaign {name}, case {case_id!r}: {exc}") from None
+            self._sized.add(timing)
+        return ResolvedCase(case_id, root, index, plant, scenario, realised)
+
+
+def sobol_problem(sobol: SobolCases) -> dict:
+    """SALib's problem dictionary of a Sobol campaign (names are the paths)."""
+    return {
+        "num_vars": len(sobol.parameters),
+        "names": [p.path for p in sobol.parameters],
+        "bounds": [list(p.bounds) for p in sobol.parameters],
+    }
+
+
+def sobol_samples(sobol: SobolCases) -> np.ndarray:
+    """Saltelli's sample (SALib, scrambled Sobol' sequence, seeded), shape
+    (n (D + 2), D): first and total indices, no second order."""
+    try:
+        from SALib.sample import sobol as sampler
+    except ImportError:
+        raise ConfigError(
+            "a Sobol campaign needs SALib: pip install 'flexsat[sensitivity]'"
+        ) from None
+    return sampler.sample(sobol_problem(sobol), sobol.n, calc_second_order=False,
+                          seed=sobol.seed)  # fmt: skip
+
+
+def _reduce(plant: dict, scenario: dict, reduced: Reduced) -> None:
+    """Apply a :class:`Reduced` model to the base plant and scenario (plain dicts)."""
+    from flexsat.config.models import APPENDAGE_CONFIGS
+
+    for appendage in plant["appendages"]:
+        fields = APPENDAGE_CONFIGS[appendage.get("model", "plate")].model_fields
+        if "locked_dofs" in fields:  # a model that can lock coordinates
+            appendage["locked_dofs"] = list(reduced.locked_dofs)
+    scenario["dt_s"], scenario["control_dt_s"] = reduced.dt_s, reduced.control_dt_s
+
+
+class CaseDigest:
+    """The digest over every case's id and inputs, built as the cases stream by."""
+
+    def __init__(self) -> None:
+        self._hash = hashlib.sha256()
+        self.count = 0
+
+    def add(self, case: ResolvedCase) -> None:
+        self._hash.update(f"{case.case_id}:{case.digest};".encode())
+        self.count += 1
+
+    def hexdigest(self) -> str:
+        return self._hash.hexdigest()[:16]
+
+
 def campaign_fingerprint(
-    definition: CampaignDefinition, satellite: SatelliteConfig, cases: list[ResolvedCase]
+    definition: CampaignDefinition,
+    satellite: SatelliteConfig,
+    cases: CaseStream | list[ResolvedCase],
 ) -> dict:
     """What a store's results depend on, part by part, to refuse a mixed resume.
 
@@ -147,13 +448,17 @@ def campaign_fingerprint(
     -------
     dict
         ``definition`` and ``satellite`` (digests), ``cases`` (count) and
-        ``case_inputs`` (a digest over every case's id and inputs).
+        ``case_inputs`` (a digest over the ids and inputs of the first
+        :data:`HEAD_CASES` cases). Every later case's inputs are checked against
+        its stored digest as the cases stream by, and the digest over all of them
+        (:class:`CaseDigest`) is recorded when the stream ends.
     """
+    head = cases.head if isinstance(cases, CaseStream) else cases
     return {
         "definition": definition.fingerprint(),
         "satellite": _digest(satellite.model_dump(mode="json")),
         "cases": len(cases),
-        "case_inputs": _digest([[case.case_id, case.digest] for case in cases]),
+        "case_inputs": _digest([[c.case_id, c.digest] for c in head[:HEAD_CASES]]),
     }
 
 
@@ -192,6 +497,9 @@ def resolve_cases(
 ) -> list[ResolvedCase]:
     """Expand and validate every case; any bad modifier is refused before a case runs.
 
+    The whole list, in memory: for small campaigns and analyses. Campaign runs
+    stream them (:class:`CaseStream`).
+
     Parameters
     ----------
     definition : CampaignDefinition
@@ -212,46 +520,4 @@ def resolve_cases(
     ConfigError
         Naming the case and the problem (unknown path, invalid resulting value).
     """
-    plant_base = satellite.model_dump(mode="json")
-    scenario_base = SlewScenario.model_validate(definition.base).model_dump(
-        mode="json", by_alias=True
-    )
-    if scenario_base["design_inertia_kg_m2"] is None:  # the base configuration's design model
-        scenario_base["design_inertia_kg_m2"] = design_inertia(satellite).tolist()
-    # (id, (root seed, case index) of its random stream, plant and scenario modifiers)
-    specs: list[tuple[str, tuple[int, int], list[Modifier], list[Modifier]]] = []
-    if definition.include_nominal:
-        specs.append(("nominal", (0, 0), [], []))
-    specs += [(c.id, (0, k), c.plant, c.scenario) for k, c in enumerate(definition.cases)]
-    if definition.grid is not None:
-        grid = definition.grid
-        for k, levels in enumerate(itertools.product(*(axis.levels for axis in grid.axes))):
-            case_id = "+".join(level.label for level in levels)
-            plant = [*grid.common.plant, *(m for lv in levels for m in lv.plant)]
-            scenario = [*grid.common.scenario, *(m for lv in levels for m in lv.scenario)]
-            specs.append((case_id, (grid.seed, k), plant, scenario))
-    if definition.random is not None:
-        rnd = definition.random
-        n = rnd.n if n_random is None else n_random
-        if n < 1:
-            raise ConfigError(f"--cases must be >= 1, got {n}")
-        for i in range(n):
-            specs.append((f"random-{i:05d}", (rnd.root_seed, i), rnd.plant, rnd.scenario))
-    ids = [spec[0] for spec in specs]
-    if len(set(ids)) != len(ids):
-        raise ConfigError(f"campaign {definition.name}: duplicate case ids")
-    resolved = []
-    for case_id, (root, index), plant_mods, scenario_mods in specs:
-        # The stream SeedSequence(root).spawn(n)[index] would give, built directly.
-        rng = np.random.default_rng(np.random.SeedSequence(root, spawn_key=(index,)))
-        realised: dict = {}
-        try:
-            plant = apply_modifiers(plant_base, plant_mods, rng, realised)
-            scenario = apply_modifiers(scenario_base, scenario_mods, rng, realised)
-        except KeyError as exc:
-            raise ConfigError(f"campaign case {case_id!r}: {exc.args[0]}") from None
-        validate_config(plant, source=f"campaign case {case_id!r} (plant)")
-        source = f"campaign case {case_id!r} (scenario)"
-        validate_config(scenario, source=source, model=SlewScenario)
-        resolved.append(ResolvedCase(case_id, root, index, plant, scenario, realised))
-    return resolved
+    return list(CaseStream(definition, satellite, n_random, strict=True))

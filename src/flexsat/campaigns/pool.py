@@ -21,6 +21,7 @@ from __future__ import annotations
 import contextlib
 import ctypes
 import ctypes.util
+import itertools
 import multiprocessing
 import os
 import signal
@@ -78,11 +79,16 @@ class LocalPool:
 
     def map_unordered(self, items: Iterable) -> Iterator:
         """Results of ``function(item)`` as they come, in completion order."""
-        pending = deque(items)
+        source = iter(items)  # pulled one item per free worker: never all up front
+        pending: deque = deque()  # items whose worker died, to run again first
         attempts: dict[int, int] = {}
-        while pending or any(w.item is not None for w in self._workers):
+        while True:
             for k, worker in enumerate(self._workers):
-                if worker.item is None and pending:
+                if worker.item is None:
+                    if not pending:
+                        pending.extend(itertools.islice(source, 1))
+                    if not pending:
+                        continue
                     item = pending.popleft()
                     try:
                         worker.give(item)
@@ -90,6 +96,8 @@ class LocalPool:
                         self._replace(worker)
                         self._workers[k].give(item)
             busy = [w for w in self._workers if w.item is not None]
+            if not busy:
+                return
             ready = wait([w.conn for w in busy] + [w.process.sentinel for w in busy])
             for worker in busy:
                 if worker.conn in ready and worker.conn.poll():
@@ -98,6 +106,7 @@ class LocalPool:
                     except (EOFError, OSError):  # died while sending: handled below
                         result = None
                     else:
+                        attempts.pop(id(worker.item), None)  # ids are reused once it is gone
                         worker.item = None
                         yield result
                         continue
@@ -106,6 +115,7 @@ class LocalPool:
                     self._replace(worker)
                     attempts[id(item)] = attempts.get(id(item), 0) + 1
                     if attempts[id(item)] >= _ATTEMPTS:
+                        del attempts[id(item)]
                         yield self.on_lost(item, exitcode)
                     else:
                         pending.appendleft(item)

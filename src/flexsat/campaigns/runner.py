@@ -1,7 +1,8 @@
 """Running campaign cases: a local process pool (default) or a Dask cluster.
 
-Cases are resolved in the parent (:func:`resolve_cases`), so every backend and
-worker count runs the same inputs and the stored rows are identical bit for bit.
+Cases are resolved in the parent, streamed as the backend consumes them
+(:class:`~flexsat.campaigns.definition.CaseStream`), so every backend and worker
+count runs the same inputs and the stored rows are identical bit for bit.
 A case that raises or diverges is stored as failed with its message; the campaign
 goes on. Ctrl-C or SIGTERM stops the run at once (pending cases cancelled, workers
 stopped) and says how many cases are stored and how to resume.
@@ -10,21 +11,23 @@ stopped) and says how many cases are stored and how to resume.
 from __future__ import annotations
 
 import contextlib
+import itertools
 import os
 import re
 import signal
 import time
 import traceback
-from collections.abc import Iterator
+from collections.abc import Iterable, Iterator
 from pathlib import Path
 
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
 
 from flexsat.campaigns.definition import (
     CampaignDefinition,
+    CaseDigest,
+    CaseStream,
     ResolvedCase,
     campaign_fingerprint,
-    resolve_cases,
 )
 from flexsat.campaigns.pool import LocalPool
 from flexsat.campaigns.store import HISTORY_UNITS, CampaignStore
@@ -38,6 +41,7 @@ __all__ = [
     "CampaignInterrupted",
     "case_history",
     "replay_case",
+    "run_batch",
     "run_campaign",
     "run_case",
     "summarize",
@@ -104,8 +108,19 @@ def summarize(store: str | Path) -> dict:
     -------
     dict
         ``cases``, ``failed``, the pass rate of each requirement (``r1_pass_rate``...,
-        fractions in [0, 1]) and the worst cases by final pointing error [deg].
+        fractions in [0, 1]) and the worst cases by final pointing error [deg]. Also
+        ``requirements`` (per requirement: passes, the exact 95 % interval of the
+        pass rate and the failing case ids), ``metrics`` (per metric: min, 5/50/95 %,
+        max) and ``cases_for_3sigma_at_95`` (the cases needed, with no failure, to
+        claim 99.73 % at 95 % confidence); see :mod:`flexsat.campaigns.statistics`.
     """
+    from flexsat.campaigns.statistics import (
+        cases_needed,
+        metric_statistics,
+        requirement_statistics,
+    )
+
+    table = CampaignStore(store).table()
     rows = CampaignStore(store).rows()
     n = len(rows)
 
@@ -126,6 +141,9 @@ def summarize(store: str | Path) -> dict:
         "r3_pass_rate": rate("r3_pass"),
         "worst_final_pointing_error_deg": worst[0][0] if worst else float("nan"),
         "worst_cases": [{"case_id": c, "final_pointing_error_deg": e} for e, c in worst],
+        "requirements": requirement_statistics(table).to_dict("records") if n else [],
+        "metrics": metric_statistics(table).to_dict("records") if n else [],
+        "cases_for_3sigma_at_95": cases_needed(0.9973, 0.95),
     }
 
 
@@ -207,6 +225,9 @@ def run_case(case: ResolvedCase) -> dict:
         "inputs": {"plant": case.plant, "scenario": case.scenario},  # for replay
     }
     start = time.perf_counter()
+    if case.error:  # refused while streaming: a failed row, nothing to run
+        row.update(status="failed", error=case.error, metrics={}, case_wall_time_s=0.0)
+        return row
     try:
         plant = Plant.from_config(SatelliteConfig.model_validate(case.plant))
         scenario = SlewScenario.model_validate(case.scenario)
@@ -280,8 +301,12 @@ def run_campaign(
     FlexsatError
         When the store cannot be written (full disk...), after stopping the workers.
     """
-    cases = resolve_cases(definition, satellite, n_random)
-    _check_sizes(definition, satellite, cases)
+    if definition.worst_case is not None:  # a search, not a fixed set of cases
+        from flexsat.campaigns.worstcase import run_worst_case
+
+        return run_worst_case(definition, definition.worst_case, satellite, out,
+                              workers=workers, resume=resume)  # fmt: skip
+    cases = CaseStream(definition, satellite, n_random)  # checks what it can up front
     store = CampaignStore(out)
     if store.root.exists() and not store.root.is_dir():
         raise ConfigError(f"--out {store.root}: exists and is not a folder")
@@ -290,26 +315,25 @@ def run_campaign(
     with _backend(workers, scheduler, dask_local) as execute, store.opened(
         campaign_fingerprint(definition, satellite, cases), definition.name, resume
     ):
-        done = store.finished({case.case_id: case.digest for case in cases})
-        todo = [case for case in cases if case.case_id not in done]
+        todo = _Todo(cases, store)
         columns = (TextColumn(f"campaign {definition.name}"), BarColumn(), MofNCompleteColumn(),
                    TextColumn("failed {task.fields[failed]}"), TimeRemainingColumn())  # fmt: skip
         interrupts = _Interrupts()
         with Progress(*columns, disable=not progress, transient=True) as bar, interrupts:
-            task = bar.add_task("cases", total=len(cases), completed=len(done), failed=0)
+            task = bar.add_task("cases", total=len(cases), completed=0, failed=0)
             try:
-                for row in execute(todo):
+                for row in execute(todo, len(cases)):
                     history = row.pop(HISTORY_KEY, None)
                     with interrupts.deferred():  # a signal never cuts a write in half
                         if history is not None:  # before the case: a stored case has its history
                             store.write_history(row["case_id"], history, status=row["status"])
                         store.write_case(row)
                     failed += row["status"] != "ok"
-                    bar.update(task, advance=1, failed=failed)
+                    bar.update(task, completed=todo.skipped + todo.ran_done(), failed=failed)
             except _Interrupted as stop:
                 interrupted = CampaignInterrupted(
                     f"campaign {definition.name} interrupted ({stop.name}): "
-                    f"{_stored(store, cases)} of {len(cases)} cases are stored in {store.root}; "
+                    f"{store.finished()} of {len(cases)} cases are stored in {store.root}; "
                     "run the same command with --resume to finish it",
                 )
                 interrupted.exit_code = 128 + stop.signum  # the shell's convention
@@ -317,13 +341,14 @@ def run_campaign(
             except OSError as exc:
                 raise _write_error(store, cases, exc) from None
         try:
+            store.record_case_inputs(todo.digest.hexdigest())
             parquet, csv = store.write_tables()
         except OSError as exc:
             raise _write_error(store, cases, exc) from None
     return {
         "campaign": definition.name,
         "cases": len(cases),
-        "ran": len(todo),
+        "ran": todo.ran,
         "failed": sum(row["status"] != "ok" for row in store.rows()),
         "wall_time_s": time.perf_counter() - start,
         "parquet": str(parquet),
@@ -331,36 +356,46 @@ def run_campaign(
     }
 
 
-def _check_sizes(definition, satellite: SatelliteConfig, cases: list[ResolvedCase]) -> None:
-    """Refuse, before any case runs, a case whose records would not fit in a worker."""
-    from flexsat.dynamics.plant import Plant
-    from flexsat.simulate import SlewScenario
-    from flexsat.simulate.common import check_run_size
+class _Todo:
+    """The cases still to run, streamed: stored ones are skipped after checking that
+    they were made from the same inputs; the digest over every case is built on the way.
+    """
 
-    n_dof = Plant.from_config(satellite).n_dof  # modifiers change values, not coordinates
-    timing = ("duration_s", "dt_s", "record_dt_s")
-    seen = set()
-    for case in cases:
-        key = tuple(case.scenario.get(name) for name in timing)
-        if key in seen:
-            continue
-        seen.add(key)
-        try:
-            check_run_size(n_dof, SlewScenario.model_validate(case.scenario))
-        except ConfigError as exc:
-            raise ConfigError(f"campaign {definition.name}, case {case.case_id!r}: {exc}") from None
+    def __init__(self, cases: CaseStream, store: CampaignStore) -> None:
+        self.cases, self.store = cases, store
+        self.stored = store.stored_ids()
+        self.digest = CaseDigest()
+        self.skipped = self.ran = 0
+        self._results = 0
+
+    def ran_done(self) -> int:
+        self._results += 1
+        return self._results
+
+    def __iter__(self) -> Iterator[ResolvedCase]:
+        for case in self.cases:
+            self.digest.add(case)
+            if case.case_id in self.stored:
+                digest = self.store.stored_digest(case.case_id)
+                if digest == case.digest:
+                    self.skipped += 1
+                    continue
+                if digest is not None:
+                    raise ConfigError(
+                        f"{self.store.root}: case {case.case_id!r} is stored with other "
+                        f"inputs (stored {digest!r}, given {case.digest!r}); refusing to "
+                        "resume into it. Use another --out"
+                    )
+            self.ran += 1
+            yield case
 
 
-def _write_error(store: CampaignStore, cases: list[ResolvedCase], exc: OSError) -> FlexsatError:
+def _write_error(store: CampaignStore, cases: CaseStream, exc: OSError) -> FlexsatError:
     return FlexsatError(
         f"cannot write to the campaign store {store.root}: {exc.strerror or exc}; "
-        f"{_stored(store, cases)} of {len(cases)} cases are stored; fix it and "
+        f"{store.finished()} of {len(cases)} cases are stored; fix it and "
         "run the same command with --resume to finish"
     )
-
-
-def _stored(store: CampaignStore, cases: list[ResolvedCase]) -> int:
-    return len(store.finished({case.case_id: case.digest for case in cases}))
 
 
 class _Interrupted(BaseException):
@@ -430,20 +465,24 @@ def _lost_case(case: ResolvedCase, exitcode: int | None) -> dict:
 
 @contextlib.contextmanager
 def _backend(workers, scheduler, dask_local):
-    """Connect to (or start) the backend, then yield ``execute(todo) -> rows``."""
+    """Connect to (or start) the backend, then yield ``execute(cases, size) -> rows``
+    (``size``: at most how many cases will come, to size the pool)."""
     if scheduler or dask_local:
         with _dask_client(scheduler, dask_local) as client:
-            yield lambda todo: _dask(client, todo)
+            yield lambda todo, size: _dask(client, todo)
         return
     workers = workers or os.cpu_count() or 1
 
-    def execute(todo) -> Iterator[dict]:
-        if workers == 1 or len(todo) <= 1:
-            for case in todo:
+    def execute(todo: Iterable[ResolvedCase], size: int) -> Iterator[dict]:
+        source = iter(todo)
+        first = list(itertools.islice(source, 2))  # no workers for one case or none
+        if workers == 1 or len(first) <= 1:
+            for case in itertools.chain(first, source):
                 yield run_case(case)
             return
-        with LocalPool(run_case, min(workers, len(todo)), _lost_case) as pool:
-            yield from pool.map_unordered(todo)
+        n = min(workers, size)
+        with LocalPool(run_case, n, _lost_case) as pool:
+            yield from pool.map_unordered(itertools.chain(first, source))
 
     yield execute
 
@@ -472,12 +511,36 @@ def _dask_client(scheduler, dask_local):
             cluster.close()
 
 
+DASK_BATCH = 8
+"""Cases per Dask task: a task's overhead (a few ms) is paid once per batch."""
+
+
+def run_batch(cases: list[ResolvedCase]) -> list[dict]:
+    """Rows of :func:`run_case` for each case, in one task (never raises)."""
+    return [run_case(case) for case in cases]
+
+
 def _dask(client, todo) -> Iterator[dict]:
+    """Batches of cases submitted as they are streamed, a few per worker in flight."""
     from dask.distributed import as_completed as dask_completed
 
-    futures = client.map(run_case, todo, pure=False)
+    source = iter(todo)
+    window = 2 * max(1, sum(client.nthreads().values()))
+
+    def submit(completed) -> bool:
+        batch = list(itertools.islice(source, DASK_BATCH))
+        if batch:
+            completed.add(client.submit(run_batch, batch, pure=False))
+        return bool(batch)
+
+    completed = dask_completed([])
     try:
-        for future in dask_completed(futures):
-            yield future.result()
+        for _ in range(window):
+            if not submit(completed):
+                break
+        for future in completed:
+            yield from future.result()
+            future.release()
+            submit(completed)
     finally:
-        client.cancel(futures)
+        client.cancel(list(completed.futures))

@@ -8,8 +8,11 @@ decimated time history of each case is kept apart, in ``histories/<id>.nc``
 (NetCDF, also written through a temporary name and an atomic rename).
 
 ``campaign.json`` holds the store's fingerprint: a digest of the campaign
-definition, of the satellite config, the number of cases and a digest of every
-case's inputs. Resuming is refused when any of them differs, naming which. While a
+definition, of the satellite config, the number of cases and a digest of the first
+cases' inputs, checked before any case runs; every stored case's own inputs digest,
+checked as the cases stream by; and, once a run has streamed every case, the
+digest over all cases' inputs (``all_case_inputs``). Resuming is refused when any
+of them differs, naming which. While a
 campaign runs into the store, ``campaign.lock`` is locked (``flock``) and names
 the process holding it, so a second run into the same store is refused instead of
 recomputing the same cases.
@@ -111,10 +114,10 @@ class CampaignStore:
             self._check(fingerprint, resume)
             self._remove_partials()
             try:
-                _write_atomic(
-                    self.root / "campaign.json",
-                    json.dumps({"name": name, "fingerprint": fingerprint}, indent=2),
-                )
+                marker = self.root / "campaign.json"
+                record = json.loads(marker.read_text()) if resume and marker.exists() else {}
+                record.update(name=name, fingerprint=fingerprint)
+                _write_atomic(marker, json.dumps(record, indent=2))
             except OSError as exc:
                 raise ConfigError(
                     f"cannot write the campaign store {self.root}: {exc.strerror or exc}"
@@ -156,22 +159,41 @@ class CampaignStore:
                 with contextlib.suppress(OSError):
                     path.unlink()
 
-    def finished(self, digests: dict[str, str] | None = None) -> set[str]:
-        """Ids of the cases stored intact (and, given ``digests``, with those inputs).
+    def finished(self) -> int:
+        """Number of cases stored intact (a damaged case file is not finished: it is
+        run again and overwritten)."""
+        return sum(_read_row(path) is not None for path in self.cases_dir.glob("*.json"))
 
-        A damaged case file (truncated, not a row) is not finished: it is run again
-        and overwritten.
-        """
+    def stored_ids(self) -> set[str]:
+        """Ids of the case files present (intact or not), without reading them."""
         if not self.cases_dir.exists():
             return set()
-        done = set()
-        for path in self.cases_dir.glob("*.json"):
-            row = _read_row(path)
-            if row is None:
-                continue
-            if digests is None or digests.get(path.stem) == row["inputs_digest"]:
-                done.add(path.stem)
-        return done
+        return {path.stem for path in self.cases_dir.glob("*.json")}
+
+    def stored_digest(self, case_id: str) -> str | None:
+        """The inputs digest of a case stored intact, or None (absent or damaged)."""
+        row = _read_row(self.cases_dir / f"{case_id}.json")
+        return None if row is None else row["inputs_digest"]
+
+    def record_case_inputs(self, digest: str) -> None:
+        """Once every case has streamed by: record the digest over all cases' inputs.
+
+        Raises
+        ------
+        ConfigError
+            A resumed store whose recorded digest differs (its cases were made
+            with other inputs).
+        """
+        marker = self.root / "campaign.json"
+        stored = json.loads(marker.read_text())
+        old = stored.get("all_case_inputs")
+        if old is not None and old != digest:
+            raise ConfigError(
+                f"{self.root} holds cases made with other inputs (digest over every case: "
+                f"stored {old!r}, given {digest!r}); use another --out"
+            )
+        stored["all_case_inputs"] = digest
+        _write_atomic(marker, json.dumps(stored, indent=2))
 
     def write_case(self, row: dict) -> None:
         _write_atomic(self.cases_dir / f"{row['case_id']}.json", json.dumps(jsonable(row)))

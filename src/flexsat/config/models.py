@@ -190,9 +190,17 @@ class AppendageConfig(_Frozen):
     damping_ratio: Annotated[float, Strict(), AllowInfNan(False), Field(ge=0.0, lt=1.0)] = Field(
         description="viscous damping ratio zeta of every joint DOF [-]"
     )
+    locked_dofs: list[Literal["eta_x", "eta_y", "eta_z", "eta_rx", "eta_ry", "eta_rz"]] = Field(
+        default_factory=list,
+        max_length=6,
+        description="joint DOFs held rigid in time simulation (reduced model; "
+        "docs/campaigns.md, 'Reduced models')",
+    )
 
     @model_validator(mode="after")
     def _one_mass(self) -> AppendageConfig:
+        if len(set(self.locked_dofs)) != len(self.locked_dofs):
+            raise ValueError(f"locked_dofs names a DOF twice: {self.locked_dofs}")
         if (self.surface_density_kg_m2 is None) == (self.mass_kg is None):
             raise ValueError("give exactly one of surface_density_kg_m2 and mass_kg")
         if self.thickness_m > min(self.length_m, self.width_m):

@@ -189,7 +189,57 @@ def accelerations(q, qd, Q, packed, qdd):
         )
         if status != STATUS_OK:
             return status
+    if packed.locked:
+        _hold_locked(q, packed, qdd)
     return STATUS_OK
+
+
+@njit(cache=True, error_model="numpy")
+def _hold_locked(q, packed, qdd):
+    """Project the unconstrained q_ddot on the free coordinates (locked ones held).
+
+    With the locked coordinates' rows of q_ddot zero and a constraint force on those
+    rows only, the free rows of M q_ddot + h = F + E lambda give
+    M_ff q_ddot_f = F_f - h_f = (M q_ddot_u)_f, where q_ddot_u (in ``qdd``) solved the
+    unconstrained M q_ddot_u + h = F at the same state: no model term beyond M(q) is
+    needed. M_ff is symmetric positive definite: Gaussian elimination without pivoting.
+    As a side result ``packed.reaction[1]`` holds the constraint forces lambda.
+    """
+    M, A, free, unconstrained = packed.mass, packed.reduced, packed.free, packed.reaction[0]
+    mass_matrix(q, packed, M)
+    n, m = qdd.shape[0], free.shape[0]
+    unconstrained[:] = qdd
+    for r in range(m):
+        i = free[r]
+        s = 0.0
+        for j in range(n):
+            s += M[i, j] * qdd[j]
+        A[r, m] = s
+        for c in range(m):
+            A[r, c] = M[i, free[c]]
+    for p in range(m):
+        for r in range(p + 1, m):
+            f = A[r, p] / A[p, p]
+            for c in range(p, m + 1):
+                A[r, c] -= f * A[p, c]
+    for r in range(m - 1, -1, -1):
+        s = A[r, m]
+        for c in range(r + 1, m):
+            s -= A[r, c] * A[c, m]
+        A[r, m] = s / A[r, r]
+    qdd[:] = 0.0
+    for r in range(m):
+        qdd[free[r]] = A[r, m]
+    # lambda = M (q_ddot - q_ddot_u) on the locked rows (zero on the free ones, to
+    # within rounding): the force the locked joints carry, reported in tau_flex.
+    reaction = packed.reaction[1]
+    reaction[:] = 0.0
+    for i in range(n):
+        if not packed.is_free[i]:
+            s = 0.0
+            for j in range(n):
+                s += M[i, j] * (qdd[j] - unconstrained[j])
+            reaction[i] = s
 
 
 @njit(cache=True, error_model="numpy")

@@ -41,6 +41,20 @@ class PackedPlant(NamedTuple):
         every evaluation; slots in the contract module).
     solve : ndarray, shape (6, 7)
         Scratch of the 6 x 6 hub solve.
+    locked : bool
+        True if some appendage coordinates are locked (held at their initial value):
+        q_ddot is then projected on the free coordinates (:mod:`flexsat.dynamics.kernels`).
+    free : ndarray, shape (n_free,), int64
+        Indices of the free coordinates (all of them when nothing is locked).
+    mass : ndarray, shape (n_dof, n_dof)
+        Scratch of M(q) for the projection (1 x 1 when nothing is locked).
+    reduced : ndarray, shape (n_free, n_free + 1)
+        Scratch of the free-coordinate solve (1 x 2 when nothing is locked).
+    is_free : ndarray, shape (n_dof,), bool
+        Per coordinate: free (True) or locked.
+    reaction : ndarray, shape (2, n_dof)
+        Scratch: the unconstrained q_ddot, then the generalized constraint forces of
+        the locked coordinates left by the last evaluation (2 x 1 when none).
     members : tuple of ndarray, shape (k_g, 2), int64
         Per group: appendage index and offset of its first coordinate in q.
     params : tuple of ndarray, shape (k_g, p_g)
@@ -58,6 +72,12 @@ class PackedPlant(NamedTuple):
     articulated: bool
     hub: np.ndarray
     solve: np.ndarray
+    locked: bool
+    free: np.ndarray
+    mass: np.ndarray
+    reduced: np.ndarray
+    is_free: np.ndarray
+    reaction: np.ndarray
     members: tuple
     params: tuple
     work: tuple

@@ -33,7 +33,7 @@ from flexsat.dynamics.layout import HUB_DOFS, StateLayout
 from flexsat.dynamics.linalg3 import euler_rate_matrix
 from flexsat.dynamics.packed import PackedPlant, first_class, only
 from flexsat.dynamics.status import STATUS_OK, status_message
-from flexsat.errors import SimulationError
+from flexsat.errors import ConfigError, SimulationError
 
 __all__ = ["HUB_DOFS", "JOINT_DOFS", "Plant"]
 
@@ -79,7 +79,7 @@ class Plant:
         # Per evaluation, the plant with only the kernels it calls (cheaper from Python).
         views = {
             "mass_matrix": ("mass_matrix",), "bias_forces": ("bias_forces",),
-            "accelerations": ("pass1", "pass2"), "observe": ("observe",),
+            "accelerations": ("pass1", "pass2", "mass_matrix"), "observe": ("observe",),
             "joint_wrench": ("joint_wrench",), "tips": ("tips",),
         }  # fmt: skip
         object.__setattr__(self, "_views", {k: only(self.packed, *v) for k, v in views.items()})
@@ -144,6 +144,9 @@ class Plant:
             kernel_sets.append(model.kernels)
             work.append(np.zeros((len(rows), max(1, *(model.work_columns(r) for r in rows)))))
         hub_J = np.ascontiguousarray(self.hub_J, dtype=float)
+        locked = self.locked_coordinates()
+        free = np.array([i for i in range(self.layout.n_dof) if i not in locked], dtype=np.int64)
+        size = (self.layout.n_dof, free.size) if locked else (1, 1)
         return PackedPlant(
             n_dof=self.layout.n_dof,
             hub_mass=self.hub_mass,
@@ -152,12 +155,38 @@ class Plant:
             articulated=any(m.transmits_inertia for m in self.models),
             hub=np.zeros(HUB_SIZE),
             solve=np.zeros((6, 7)),
+            locked=bool(locked),
+            free=free,
+            mass=np.zeros((size[0], size[0])),
+            reduced=np.zeros((size[1], size[1] + 1)),
+            is_free=np.isin(np.arange(self.layout.n_dof), free),
+            reaction=np.zeros((2, self.layout.n_dof if locked else 1)),
             members=tuple(members),
             params=tuple(params),
             work=tuple(work),
             **{name: tuple(first_class(getattr(k, name), signature) for k in kernel_sets)
                for name, signature in SIGNATURES._asdict().items()},
         )  # fmt: skip
+
+    def locked_coordinates(self) -> tuple[int, ...]:
+        """Indices in q of the coordinates held rigid (each appendage's ``locked_dofs``).
+
+        Raises
+        ------
+        ConfigError
+            An appendage locks a name that is not one of its model's coordinates.
+        """
+        indices = []
+        for k, (app, block) in enumerate(zip(self.config.appendages, self.layout.blocks,
+                                             strict=True)):  # fmt: skip
+            for name in getattr(app, "locked_dofs", ()):
+                if name not in block.names:
+                    raise ConfigError(
+                        f"appendages[{k}].locked_dofs: {name!r} is not a coordinate of a "
+                        f"{block.model!r} appendage (allowed: {', '.join(block.names)})"
+                    )
+                indices.append(block.offset + block.names.index(name))
+        return tuple(sorted(indices))
 
     # -- sizes ----------------------------------------------------------------------------
 

@@ -65,7 +65,7 @@ def derive_records(
     """
     m, n = q.shape
     Q = np.zeros(n)
-    no_external = np.zeros(n)  # tau_flex: elastic and damping wrench only
+    no_external = np.zeros(n)  # tau_flex: elastic and damping wrench (and constraint forces)
     qdd = np.empty(n)
     wrench = np.empty(6)
     obs = np.empty(OBS_SIZE)
@@ -77,7 +77,9 @@ def derive_records(
         omega[k, 0], omega[k, 1], omega[k, 2] = w
         Q[3], Q[4], Q[5] = mtv(S, load_seg(tau_B[k], 0))
         status = accelerations(qk, qdk, Q, packed, qdd)
-        status |= hub_joint_wrench(qk, qdk, no_external, packed, wrench)
+        # a locked joint carries its constraint force (left by accelerations)
+        joint = packed.reaction[1] if packed.locked else no_external
+        status |= hub_joint_wrench(qk, qdk, joint, packed, wrench)
         if status == STATUS_OK:
             bias = euler_rate_bias(qk[3], qk[4], qdk[3], qdk[4], qdk[5])
             w_dot = mv(S, load_seg(qdd, 3))

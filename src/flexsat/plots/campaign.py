@@ -1,7 +1,7 @@
 """Campaign figures: envelopes of every case's time history and a summary table.
 
-Each envelope figure draws the min–max band of all successful cases of a campaign
-(from the decimated histories in ``histories/<id>.nc``, see
+Each envelope figure draws the min–max band and the 5–95 % band of all successful
+cases of a campaign (from the decimated histories in ``histories/<id>.nc``, see
 :class:`flexsat.campaigns.store.CampaignStore`) with the nominal case's line over
 it, in the style of the thesis's robustness figures: pointing error and residual
 rate on log axes with the R1 and R2 bands, commanded torque per axis with the
@@ -13,6 +13,7 @@ their parameters.
 from __future__ import annotations
 
 import json
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -20,12 +21,14 @@ import xarray as xr
 from matplotlib.figure import Figure
 
 from flexsat.campaigns.runner import summarize
+from flexsat.campaigns.statistics import PERCENTILES, percentile_envelope
 from flexsat.campaigns.store import CampaignStore
 from flexsat.plots import style
 
 __all__ = [
     "CAMPAIGN_FIGURES",
     "campaign_envelope",
+    "campaign_percentiles",
     "plot_envelope_energy",
     "plot_envelope_gains",
     "plot_envelope_pointing",
@@ -80,15 +83,10 @@ def _load(store_dir) -> _Campaign:
     return store_dir if isinstance(store_dir, _Campaign) else _Campaign(store_dir)
 
 
-def campaign_envelope(
-    histories: dict[str, xr.Dataset], name: str, t: np.ndarray, axis: int | None = None
-) -> tuple[np.ndarray, np.ndarray]:
-    """(min, max) over the cases of one history variable on the times ``t``.
-
-    Each case is interpolated linearly onto ``t`` (a no-op for cases sharing its
-    times); a case contributes nothing outside its own time span. Times no case
-    covers come back NaN.
-    """
+def _stack(histories: dict[str, xr.Dataset], name: str, t: np.ndarray, axis: int | None
+           ) -> np.ndarray | None:  # fmt: skip
+    """Every case's variable interpolated onto ``t``, (cases, len(t)), NaN outside each
+    case's own time span; None when no case has it."""
     columns = []
     for ds in histories.values():
         if name not in ds:
@@ -102,15 +100,41 @@ def campaign_envelope(
         column = np.interp(t, own, values)
         column[(t < own[0] - 1e-9) | (t > own[-1] + 1e-9)] = np.nan
         columns.append(column)
-    if not columns:
+    return np.vstack(columns) if columns else None
+
+
+def campaign_envelope(
+    histories: dict[str, xr.Dataset], name: str, t: np.ndarray, axis: int | None = None
+) -> tuple[np.ndarray, np.ndarray]:
+    """(min, max) over the cases of one history variable on the times ``t``.
+
+    Each case is interpolated linearly onto ``t`` (a no-op for cases sharing its
+    times); a case contributes nothing outside its own time span. Times no case
+    covers come back NaN.
+    """
+    stack = _stack(histories, name, t, axis)
+    if stack is None:
         nan = np.full(t.shape, np.nan)
         return nan, nan
-    stack = np.vstack(columns)
     finite = np.isfinite(stack)
     covered = finite.any(axis=0)
     lo = np.where(finite, stack, np.inf).min(axis=0)
     hi = np.where(finite, stack, -np.inf).max(axis=0)
     return np.where(covered, lo, np.nan), np.where(covered, hi, np.nan)
+
+
+def campaign_percentiles(
+    histories: dict[str, xr.Dataset], name: str, t: np.ndarray, axis: int | None = None,
+    percentiles: tuple[float, ...] = PERCENTILES,
+) -> np.ndarray:  # fmt: skip
+    """Percentiles over the cases (5/50/95 % by default) on the times ``t``,
+    shape (len(percentiles), len(t)); interpolated as :func:`campaign_envelope`."""
+    stack = _stack(histories, name, t, axis)
+    if stack is None:
+        return np.full((len(percentiles), t.size), np.nan)
+    with warnings.catch_warnings():  # a time no case covers is NaN, as documented
+        warnings.simplefilter("ignore", RuntimeWarning)
+        return percentile_envelope(stack, percentiles)
 
 
 def _nominal(campaign: _Campaign, name: str, axis: int | None = None) -> np.ndarray:
@@ -140,6 +164,11 @@ def _band_and_line(
     ax.fill_between(
         t, lo, hi, color=colour, alpha=_ENVELOPE_ALPHA, linewidth=0, label="all cases (min–max)"
     )
+    p5, _, p95 = scale * campaign_percentiles(campaign.histories, name, t, axis)
+    if log:
+        p5, p95 = style.positive(p5), style.positive(p95)
+    ax.fill_between(t, p5, p95, color=colour, alpha=2 * _ENVELOPE_ALPHA, linewidth=0,
+                    label="5–95 % of the cases")  # fmt: skip
     ax.plot(t, line, color=colour, linewidth=1.1, label=f"{campaign.nominal}")
     if log:
         ax.set_yscale("log")

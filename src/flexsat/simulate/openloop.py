@@ -73,6 +73,13 @@ def initial_state(plant: Plant, scenario: OpenLoopScenario) -> tuple[np.ndarray,
             q[block.slice], qd[block.slice] = model.initial_state(config, entry)
         except ValueError as exc:
             raise ConfigError(str(exc)) from None
+    names = plant.dof_names()
+    for index in plant.locked_coordinates():  # held at q(0): they cannot move
+        if qd[index] != 0.0:
+            raise ConfigError(
+                f"initial.appendages: {names[index]} is locked (locked_dofs): its initial "
+                "rate must be 0"
+            )
     return q, qd
 
 

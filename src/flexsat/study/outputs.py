@@ -219,6 +219,7 @@ def fly_campaign(definition, config, store: Path, *, progress: bool = True, **ba
     """
     from flexsat.campaigns import run_campaign, summarize
     from flexsat.plots.campaign import write_campaign_figures
+    from flexsat.plots.campaign_statistics import write_statistics_figures
 
     run = run_campaign(definition, config, store, progress=progress, **backend)
     summary = {
@@ -230,8 +231,11 @@ def fly_campaign(definition, config, store: Path, *, progress: bool = True, **ba
     }
     try:
         figures = write_campaign_figures(store)
+        figures += write_statistics_figures(store)
     except ValueError:  # no successful case history to draw
         figures = []
+    if "worst_case" in run:  # a worst-case search: what it found
+        summary["worst_case"] = {k: run[k] for k in ("case_id", "metric", "value", "parameters")}
     summary["figures"] = [str(path) for path in figures]
     write_json(Path(store) / "summary.json", summary)
     return summary

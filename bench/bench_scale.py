@@ -1,0 +1,92 @@
+"""Benchmark: 1000 random Monte Carlo cases of the thesis slew, full and reduced model,
+local pool and Dask, 1 and 2 workers, against the goal.
+
+Goal (campaigns at scale): 1000 random Monte Carlo cases of the 120 s thesis slew in
+<= 30 s on 2 cores with the reduced model (root translations locked, 10 ms step and
+control period), the full model (1 ms) beside it; >= 90 % parallel efficiency from 1
+to 2 workers, local and Dask. Each configuration runs the same cases into a fresh
+temporary store; the wall time includes starting the workers.
+
+``--cases N`` (default 999 random + the nominal), ``--duration S`` (default 120),
+``--only full|reduced``, ``--backends local,dask``. Run with
+``python bench/bench_scale.py`` (or ``make bench``); on a shared machine the numbers
+are pessimistic.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import tempfile
+from pathlib import Path
+
+from rich.console import Console
+from rich.table import Table
+
+from flexsat.campaigns import load_campaign, run_campaign
+from flexsat.campaigns.definition import CampaignDefinition, Reduced
+from flexsat.config import nominal, validate_config
+
+GOAL_S = 30.0  # 1000 reduced-model cases on 2 cores
+GOAL_EFFICIENCY = 0.9
+
+
+def definition(duration_s: float, reduced: bool) -> CampaignDefinition:
+    data = load_campaign("montecarlo-random").model_dump(mode="json")
+    data["base"] = {**data["base"], "duration_s": duration_s}
+    if reduced:
+        data["reduced"] = Reduced().model_dump(mode="json")
+    return validate_config(data, model=CampaignDefinition)
+
+
+def main(argv: list[str] | None = None) -> dict:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--cases", type=int, default=999, help="random cases (+ the nominal)")
+    parser.add_argument("--duration", type=float, default=120.0, help="slew length [s]")
+    parser.add_argument("--only", choices=("full", "reduced"), default=None)
+    parser.add_argument("--backends", default="local,dask")
+    args = parser.parse_args(argv)
+    console = Console(width=150)
+    models = [args.only] if args.only else ["reduced", "full"]
+    backends = args.backends.split(",")
+    n = args.cases + 1
+    console.print(f"{n} cases of {args.duration:g} s, {os.cpu_count()} cores, load "
+                  f"{', '.join(f'{x:.2f}' for x in os.getloadavg())}")  # fmt: skip
+    walls: dict[tuple[str, str, int], float] = {}
+    with tempfile.TemporaryDirectory(prefix="flexsat-bench-scale-") as tmp:
+        for model in models:
+            campaign = definition(args.duration, model == "reduced")
+            for backend in backends:
+                for workers in (1, 2):
+                    store = Path(tmp) / f"{model}-{backend}-{workers}"
+                    options = ({"workers": workers} if backend == "local"
+                               else {"dask_local": workers})  # fmt: skip
+                    run = run_campaign(campaign, nominal(), store, n_random=args.cases,
+                                       progress=False, **options)  # fmt: skip
+                    walls[model, backend, workers] = run["wall_time_s"]
+                    console.print(f"  {model:7s} {backend:5s} x{workers}: "
+                                  f"{run['wall_time_s']:.1f} s ({n / run['wall_time_s']:.2f} "
+                                  "cases/s)")  # fmt: skip
+    table = Table(title=f"{n} random Monte Carlo cases ({args.duration:g} s slews)")
+    for column in ("model", "backend", "x1 (s)", "x2 (s)", "cases/s x2", "efficiency",
+                   "1000 cases x2 (s)", "<= 30 s", ">= 90 %"):  # fmt: skip
+        table.add_column(column, justify="left" if column in ("model", "backend") else "right")
+    results = {}
+    for model in models:
+        for backend in backends:
+            one, two = walls[model, backend, 1], walls[model, backend, 2]
+            per_1000 = two * 1000 / n
+            efficiency = one / two / 2
+            speed = ("met" if per_1000 <= GOAL_S else "not met") if model == "reduced" else "-"
+            scaling = "met" if efficiency >= GOAL_EFFICIENCY else "not met"
+            table.add_row(model, backend, f"{one:.1f}", f"{two:.1f}", f"{n / two:.2f}",
+                          f"{efficiency:.0%}", f"{per_1000:.0f}", speed, scaling)  # fmt: skip
+            results[f"{model} {backend}"] = {"wall_1_s": one, "wall_2_s": two,
+                                             "cases_per_s_2": n / two, "efficiency": efficiency,
+                                             "per_1000_cases_2_s": per_1000}  # fmt: skip
+    console.print(table)
+    return {"cases": n, "duration_s": args.duration, "results": results}
+
+
+if __name__ == "__main__":
+    main()
