@@ -8,7 +8,9 @@ warm-up call that loads the compiled kernels):
 * about a steady spin (1 rad/s about body X): the relative equilibrium (Gauss-Newton)
   and Richardson differences;
 * balanced truncation of the torque -> rate model to 16 states; the PD loop margins
-  of the three axes.
+  of the three axes;
+* the ``chain`` preset with each panel as a 32-segment chain (3 rotational DOFs per
+  joint: 198 DOF, 396 states), about rest, analytic against Richardson differences.
 
 The agreement of the two rest Jacobians (max |A_fd - A_exact| / max |A|) is printed
 with them. Run with ``python bench/bench_linear.py``.
@@ -22,7 +24,7 @@ import numpy as np
 from rich.console import Console
 from rich.table import Table
 
-from flexsat.config import nominal
+from flexsat.config import load_config, nominal, preset_path
 from flexsat.dynamics.plant import Plant
 from flexsat.linear import linearize
 from flexsat.linear.frequency import loop_margins, pd_gains, pd_loop
@@ -57,12 +59,29 @@ def main() -> None:
     K = pd_gains(plant)
     t_m, _ = _best(lambda: [loop_margins(pd_loop(exact, K, a)) for a in "xyz"])
     rows.append(("PD loop margins, 3 axes", t_m, ""))
+    chain = _chain_plant(32)
+    t_chain, chain_exact = _best(lambda: linearize(chain))
+    rows.append((f"2 x 32-segment chains, rest, analytic ({chain_exact.n_states} states)",
+                 t_chain, ""))  # fmt: skip
+    t_chain_fd, chain_fd = _best(lambda: linearize(chain, jacobian="richardson"))
+    err = np.max(np.abs(chain_fd.A - chain_exact.A)) / np.max(np.abs(chain_exact.A))
+    rows.append(("2 x 32-segment chains, rest, Richardson", t_chain_fd,
+                 f"max rel. diff. to analytic {err:.1e}"))  # fmt: skip
     table = Table(title=f"Linear analysis, nominal satellite ({exact.n_states} states)")
     for column in ("what", "time [ms]", "note"):
         table.add_column(column)
     for what, t, note in rows:
         table.add_row(what, f"{1e3 * t:.2f}", note)
     Console().print(table)
+
+
+def _chain_plant(segments: int) -> Plant:
+    """The ``chain`` preset with ``segments`` segments per panel."""
+    config = load_config(preset_path("chain"))
+    data = config.model_dump(mode="json")
+    for appendage in data["appendages"]:
+        appendage["segments"] = segments
+    return Plant.from_config(type(config).model_validate(data))
 
 
 if __name__ == "__main__":
