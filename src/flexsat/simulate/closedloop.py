@@ -13,6 +13,7 @@ from flexsat.config.models import SatelliteConfig
 from flexsat.control.laws import get_law
 from flexsat.control.quaternion import pointing_errors, target_quaternion
 from flexsat.control.stages import ACTUATORS, SENSORS
+from flexsat.dynamics.attitude import identity_frame, inertial_view, is_identity
 from flexsat.dynamics.integrators import rk4_hold
 from flexsat.dynamics.plant import Plant
 from flexsat.dynamics.rigid import rigid_inertia
@@ -116,24 +117,27 @@ def run_slew(
     rec_t = np.full(n_records, np.nan)
     rec_x = np.full((n_records, layout.plant.size), np.nan)
     rec_ctrl = np.full((n_records, layout.record_size), np.nan)
+    rec_frame = np.full((n_records, 9), np.nan)
     x = np.concatenate([q0, qd0, [0.0, 0.0]])
+    frame = identity_frame()  # attitude reference R_NF (flexsat.dynamics.attitude)
     data = _loop_data(layout, scenario, J)
     stages = LoopStages((layout.sensor.step,), (law.step,), (layout.actuator.step,))
     show = steps >= PROGRESS_MIN_STEPS if progress is None else progress
     start = time.perf_counter()
     with progress_bar(show, scenario.duration_s) as (bar, task):
         if controller is None:
-            status, done, rows = _compiled_loop(plant, scenario, x, stages, data, rec_t, rec_x,
-                                                rec_ctrl, bar, task)  # fmt: skip
+            status, done, rows = _compiled_loop(plant, scenario, x, frame, stages, data, rec_t,
+                                                rec_x, rec_ctrl, rec_frame, bar, task)  # fmt: skip
         else:
-            status, done, rows = _python_loop(plant, scenario, x, stages, data, rec_t, rec_x,
-                                              rec_ctrl, bar, task, controller)  # fmt: skip
+            status, done, rows = _python_loop(plant, scenario, x, frame, stages, data, rec_t,
+                                              rec_x, rec_ctrl, rec_frame, bar, task,
+                                              controller)  # fmt: skip
     wall = time.perf_counter() - start
     t_fail = done * scenario.dt_s if status else -1.0
     if status:  # keep the last good state as the final record
-        rec_t[rows], rec_x[rows], rec_ctrl[rows] = t_fail, x, data.held
+        rec_t[rows], rec_x[rows], rec_ctrl[rows], rec_frame[rows] = t_fail, x, data.held, frame
         rows += 1
-    rec_t, rec_x, rec_ctrl = rec_t[:rows], rec_x[:rows], rec_ctrl[:rows]
+    rec_t, rec_x, rec_ctrl, rec_frame = (a[:rows] for a in (rec_t, rec_x, rec_ctrl, rec_frame))
     attrs = run_attributes(plant, scenario, "closed-loop", status, t_fail, wall, done)
     attrs["controller"] = law.name if controller is None else "python"
     attrs["controller_label"] = law.label if controller is None else "Python law"
@@ -149,7 +153,7 @@ def run_slew(
     ds = build_dataset(
         plant, rec_t, rec_x[:, at.q], rec_x[:, at.qd], rec_x[:, at.work_in],
         rec_x[:, at.dissipated], rec_ctrl[:, layout.tau_cmd], rec_ctrl[:, layout.tau_applied],
-        attrs,
+        attrs, frames=rec_frame,
     )  # fmt: skip
     ta = ("time", "axis")
     for channel, columns in layout.channels():
@@ -157,7 +161,7 @@ def run_slew(
         attributes = {"units": channel.units, "description": channel.description}
         ds[channel.name] = (ta if channel.per_axis else "time", values, attributes)
     # of the true attitude, whatever the sensor measured
-    pointing = pointing_errors(data.q_d, np.ascontiguousarray(rec_x[:, at.attitude]))
+    pointing = pointing_errors(data.q_d, np.ascontiguousarray(ds["q"].values[:, at.attitude]))
     ds["pointing_error_deg"] = (
         "time", np.degrees(pointing),
         {"units": "deg", "description": "2 asin |q_v,e| of the true attitude: absolute "
@@ -202,7 +206,8 @@ def _loop_data(layout: LoopLayout, scenario: SlewScenario, J: np.ndarray) -> Loo
     )
 
 
-def _compiled_loop(plant, scenario, x, stages, data, rec_t, rec_x, rec_ctrl, bar, task):
+def _compiled_loop(plant, scenario, x, frame, stages, data, rec_t, rec_x, rec_ctrl, rec_frame,
+                   bar, task):  # fmt: skip
     """The whole loop, stages and law included, in compiled chunks."""
     steps, every, control = scenario.n_steps, scenario.record_every, scenario.control_every
     chunk = chunk_steps(every, control)
@@ -212,7 +217,8 @@ def _compiled_loop(plant, scenario, x, stages, data, rec_t, rec_x, rec_ctrl, bar
         final = done + n_chunk == steps
         clock = LoopClock(done * scenario.dt_s, scenario.dt_s, n_chunk, final, control, every)
         status, ran, written = rk4_closed_loop(
-            x, clock, stages, data, LoopRecords(rec_t, rec_x, rec_ctrl, rows), plant.packed
+            x, clock, stages, data, LoopRecords(rec_t, rec_x, rec_ctrl, rows, rec_frame),
+            plant.packed, frame,
         )
         done += ran
         rows += written
@@ -223,7 +229,8 @@ def _compiled_loop(plant, scenario, x, stages, data, rec_t, rec_x, rec_ctrl, bar
     return status, done, rows
 
 
-def _python_loop(plant, scenario, x, stages, d, rec_t, rec_x, rec_ctrl, bar, task, controller):
+def _python_loop(plant, scenario, x, frame, stages, d, rec_t, rec_x, rec_ctrl, rec_frame, bar,
+                 task, controller):  # fmt: skip
     """Python controller at each control instant between the compiled stages; the plant
     steps compiled in between."""
     n = plant.n_dof
@@ -232,12 +239,17 @@ def _python_loop(plant, scenario, x, stages, d, rec_t, rec_x, rec_ctrl, bar, tas
     control_dt = control * scenario.dt_s
     limit = scenario.actuator.reduction_factor * scenario.actuator.t_max_nm
     d.law_diag[:] = np.nan
+    view = np.empty_like(x)
     rows, status, k = 0, 0, 0
     while True:
         t = k * scenario.dt_s
         if k % control == 0:
-            status = stages.sensor[0](x, n, t, d.sensor_params, d.sensor_state, d.q_meas,
-                                      d.omega_meas, d.sensor_record)  # fmt: skip
+            sensed = x
+            if not is_identity(frame):  # re-based by rk4_hold: the sensor reads N
+                inertial_view(x, n, frame, view)
+                sensed = view
+            status = stages.sensor[0](sensed, n, t, d.sensor_params, d.sensor_state,
+                                      d.q_meas, d.omega_meas, d.sensor_record)  # fmt: skip
             tau_cmd = np.asarray(controller(t, d.q_meas.copy(), d.omega_meas.copy()), dtype=float)
             if tau_cmd.shape != (3,) or not np.all(np.isfinite(tau_cmd)):
                 raise SimulationError(f"controller returned {tau_cmd!r} at t = {t:.6g} s")
@@ -249,12 +261,12 @@ def _python_loop(plant, scenario, x, stages, d, rec_t, rec_x, rec_ctrl, bar, tas
             if status:
                 return STATUS_CONTROL_FAILED, k, rows
         if k % every == 0:
-            rec_t[rows], rec_x[rows], rec_ctrl[rows] = t, x, d.held
+            rec_t[rows], rec_x[rows], rec_ctrl[rows], rec_frame[rows] = t, x, d.held, frame
             rows += 1
         if k == steps:
             return 0, k, rows
         torque = (d.tau_applied[0], d.tau_applied[1], d.tau_applied[2])
-        status, ran = rk4_hold(x, scenario.dt_s, block, torque, plant.packed)
+        status, ran = rk4_hold(x, scenario.dt_s, block, torque, plant.packed, frame)
         k += ran
         if status:
             return status, k, rows
