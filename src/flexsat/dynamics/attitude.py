@@ -8,7 +8,7 @@ floats, F components to inertial N components)::
     R_NB = R_NF R_FB(Theta),   R_FB(Theta) = Rz(psi) Ry(theta) Rx(phi)   (eq. 2.25)
 
 and the hub position and velocity q[0:3], q_dot[0:3] are F components. Between two
-steps, when |cos(pitch)| falls below ``SWITCH_COS`` (pitch beyond +-60 deg),
+steps, when the pitch coordinate leaves +-``SWITCH_PITCH`` (60 deg),
 :func:`rebase` moves F onto the hub's current body frame: R_NF <- R_NF R_FB(Theta),
 Theta <- 0, Theta_dot <- S(0)^-1 omega_B = omega_B (eq. 2.28), r_F and v_F rotated
 into the new F. This is the Euler-angle analogue of switching MRPs: the coordinates
@@ -27,7 +27,7 @@ parametrization'.
 from __future__ import annotations
 
 import warnings
-from math import atan2, cos, hypot
+from math import atan2, hypot, pi
 
 import numpy as np
 from numba import njit
@@ -45,7 +45,7 @@ from flexsat.dynamics.linalg3 import (
 )
 
 __all__ = [
-    "SWITCH_COS",
+    "SWITCH_PITCH",
     "euler_zyx",
     "identity_frame",
     "inertial_records",
@@ -55,10 +55,12 @@ __all__ = [
     "vectors_to_inertial",
 ]
 
-SWITCH_COS = 0.5
-"""Re-base the attitude when |cos(pitch)| < 0.5 (pitch beyond +-60 deg): far enough
-from the singularity that S(Theta)^-1 has a condition number below 4, far enough from
-the thesis's slews (pitch up to 45 deg) that they never switch."""
+SWITCH_PITCH = pi / 3.0
+"""Re-base the attitude when |pitch| > 60 deg [rad]: far enough from the singularity
+that |cos(pitch)| >= 0.5 (S(Theta)^-1 stays well conditioned), far enough from the
+thesis's slews (pitch up to 45 deg) that they never switch. A test on the coordinate
+itself, not on cos(pitch): the pitch coordinate grows continuously from 0 after each
+re-base, so an adaptive solver's event on it cannot be stepped over."""
 
 
 def identity_frame() -> np.ndarray:
@@ -91,8 +93,8 @@ def _store_m33(a, R):
 
 
 @njit(cache=True, error_model="numpy")
-def rebase(x, n_dof, frame):
-    """Move the reference frame onto the hub's body frame if |cos(pitch)| < ``SWITCH_COS``.
+def rebase(x, n_dof, frame, threshold=SWITCH_PITCH):
+    """Move the reference frame onto the hub's body frame if |pitch| > ``threshold``.
 
     Parameters
     ----------
@@ -101,6 +103,9 @@ def rebase(x, n_dof, frame):
     n_dof : int
     frame : ndarray, shape (9,)
         R_NF, row-major; updated in place.
+    threshold : float
+        ``SWITCH_PITCH`` [rad]; an adaptive solver that located the switch as an event
+        (where |pitch| = ``SWITCH_PITCH`` up to round-off) passes 0.0.
 
     Returns
     -------
@@ -109,7 +114,7 @@ def rebase(x, n_dof, frame):
         independent and left as they are.
     """
     phi, theta, psi = x[3], x[4], x[5]
-    if abs(cos(theta)) >= SWITCH_COS:
+    if abs(theta) <= threshold:
         return False
     R_FB = rot_zyx(phi, theta, psi)
     omega_B = mv(euler_rate_matrix(phi, theta), load_seg(x, n_dof + 3))  # eq. 2.28

@@ -8,7 +8,7 @@ import time
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from flexsat.dynamics.attitude import SWITCH_COS, identity_frame, rebase
+from flexsat.dynamics.attitude import SWITCH_PITCH, identity_frame, rebase
 from flexsat.dynamics.integrators import (
     STATUS_NOT_FINITE,
     applied_torque,
@@ -159,7 +159,7 @@ def _run_rk4(plant, scenario, q0, qd0, profile, progress):
 def _run_dop853(plant, scenario, q0, qd0, profile):
     """Adaptive DOP853 (scipy), integrated piecewise between torque switching times.
 
-    Each piece also ends where |cos(pitch)| reaches ``SWITCH_COS`` (a terminal event):
+    Each piece also ends where |pitch| reaches ``SWITCH_PITCH`` (a terminal event):
     the attitude is re-based there (:func:`flexsat.dynamics.attitude.rebase`) and the
     piece continues from the event. A run that diverges stops there, like RK4: the
     records up to the failure and the last good state are kept, with its status.
@@ -181,7 +181,7 @@ def _run_dop853(plant, scenario, q0, qd0, profile):
     kernel_status = STATUS_OK
 
     def switch(t, y, torque=None):  # positive after each rebase
-        return abs(np.cos(y[4])) - SWITCH_COS
+        return SWITCH_PITCH - abs(y[4])
 
     switch.terminal = True
     switch.direction = -1.0
@@ -208,11 +208,14 @@ def _run_dop853(plant, scenario, q0, qd0, profile):
         )  # fmt: skip
         t_end = float(sol.t[-1])
         inside = (t_rec >= a) & (t_rec <= t_end)
-        X[inside] = sol.sol(t_rec[inside]).T
-        F[inside] = frame
+        if inside.any():  # a piece cut short by a switch may hold no record
+            X[inside] = sol.sol(t_rec[inside]).T
+            F[inside] = frame
         x = sol.y[:, -1].copy()
-        if sol.status == 1 and t_end < b:  # the switching event: re-base, go on to b
-            pieces.insert(0, (t_end, b))
+        if sol.status == 1:  # the switching event: re-base, go on to b
+            rebase(x, n, frame, 0.0)
+            if t_end < b:
+                pieces.insert(0, (t_end, b))
         elif sol.status == -1:  # the steps failed (diverged)
             status = kernel_status or STATUS_NOT_FINITE
             t_fail = t_end
