@@ -15,7 +15,7 @@ from flexsat.errors import ConfigError, shorten
 
 __all__ = ["PRESETS", "load_config", "nominal", "preset_path", "read_toml", "validate_config"]
 
-PRESETS = ("nominal",)
+PRESETS = ("nominal", "chain")
 _MAX_REPORTED = 3  # problems listed in one error message
 
 

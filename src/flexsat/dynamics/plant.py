@@ -117,13 +117,20 @@ class Plant:
         groups: dict[str, list[int]] = {}
         for i, model in enumerate(self.models):
             groups.setdefault(model.name, []).append(i)
-        members, params, kernel_sets, models = [], [], [], []
+        members, params, kernel_sets, work = [], [], [], []
         for indices in groups.values():
             offsets = [self.layout.blocks[i].offset for i in indices]
             members.append(np.array([indices, offsets], dtype=np.int64).T.copy())
-            params.append(np.ascontiguousarray(np.stack([self.params[i] for i in indices])))
-            kernel_sets.append(self.models[indices[0]].kernels)
-            models.append(self.models[indices[0]])
+            # Rows of one model may differ in length (a chain's grows with its segments):
+            # the group's array is as wide as its widest row, zero-padded.
+            rows = [self.params[i] for i in indices]
+            stacked = np.zeros((len(rows), max(len(r) for r in rows)))
+            for k, r in enumerate(rows):
+                stacked[k, : len(r)] = r
+            params.append(stacked)
+            model = self.models[indices[0]]
+            kernel_sets.append(model.kernels)
+            work.append(np.zeros((len(rows), max(1, *(model.work_columns(r) for r in rows)))))
         hub_J = np.ascontiguousarray(self.hub_J, dtype=float)
         return PackedPlant(
             n_dof=self.layout.n_dof,
@@ -135,8 +142,7 @@ class Plant:
             solve=np.zeros((6, 7)),
             members=tuple(members),
             params=tuple(params),
-            work=tuple(np.zeros((len(m), max(1, k.work_size)))
-                       for m, k in zip(members, models, strict=True)),
+            work=tuple(work),
             **{name: tuple(first_class(getattr(k, name), signature) for k in kernel_sets)
                for name, signature in SIGNATURES._asdict().items()},
         )  # fmt: skip

@@ -48,6 +48,8 @@ def initial_state(plant: Plant, scenario: OpenLoopScenario) -> tuple[np.ndarray,
     omega_B = np.radians(init.rate_deg_s)
     qd[3:6] = np.array(euler_rate_matrix_inv(q[3], q[4])) @ omega_B  # Theta_dot = S^-1 omega
     configs = {a.name: (a, m) for a, m in zip(plant.config.appendages, plant.models, strict=True)}
+    for (config, model), block in zip(configs.values(), plant.layout.blocks, strict=True):
+        q[block.slice], qd[block.slice] = model.default_state(config)
     for entry in init.appendages:
         try:
             block = plant.layout.block(entry.name)

@@ -121,8 +121,8 @@ def build_dataset(
     quaternion = np.column_stack([quat_scalar_last[:, 3], quat_scalar_last[:, :3]])
     # Root motion per appendage, as its model defines it.
     blocks = list(zip(plant.models, plant.layout.blocks, strict=True))
-    root = [model.root_motion(q[:, b.slice]) for model, b in blocks]
-    root_rate = [model.root_motion(qd[:, b.slice]) for model, b in blocks]
+    root = [model.root_motion(q[:, b.slice], b.names) for model, b in blocks]
+    root_rate = [model.root_motion(qd[:, b.slice], b.names) for model, b in blocks]
 
     def var(dims, data, units, description):
         return (dims, data, {"units": units, "description": description})

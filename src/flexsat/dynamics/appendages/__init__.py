@@ -1,9 +1,11 @@
 """Appendage models: the contract, the registry and the built-in models.
 
-The thesis's plate on its 6-DOF root joint (:mod:`.plate`) is registered here; a
+The thesis's plate on its 6-DOF root joint (:mod:`.plate`) and the chain of rigid
+segments (:mod:`.chain`) are registered here; a
 user's model is registered the same way, from the user's own file.
 """
 
+from flexsat.dynamics.appendages.chain import ChainModel
 from flexsat.dynamics.appendages.contract import (
     AppendageKernels,
     AppendageModel,
@@ -18,10 +20,12 @@ from flexsat.dynamics.appendages.registry import (
 )
 
 register_appendage_model(PlateModel())
+register_appendage_model(ChainModel())
 
 __all__ = [
     "AppendageKernels",
     "AppendageModel",
+    "ChainModel",
     "Coordinate",
     "PlateModel",
     "RigidBody",

@@ -174,7 +174,8 @@ class AppendageModel(ABC):
         False for a model on a full 6-DOF joint (the engine then skips the 6 x 6
         hub solve); True when ``pass1`` adds an articulated inertia.
     work_size : int
-        Columns of the scratch rows ``work`` that pass 1 may leave for pass 2.
+        Columns of the scratch rows ``work`` that pass 1 may leave for pass 2 (see
+        :meth:`work_columns` for a scratch that grows with the appendage).
     modifiers : dict
         Derived campaign modifier paths beyond the config's own fields: name ->
         function(table, value) that changes the appendage's plain-dict table in place
@@ -230,6 +231,17 @@ class AppendageModel(ABC):
             "no initial state to set"
         )
 
+    def work_columns(self, params: np.ndarray) -> int:
+        """Columns of the scratch row one member with packed row ``params`` needs (a
+        model whose scratch grows with its size overrides it). Default: ``work_size``."""
+        return self.work_size
+
+    def default_state(self, config: BaseModel) -> tuple[np.ndarray, np.ndarray]:
+        """Its rows of q(0) and q_dot(0) before any scenario entry (a model whose config
+        holds an initial state overrides it). Default: at rest, undeformed."""
+        count = len(self.coordinates(config))
+        return np.zeros(count), np.zeros(count)
+
     def describe(self, config: BaseModel, params: np.ndarray) -> dict:
         """Derived properties for reports and ``flexsat config`` (JSON-ready). Default:
         the rigid body's mass [kg] and inertia about its centre of mass in B [kg m^2]."""
@@ -255,10 +267,12 @@ class AppendageModel(ABC):
         coordinates hold most of its strain energy. Default: the coordinate names."""
         return tuple(c.name for c in self.coordinates(config))
 
-    def root_motion(self, q_block: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    def root_motion(self, q_block: np.ndarray, names: tuple[str, ...] = ()
+                    ) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
         """Root translation eta [m] and rotation rho [rad] of its joint, each (m, 3),
-        from recorded coordinates (or rates) ``q_block`` (m, count). Default: NaN (the
-        model has no root joint of that form)."""
+        from recorded coordinates (or rates) ``q_block`` (m, count) named ``names`` (its
+        coordinate names, in order). Default: NaN (the model has no root joint of that
+        form)."""
         nan = np.full((q_block.shape[0], 3), np.nan)
         return nan, nan.copy()
 

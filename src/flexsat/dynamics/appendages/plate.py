@@ -499,7 +499,8 @@ class PlateModel(AppendageModel):
     def mode_kinds(self, config: AppendageConfig) -> tuple[str, ...]:
         return ("translation", "translation", "translation", "flapping", "torsion", "in_plane")
 
-    def root_motion(self, q_block: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    def root_motion(self, q_block: np.ndarray, names: tuple[str, ...] = ()
+                    ) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
         return q_block[:, :3], q_block[:, 3:]
 
     def mirror_block(self, params_i: np.ndarray, params_j: np.ndarray, reflect: np.ndarray,

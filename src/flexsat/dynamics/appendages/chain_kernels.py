@@ -1,0 +1,705 @@
+"""Compiled kernels of the chain appendage: an O(N) articulated-body recursion.
+
+Spatial vectors (Featherstone's notation, docs/model.md, 'Chain appendages') are
+pairs of 3-tuples: a motion vector [omega; v] (angular velocity; velocity of the point
+at the frame's origin), a force vector [n; f] (moment about the origin; force). Every
+segment's quantities are in its own frame P_k at its joint origin; the hub's in B at
+the hub centre of mass, with the hub's linear velocity taken as zero (a Galilean
+boost: accelerations do not depend on it).
+
+Joint k connects the parent (the hub for k = 0, else segment k - 1) to segment k. Its
+parent-side frame J_k is the mount frame M (k = 0) or the parent's frame moved to the
+parent's next-joint point; relative to it the segment's origin is at t = (x, y, z) and
+its axes turned by R_JP = Rz(rz) Ry(ry) Rx(rx), with relative body rate S(rho)
+rho_dot, exactly as the plate's root joint (eq. 2.31). Locked DOFs stay zero. The
+motion subspace S_k (6 x n_k) holds the columns [0; R_JP^T e_i] of the translations
+and [S(rho) e_i; 0] of the rotations.
+
+Articulated-body algorithm per chain (eqs. of docs/model.md, 'Chain appendages'):
+pass 1 runs outward for the velocities v_k = X_k v_{k-1} + S_k qd_k and bias
+accelerations c_k, then inward for the articulated inertias I^A_k and bias forces
+p^A_k, handing the hub X_0^T I^a_0 X_0 and X_0^T p^a_0; pass 2 runs outward for
+q_ddot_k = D_k^-1 (u_k - U_k^T (X_k a_{k-1} + c_k)). Cost is linear in N. M(q) and
+h(q, q_dot) (analysis only, not in the integration loop) are the composite-rigid-body
+and recursive Newton-Euler algorithms and allocate one scratch row per chain.
+"""
+
+from __future__ import annotations
+
+from math import cos
+
+import numpy as np
+from numba import njit
+
+from flexsat.dynamics.appendages.contract import (
+    BIAS_SIGNATURE,
+    HUB_ACC,
+    HUB_ALPHA,
+    HUB_DISSIPATION,
+    HUB_FORCE,
+    HUB_INERTIA,
+    HUB_OMEGA,
+    HUB_SBIAS,
+    HUB_TORQUE,
+    MASS_SIGNATURE,
+    OBS_DISSIPATION,
+    OBS_ELASTIC,
+    OBS_KINETIC,
+    OBS_LOCKED_INERTIA,
+    OBS_MOMENTUM,
+    OBSERVE_SIGNATURE,
+    PASS1_SIGNATURE,
+    PASS2_SIGNATURE,
+    TIPS_SIGNATURE,
+    WRENCH_SIGNATURE,
+)
+from flexsat.dynamics.linalg3 import (
+    add,
+    cross,
+    dot,
+    euler_rate_bias,
+    euler_rate_matrix,
+    load_m33_at,
+    load_seg,
+    mm,
+    mtv,
+    mv,
+    rot_zyx,
+    scale,
+    sub,
+    transpose,
+)
+from flexsat.dynamics.status import STATUS_JOINT_GIMBAL_LOCK, STATUS_OK
+
+__all__ = [
+    "G_C",
+    "G_COM",
+    "G_FREE",
+    "G_J",
+    "G_K",
+    "G_MASS",
+    "G_NEXT",
+    "G_NF",
+    "G_OFF",
+    "HEADER",
+    "H_MOUNT",
+    "H_N",
+    "H_R_BM",
+    "H_TIP",
+    "H_TIP0",
+    "SEG",
+    "WSEG",
+    "bias_forces",
+    "joint_wrench",
+    "mass_matrix",
+    "observe",
+    "pass1",
+    "pass2",
+    "tips",
+]
+
+# Packed parameter row of one chain: a header, then SEG columns per segment.
+H_MOUNT = 0  # (3) r_m, root joint position in B [m]
+H_R_BM = 3  # (9) R_BM, mount frame -> hub frame, row-major
+H_N = 12  # (1) segment count N
+H_TIP = 13  # (3) tip point in the last segment's frame [m]
+H_TIP0 = 16  # (3) undeformed tip, mount frame [m]
+HEADER = 19
+G_MASS = 0  # (1) segment mass, tip mass included [kg]
+G_J = 1  # (9) inertia about its centre of mass, segment frame [kg m^2]
+G_COM = 10  # (3) joint -> centre of mass, segment frame [m]
+G_NEXT = 13  # (3) joint -> next joint, segment frame [m]
+G_FREE = 16  # (6) 1.0 where the DOF (x, y, z, rx, ry, rz) is free
+G_K = 22  # (6) stiffness per DOF [N/m, N m/rad] (0 where locked)
+G_C = 28  # (6) damping per DOF [N s/m, N m s/rad]
+G_OFF = 34  # (1) offset of the joint's first coordinate in the chain's block
+G_NF = 35  # (1) number of free DOFs n_k
+SEG = 36
+
+# Scratch per segment in a work row (pass 1 -> pass 2).
+W_R = 0  # (9) R_{parent, P_k}, row-major
+W_POS = 9  # (3) segment origin in parent coordinates [m]
+W_CA = 12  # (6) bias acceleration c_k [angular; linear]
+W_S = 18  # (36) motion subspace, column a at W_S + 6 a
+W_IA = 54  # (36) articulated inertia I^A_k, row-major [n; f] x [omega; v]
+W_PA = 90  # (6) bias force p^A_k [n; f]
+W_U = 96  # (36) U_k = I^A_k S_k, column a at W_U + 6 a
+W_DI = 132  # (36) D_k^-1, row-major, stride 6
+W_TAU = 168  # (6) tau_k, then u_k = tau_k - S_k^T p^A_k
+WSEG = 174
+
+MIN_COS = 1e-9  # |cos(ry)| below this is a gimbal lock when rx and rz are both free
+_ZERO = (0.0, 0.0, 0.0)
+
+
+@njit(cache=True, error_model="numpy")
+def _xm(R, pos, ua, ul):
+    """Motion vector from parent to child coordinates: (R^T ua, R^T (ul - pos x ua))."""
+    return mtv(R, ua), mtv(R, sub(ul, cross(pos, ua)))
+
+
+@njit(cache=True, error_model="numpy")
+def _xft(R, pos, n, f):
+    """Force vector from child to parent coordinates (X^T): (R n + pos x R f, R f)."""
+    Rf = mv(R, f)
+    return add(mv(R, n), cross(pos, Rf)), Rf
+
+
+@njit(cache=True, error_model="numpy")
+def _crm(va, vl, ua, ul):
+    """v x_m u (motion cross product)."""
+    return cross(va, ua), add(cross(va, ul), cross(vl, ua))
+
+
+@njit(cache=True, error_model="numpy")
+def _crf(va, vl, n, f):
+    """v x_f f (force cross product)."""
+    return add(cross(va, n), cross(vl, f)), cross(va, f)
+
+
+@njit(cache=True, error_model="numpy")
+def _inertia_mul(m, c, J, ua, ul):
+    """I u for the spatial inertia at the origin of a body of mass m, centre of mass c,
+    centroidal inertia J: l = m (v + omega x c), n = J omega + c x l."""
+    lin = scale(m, add(ul, cross(ua, c)))
+    return add(mv(J, ua), cross(c, lin)), lin
+
+
+@njit(cache=True, error_model="numpy")
+def _mul6(a, k, ua, ul):
+    """(a[k:k+36] as a row-major 6 x 6) @ [ua; ul]."""
+    n0 = (a[k] * ua[0] + a[k + 1] * ua[1] + a[k + 2] * ua[2]
+          + a[k + 3] * ul[0] + a[k + 4] * ul[1] + a[k + 5] * ul[2])  # fmt: skip
+    n1 = (a[k + 6] * ua[0] + a[k + 7] * ua[1] + a[k + 8] * ua[2]
+          + a[k + 9] * ul[0] + a[k + 10] * ul[1] + a[k + 11] * ul[2])  # fmt: skip
+    n2 = (a[k + 12] * ua[0] + a[k + 13] * ua[1] + a[k + 14] * ua[2]
+          + a[k + 15] * ul[0] + a[k + 16] * ul[1] + a[k + 17] * ul[2])  # fmt: skip
+    f0 = (a[k + 18] * ua[0] + a[k + 19] * ua[1] + a[k + 20] * ua[2]
+          + a[k + 21] * ul[0] + a[k + 22] * ul[1] + a[k + 23] * ul[2])  # fmt: skip
+    f1 = (a[k + 24] * ua[0] + a[k + 25] * ua[1] + a[k + 26] * ua[2]
+          + a[k + 27] * ul[0] + a[k + 28] * ul[1] + a[k + 29] * ul[2])  # fmt: skip
+    f2 = (a[k + 30] * ua[0] + a[k + 31] * ua[1] + a[k + 32] * ua[2]
+          + a[k + 33] * ul[0] + a[k + 34] * ul[1] + a[k + 35] * ul[2])  # fmt: skip
+    return (n0, n1, n2), (f0, f1, f2)
+
+
+@njit(cache=True, error_model="numpy")
+def _unit(j):
+    """The j-th unit motion vector (j in 0..5) as (angular, linear)."""
+    e = (1.0 if j % 3 == 0 else 0.0, 1.0 if j % 3 == 1 else 0.0, 1.0 if j % 3 == 2 else 0.0)
+    if j < 3:
+        return e, _ZERO
+    return _ZERO, e
+
+
+@njit(cache=True, error_model="numpy")
+def _put3(x, k, v):
+    x[k], x[k + 1], x[k + 2] = v
+
+
+@njit(cache=True, error_model="numpy")
+def _put_m33(x, k, m):
+    for a in range(3):
+        x[k + 3 * a], x[k + 3 * a + 1], x[k + 3 * a + 2] = m[a]
+
+
+@njit(cache=True, error_model="numpy")
+def _store_inertia(w, k, m, c, J):
+    """w[k:k+36] = the spatial inertia at the origin, row-major."""
+    for j in range(6):
+        ua, ul = _unit(j)
+        n, f = _inertia_mul(m, c, J, ua, ul)
+        for r in range(3):
+            w[k + 6 * r + j] = n[r]
+            w[k + 6 * (r + 3) + j] = f[r]
+
+
+@njit(cache=True, error_model="numpy")
+def _add_congruence(src, s, R, pos, dst, d, swap):
+    """dst[d:d+36] += X^T (src[s:s+36]) X, X the parent -> child motion transform.
+
+    ``swap`` = 3 writes it in the hub exchange order [force; torque] x [a; omega_dot].
+    """
+    for j in range(6):
+        ua, ul = _unit(j)
+        xa, xl = _xm(R, pos, ua, ul)
+        n, f = _mul6(src, s, xa, xl)
+        zn, zf = _xft(R, pos, n, f)
+        col = (j + swap) % 6
+        for r in range(3):
+            dst[d + 6 * ((r + swap) % 6) + col] += zn[r]
+            dst[d + 6 * ((r + 3 + swap) % 6) + col] += zf[r]
+
+
+@njit(cache=True, error_model="numpy")
+def _joint_pose(q, qd, o, p, g, first):
+    """Pose and relative motion of the joint whose segment's columns start at p[g].
+
+    Returns R (parent <- segment), pos (segment origin, parent coordinates), R_JP,
+    S(rho), the joint velocity v_J = S_k qd_k and its bias c_J = S_dot_k qd_k (both in
+    segment coordinates), and a status.
+    """
+    c = o + int(p[g + G_OFF])
+    x = y = z = rx = ry = rz = 0.0
+    dx = dy = dz = drx = dry = drz = 0.0
+    for i in range(6):
+        if p[g + G_FREE + i] != 0.0:
+            v, dv = q[c], qd[c]
+            c += 1
+            if i == 0:
+                x, dx = v, dv
+            elif i == 1:
+                y, dy = v, dv
+            elif i == 2:
+                z, dz = v, dv
+            elif i == 3:
+                rx, drx = v, dv
+            elif i == 4:
+                ry, dry = v, dv
+            else:
+                rz, drz = v, dv
+    status = STATUS_OK
+    if p[g + G_FREE + 3] != 0.0 and p[g + G_FREE + 5] != 0.0 and abs(cos(ry)) < MIN_COS:
+        status = STATUS_JOINT_GIMBAL_LOCK
+    R_JP = rot_zyx(rx, ry, rz)
+    S_rho = euler_rate_matrix(rx, ry)
+    t = (x, y, z)
+    if first:
+        R_PJ = load_m33_at(p, H_R_BM)
+        origin = load_seg(p, H_MOUNT)
+    else:
+        R_PJ = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
+        origin = load_seg(p, g - SEG + G_NEXT)
+    pos = add(origin, mv(R_PJ, t))
+    R = mm(R_PJ, R_JP)
+    omega_rel = mv(S_rho, (drx, dry, drz))
+    v_lin = mtv(R_JP, (dx, dy, dz))
+    c_ang = euler_rate_bias(rx, ry, drx, dry, drz)
+    c_lin = scale(-1.0, cross(omega_rel, v_lin))
+    return R, pos, R_JP, S_rho, omega_rel, v_lin, c_ang, c_lin, status
+
+
+@njit(cache=True, error_model="numpy")
+def _store_subspace(w, b, p, g, R_JP, S_rho):
+    """Columns of S_k (free DOFs only) at w[b + W_S + 6 a]."""
+    a = 0
+    for i in range(6):
+        if p[g + G_FREE + i] == 0.0:
+            continue
+        k = b + W_S + 6 * a
+        for r in range(6):
+            w[k + r] = 0.0
+        if i < 3:  # translation: [0; R_JP^T e_i] = [0; row i of R_JP]
+            w[k + 3], w[k + 4], w[k + 5] = R_JP[i]
+        else:  # rotation: [S(rho) e_i; 0]
+            w[k], w[k + 1], w[k + 2] = S_rho[0][i - 3], S_rho[1][i - 3], S_rho[2][i - 3]
+        a += 1
+
+
+@njit(cache=True, error_model="numpy")
+def _col(w, k):
+    return (w[k], w[k + 1], w[k + 2]), (w[k + 3], w[k + 4], w[k + 5])
+
+
+@njit(cache=True, error_model="numpy")
+def _pose_of(w, b):
+    return load_m33_at(w, b + W_R), load_seg(w, b + W_POS)
+
+
+@njit(cache=True, error_model="numpy")
+def _invert_spd(w, k, n):
+    """Invert the n x n symmetric positive definite w[k + 6 r + c] in place (Gauss-Jordan)."""
+    for e in range(n):
+        pivot = w[k + 7 * e]
+        w[k + 7 * e] = 1.0
+        for c in range(n):
+            w[k + 6 * e + c] /= pivot
+        for r in range(n):
+            if r == e:
+                continue
+            f = w[k + 6 * r + e]
+            w[k + 6 * r + e] = 0.0
+            for c in range(n):
+                w[k + 6 * r + c] -= f * w[k + 6 * e + c]
+
+
+@njit(PASS1_SIGNATURE, cache=True, error_model="numpy")
+def pass1(q, qd, Q, members, params, work, hub, qdd):
+    """Velocities outward, articulated inertias inward; the root's share to the hub."""
+    omega_B = load_seg(hub, HUB_OMEGA)
+    for j in range(members.shape[0]):
+        o = members[j, 1]
+        p = params[j]
+        w = work[j]
+        n_seg = int(p[H_N])
+        va, vl = omega_B, _ZERO
+        for k in range(n_seg):
+            g, b = HEADER + k * SEG, k * WSEG
+            R, pos, R_JP, S_rho, ja, jl, ca, cl, status = _joint_pose(q, qd, o, p, g, k == 0)
+            if status != STATUS_OK:
+                return status
+            _put_m33(w, b + W_R, R)
+            _put3(w, b + W_POS, pos)
+            _store_subspace(w, b, p, g, R_JP, S_rho)
+            xa, xl = _xm(R, pos, va, vl)
+            va, vl = add(xa, ja), add(xl, jl)
+            ba, bl = _crm(va, vl, ja, jl)
+            _put3(w, b + W_CA, add(ca, ba))
+            _put3(w, b + W_CA + 3, add(cl, bl))
+            m, c, J = p[g + G_MASS], load_seg(p, g + G_COM), load_m33_at(p, g + G_J)
+            _store_inertia(w, b + W_IA, m, c, J)
+            hn, hf = _inertia_mul(m, c, J, va, vl)
+            pn, pf = _crf(va, vl, hn, hf)
+            _put3(w, b + W_PA, pn)
+            _put3(w, b + W_PA + 3, pf)
+            a, col = 0, o + int(p[g + G_OFF])
+            for i in range(6):
+                if p[g + G_FREE + i] != 0.0:
+                    rate = qd[col + a]
+                    w[b + W_TAU + a] = (
+                        Q[col + a] - p[g + G_K + i] * q[col + a] - p[g + G_C + i] * rate
+                    )
+                    hub[HUB_DISSIPATION] += p[g + G_C + i] * rate * rate  # eq. 2.36
+                    a += 1
+        for k in range(n_seg - 1, -1, -1):
+            g, b = HEADER + k * SEG, k * WSEG
+            nf = int(p[g + G_NF])
+            # U = I^A S, D = S^T U, u = tau - S^T p^A
+            for a in range(nf):
+                sa, sl = _col(w, b + W_S + 6 * a)
+                un, uf = _mul6(w, b + W_IA, sa, sl)
+                _put3(w, b + W_U + 6 * a, un)
+                _put3(w, b + W_U + 6 * a + 3, uf)
+                w[b + W_TAU + a] -= dot(sa, load_seg(w, b + W_PA)) + dot(
+                    sl, load_seg(w, b + W_PA + 3)
+                )
+            for a in range(nf):
+                sa, sl = _col(w, b + W_S + 6 * a)
+                for e in range(nf):
+                    un, uf = _col(w, b + W_U + 6 * e)
+                    w[b + W_DI + 6 * a + e] = dot(sa, un) + dot(sl, uf)
+            _invert_spd(w, b + W_DI, nf)
+            # I^a = I^A - U D^-1 U^T; p^a = p^A + I^a c + U D^-1 u
+            for a in range(nf):
+                y = 0.0
+                for e in range(nf):
+                    y += w[b + W_DI + 6 * a + e] * w[b + W_TAU + e]
+                for r in range(6):
+                    w[b + W_PA + r] += w[b + W_U + 6 * a + r] * y
+            for r in range(6):
+                for s in range(6):
+                    acc = 0.0
+                    for a in range(nf):
+                        ua = w[b + W_U + 6 * a + r]
+                        for e in range(nf):
+                            acc += ua * w[b + W_DI + 6 * a + e] * w[b + W_U + 6 * e + s]
+                    w[b + W_IA + 6 * r + s] -= acc
+            ia_n, ia_f = _mul6(w, b + W_IA, load_seg(w, b + W_CA), load_seg(w, b + W_CA + 3))
+            for r in range(3):
+                w[b + W_PA + r] += ia_n[r]
+                w[b + W_PA + 3 + r] += ia_f[r]
+            R, pos = _pose_of(w, b)
+            pn, pf = _xft(R, pos, load_seg(w, b + W_PA), load_seg(w, b + W_PA + 3))
+            if k > 0:
+                up = b - WSEG
+                _add_congruence(w, b + W_IA, R, pos, w, up + W_IA, 0)
+                for r in range(3):
+                    w[up + W_PA + r] += pn[r]
+                    w[up + W_PA + 3 + r] += pf[r]
+            else:
+                _add_congruence(w, b + W_IA, R, pos, hub, HUB_INERTIA, 3)
+                for r in range(3):
+                    hub[HUB_FORCE + r] -= pf[r]
+                    hub[HUB_TORQUE + r] -= pn[r]
+    return STATUS_OK
+
+
+@njit(PASS2_SIGNATURE, cache=True, error_model="numpy")
+def pass2(q, qd, members, params, work, hub, qdd):
+    """Joint accelerations outward from the hub's: q_ddot_k = D^-1 (u - U^T a'_k)."""
+    for j in range(members.shape[0]):
+        o = members[j, 1]
+        p = params[j]
+        w = work[j]
+        aa, al = load_seg(hub, HUB_ALPHA), load_seg(hub, HUB_ACC)
+        for k in range(int(p[H_N])):
+            g, b = HEADER + k * SEG, k * WSEG
+            nf = int(p[g + G_NF])
+            col = o + int(p[g + G_OFF])
+            R, pos = _pose_of(w, b)
+            xa, xl = _xm(R, pos, aa, al)
+            aa = add(xa, load_seg(w, b + W_CA))
+            al = add(xl, load_seg(w, b + W_CA + 3))
+            for a in range(nf):
+                un, uf = _col(w, b + W_U + 6 * a)
+                w[b + W_PA + a] = w[b + W_TAU + a] - dot(un, aa) - dot(uf, al)
+            for a in range(nf):
+                y = 0.0
+                for e in range(nf):
+                    y += w[b + W_DI + 6 * a + e] * w[b + W_PA + e]
+                qdd[col + a] = y
+            for a in range(nf):
+                sa, sl = _col(w, b + W_S + 6 * a)
+                aa = add(aa, scale(qdd[col + a], sa))
+                al = add(al, scale(qdd[col + a], sl))
+    return STATUS_OK
+
+
+@njit(cache=True, error_model="numpy")
+def _subspace_pass(q, o, p, w):
+    """Poses and motion subspaces of every segment into the scratch row ``w``."""
+    for k in range(int(p[H_N])):
+        g, b = HEADER + k * SEG, k * WSEG
+        R, pos, R_JP, S_rho, ja, jl, ca, cl, status = _joint_pose(q, q, o, p, g, k == 0)
+        _put_m33(w, b + W_R, R)
+        _put3(w, b + W_POS, pos)
+        _store_subspace(w, b, p, g, R_JP, S_rho)
+
+
+@njit(MASS_SIGNATURE, cache=True, error_model="numpy")
+def mass_matrix(q, members, params, M):
+    """The chains' share of M(q) (eq. 2.39): composite-rigid-body algorithm."""
+    R_NB = rot_zyx(q[3], q[4], q[5])
+    S = euler_rate_matrix(q[3], q[4])
+    ic_hub = np.zeros(36)
+    for j in range(members.shape[0]):
+        o = members[j, 1]
+        p = params[j]
+        n_seg = int(p[H_N])
+        w = np.zeros(n_seg * WSEG)
+        _subspace_pass(q, o, p, w)
+        for k in range(n_seg):
+            g = HEADER + k * SEG
+            _store_inertia(w, k * WSEG + W_IA, p[g + G_MASS], load_seg(p, g + G_COM),
+                           load_m33_at(p, g + G_J))  # fmt: skip
+        ic_hub[:] = 0.0
+        for k in range(n_seg - 1, -1, -1):
+            b = k * WSEG
+            R, pos = _pose_of(w, b)
+            if k > 0:
+                _add_congruence(w, b + W_IA, R, pos, w, b - WSEG + W_IA, 0)
+            else:
+                _add_congruence(w, b + W_IA, R, pos, ic_hub, 0, 0)
+        for k in range(n_seg):
+            g, b = HEADER + k * SEG, k * WSEG
+            col = o + int(p[g + G_OFF])
+            for a in range(int(p[g + G_NF])):
+                sa, sl = _col(w, b + W_S + 6 * a)
+                fn, ff = _mul6(w, b + W_IA, sa, sl)
+                for e in range(int(p[g + G_NF])):
+                    sa, sl = _col(w, b + W_S + 6 * e)
+                    M[col + e, col + a] += dot(sa, fn) + dot(sl, ff)
+                for i in range(k - 1, -2, -1):
+                    R, pos = _pose_of(w, (i + 1) * WSEG)
+                    fn, ff = _xft(R, pos, fn, ff)
+                    if i < 0:
+                        break
+                    gi = HEADER + i * SEG
+                    ci = o + int(p[gi + G_OFF])
+                    for e in range(int(p[gi + G_NF])):
+                        sa, sl = _col(w, i * WSEG + W_S + 6 * e)
+                        v = dot(sa, fn) + dot(sl, ff)
+                        M[ci + e, col + a] += v
+                        M[col + a, ci + e] += v
+                lin, ang = mv(R_NB, ff), mtv(S, fn)
+                for r in range(3):
+                    M[r, col + a] += lin[r]
+                    M[col + a, r] += lin[r]
+                    M[3 + r, col + a] += ang[r]
+                    M[col + a, 3 + r] += ang[r]
+        # Hub block: [r_dot_N; Theta_dot] -> [omega_B; v_B] is [[0, S], [R_NB^T, 0]].
+        for r in range(3):
+            for c in range(3):
+                inn = ic_hub[6 * r + c]
+                for a in range(3):
+                    for e in range(3):
+                        M[3 + a, 3 + e] += S[r][a] * inn * S[c][e]
+                        M[a, e] += R_NB[a][r] * ic_hub[6 * (r + 3) + c + 3] * R_NB[e][c]
+                        v = R_NB[a][r] * ic_hub[6 * (r + 3) + c] * S[c][e]
+                        M[a, 3 + e] += v
+                        M[3 + e, a] += v
+
+
+@njit(BIAS_SIGNATURE, cache=True, error_model="numpy")
+def bias_forces(q, qd, members, params, hub, h):
+    """The chains' share of h(q, q_dot) (eq. 2.43): recursive Newton-Euler at q_ddot = 0."""
+    R_NB = rot_zyx(q[3], q[4], q[5])
+    omega_B = load_seg(hub, HUB_OMEGA)
+    s_bias = load_seg(hub, HUB_SBIAS)
+    for j in range(members.shape[0]):
+        o = members[j, 1]
+        p = params[j]
+        n_seg = int(p[H_N])
+        w = np.zeros(n_seg * WSEG)
+        va, vl, aa, al = omega_B, _ZERO, s_bias, _ZERO
+        for k in range(n_seg):
+            g, b = HEADER + k * SEG, k * WSEG
+            R, pos, R_JP, S_rho, ja, jl, ca, cl, status = _joint_pose(q, qd, o, p, g, k == 0)
+            _put_m33(w, b + W_R, R)
+            _put3(w, b + W_POS, pos)
+            _store_subspace(w, b, p, g, R_JP, S_rho)
+            xa, xl = _xm(R, pos, va, vl)
+            va, vl = add(xa, ja), add(xl, jl)
+            xa, xl = _xm(R, pos, aa, al)
+            ba, bl = _crm(va, vl, ja, jl)
+            aa, al = add(add(xa, ca), ba), add(add(xl, cl), bl)
+            m, c, J = p[g + G_MASS], load_seg(p, g + G_COM), load_m33_at(p, g + G_J)
+            fn, ff = _inertia_mul(m, c, J, aa, al)
+            hn, hf = _inertia_mul(m, c, J, va, vl)
+            gn, gf = _crf(va, vl, hn, hf)
+            _put3(w, b + W_PA, add(fn, gn))
+            _put3(w, b + W_PA + 3, add(ff, gf))
+        for k in range(n_seg - 1, -1, -1):
+            g, b = HEADER + k * SEG, k * WSEG
+            fn, ff = load_seg(w, b + W_PA), load_seg(w, b + W_PA + 3)
+            col = o + int(p[g + G_OFF])
+            for a in range(int(p[g + G_NF])):
+                sa, sl = _col(w, b + W_S + 6 * a)
+                h[col + a] = dot(sa, fn) + dot(sl, ff)
+            R, pos = _pose_of(w, b)
+            pn, pf = _xft(R, pos, fn, ff)
+            if k > 0:
+                for r in range(3):
+                    w[b - WSEG + W_PA + r] += pn[r]
+                    w[b - WSEG + W_PA + 3 + r] += pf[r]
+            else:
+                f_N = mv(R_NB, pf)
+                for r in range(3):
+                    hub[HUB_FORCE + r] += f_N[r]
+                    hub[HUB_TORQUE + r] += pn[r]
+
+
+@njit(OBSERVE_SIGNATURE, cache=True, error_model="numpy")
+def observe(q, qd, members, params, out):
+    """Add the chains' kinetic energy, momentum, locked inertia, elastic energy, damper power."""
+    R_NB = rot_zyx(q[3], q[4], q[5])
+    r_hub = load_seg(q, 0)
+    omega_B = mv(euler_rate_matrix(q[3], q[4]), load_seg(qd, 3))
+    v_hub_B = mtv(R_NB, load_seg(qd, 0))
+    for j in range(members.shape[0]):
+        o = members[j, 1]
+        p = params[j]
+        va, vl = omega_B, v_hub_B
+        R_BP = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
+        r_O = _ZERO
+        for k in range(int(p[H_N])):
+            g = HEADER + k * SEG
+            R, pos, R_JP, S_rho, ja, jl, ca, cl, status = _joint_pose(q, qd, o, p, g, k == 0)
+            r_O = add(r_O, mv(R_BP, pos))
+            R_BP = mm(R_BP, R)
+            xa, xl = _xm(R, pos, va, vl)
+            va, vl = add(xa, ja), add(xl, jl)
+            m, c, J = p[g + G_MASS], load_seg(p, g + G_COM), load_m33_at(p, g + G_J)
+            v_G = add(vl, cross(va, c))
+            out[OBS_KINETIC] += 0.5 * m * dot(v_G, v_G) + 0.5 * dot(va, mv(J, va))  # eq. 2.32
+            r_G = add(r_O, mv(R_BP, c))
+            R_NP = mm(R_NB, R_BP)
+            linear = cross(add(r_hub, mv(R_NB, r_G)), scale(m, mv(R_NP, v_G)))
+            spin = mv(R_NP, mv(J, va))
+            for a in range(3):
+                out[OBS_MOMENTUM + a] += linear[a] + spin[a]
+            J_B = mm(R_BP, mm(J, transpose(R_BP)))
+            r2 = dot(r_G, r_G)
+            for a in range(3):
+                for e in range(3):
+                    out[OBS_LOCKED_INERTIA + 3 * a + e] += J_B[a][e] - m * r_G[a] * r_G[e]
+                out[OBS_LOCKED_INERTIA + 4 * a] += m * r2
+            a, col = 0, o + int(p[g + G_OFF])
+            for i in range(6):
+                if p[g + G_FREE + i] != 0.0:
+                    out[OBS_ELASTIC] += 0.5 * p[g + G_K + i] * q[col + a] ** 2  # eq. 2.35
+                    out[OBS_DISSIPATION] += p[g + G_C + i] * qd[col + a] ** 2  # eq. 2.36
+                    a += 1
+
+
+@njit(cache=True, error_model="numpy")
+def _inv3(m):
+    """Inverse of a 3 x 3 matrix by cofactors."""
+    c00 = m[1][1] * m[2][2] - m[1][2] * m[2][1]
+    c01 = m[1][2] * m[2][0] - m[1][0] * m[2][2]
+    c02 = m[1][0] * m[2][1] - m[1][1] * m[2][0]
+    det = m[0][0] * c00 + m[0][1] * c01 + m[0][2] * c02
+    s = 1.0 / det
+    return (
+        (s * c00, s * (m[0][2] * m[2][1] - m[0][1] * m[2][2]),
+         s * (m[0][1] * m[1][2] - m[0][2] * m[1][1])),
+        (s * c01, s * (m[0][0] * m[2][2] - m[0][2] * m[2][0]),
+         s * (m[0][2] * m[1][0] - m[0][0] * m[1][2])),
+        (s * c02, s * (m[0][1] * m[2][0] - m[0][0] * m[2][1]),
+         s * (m[0][0] * m[1][1] - m[0][1] * m[1][0])),
+    )  # fmt: skip
+
+
+@njit(WRENCH_SIGNATURE, cache=True, error_model="numpy")
+def joint_wrench(q, qd, Q, members, params, out):
+    """Add the wrench each chain's root joint exerts on the hub (tau_flex in out[3:6]).
+
+    The root's generalized forces tau (elastic, damping, external) are the wrench
+    [n; f] on segment 0 with S^T [n; f] = tau and no component the joint does not
+    free: f = sum_i tau_i R_JP^T e_i, n = S_r (S_r^T S_r)^-1 tau_r over the free
+    rotations (= S(rho)^-T tau_r on a full joint, the plate's N_P).
+    """
+    for j in range(members.shape[0]):
+        o = members[j, 1]
+        p = params[j]
+        g = HEADER
+        R, pos, R_JP, S_rho, ja, jl, ca, cl, status = _joint_pose(q, qd, o, p, g, True)
+        if status != STATUS_OK:
+            return status
+        col = o + int(p[g + G_OFF])
+        t0 = t1 = t2 = r0 = r1 = r2 = 0.0
+        a = 0
+        for i in range(6):
+            if p[g + G_FREE + i] != 0.0:
+                v = Q[col + a] - p[g + G_K + i] * q[col + a] - p[g + G_C + i] * qd[col + a]
+                a += 1
+                if i == 0:
+                    t0 = v
+                elif i == 1:
+                    t1 = v
+                elif i == 2:
+                    t2 = v
+                elif i == 3:
+                    r0 = v
+                elif i == 4:
+                    r1 = v
+                else:
+                    r2 = v
+        f = mtv(R_JP, (t0, t1, t2))
+        fx, fy, fz = p[g + G_FREE + 3], p[g + G_FREE + 4], p[g + G_FREE + 5]
+        s0 = scale(fx, (S_rho[0][0], S_rho[1][0], S_rho[2][0]))
+        s1 = scale(fy, (S_rho[0][1], S_rho[1][1], S_rho[2][1]))
+        s2 = scale(fz, (S_rho[0][2], S_rho[1][2], S_rho[2][2]))
+        G = (
+            (dot(s0, s0) + 1.0 - fx, dot(s0, s1), dot(s0, s2)),
+            (dot(s1, s0), dot(s1, s1) + 1.0 - fy, dot(s1, s2)),
+            (dot(s2, s0), dot(s2, s1), dot(s2, s2) + 1.0 - fz),
+        )
+        y = mv(_inv3(G), (r0, r1, r2))
+        n = add(add(scale(y[0], s0), scale(y[1], s1)), scale(y[2], s2))
+        hn, hf = _xft(R, pos, n, f)
+        for r in range(3):
+            out[r] -= hf[r]
+            out[3 + r] -= hn[r]
+    return STATUS_OK
+
+
+@njit(TIPS_SIGNATURE, cache=True, error_model="numpy")
+def tips(q, members, params, out):
+    """Displacement of each chain's free end from its undeformed place, mount frame [m]."""
+    for j in range(members.shape[0]):
+        o = members[j, 1]
+        p = params[j]
+        R_BP = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
+        r_O = _ZERO
+        for k in range(int(p[H_N])):
+            R, pos, R_JP, S_rho, ja, jl, ca, cl, status = _joint_pose(
+                q, q, o, p, HEADER + k * SEG, k == 0
+            )
+            r_O = add(r_O, mv(R_BP, pos))
+            R_BP = mm(R_BP, R)
+        r_tip = add(r_O, mv(R_BP, load_seg(p, H_TIP)))
+        moved = sub(mtv(load_m33_at(p, H_R_BM), sub(r_tip, load_seg(p, H_MOUNT))),
+                    load_seg(p, H_TIP0))  # fmt: skip
+        i = members[j, 0]
+        out[i, 0], out[i, 1], out[i, 2] = moved
