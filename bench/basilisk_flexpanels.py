@@ -34,16 +34,7 @@ ROWS = 200  # records kept per history: a few hundred kB for the six files
 
 def principal_angles(sigma_a: np.ndarray, sigma_b: np.ndarray) -> np.ndarray:
     """Principal angle between two MRP histories (m, 3) [rad]."""
-    return (mrp_rotation(sigma_a).inv() * mrp_rotation(sigma_b)).magnitude()
-
-
-def mrp_rotation(sigma: np.ndarray):
-    """scipy Rotation of MRPs sigma_BN (m, 3): B relative to N."""
-    from scipy.spatial.transform import Rotation
-
-    s2 = np.sum(sigma**2, axis=1)
-    return Rotation.from_quat(np.column_stack([2.0 * sigma / (1.0 + s2)[:, None],
-                                               (1.0 - s2) / (1.0 + s2)]))  # fmt: skip
+    return (fp.mrp_rotation(sigma_a).inv() * fp.mrp_rotation(sigma_b)).magnitude()
 
 
 def reference(bsk, n: int) -> dict:

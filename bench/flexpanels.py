@@ -113,10 +113,12 @@ def hinge_angles(ds) -> np.ndarray:
 
 
 def import_basilisk() -> SimpleNamespace:
-    """The Basilisk modules used here (ImportError when Basilisk is not installed)."""
+    """The Basilisk modules every Basilisk benchmark uses (ImportError when Basilisk is
+    not installed); ``mujoco`` is None when the wheel does not ship the MuJoCo back end."""
     import importlib.metadata
 
     from Basilisk.simulation import (
+        extForceTorque,
         nHingedRigidBodyStateEffector,
         spacecraft,
         spinningBodyNDOFStateEffector,
@@ -130,10 +132,20 @@ def import_basilisk() -> SimpleNamespace:
         mujoco = None
     return SimpleNamespace(
         nHinged=nHingedRigidBodyStateEffector, ndof=spinningBodyNDOFStateEffector,
+        spinningBodyNDOFStateEffector=spinningBodyNDOFStateEffector, extForceTorque=extForceTorque,
         spacecraft=spacecraft, svIntegrators=svIntegrators, mujoco=mujoco,
         SimulationBaseClass=SimulationBaseClass, macros=macros,
         version=importlib.metadata.version("bsk"),
     )  # fmt: skip
+
+
+def mrp_rotation(sigma: np.ndarray):
+    """scipy Rotation of MRP histories sigma_BN, shape (m, 3): B relative to N."""
+    from scipy.spatial.transform import Rotation
+
+    s2 = np.sum(sigma**2, axis=1)
+    return Rotation.from_quat(np.column_stack([2.0 * sigma / (1.0 + s2)[:, None],
+                                               (1.0 - s2) / (1.0 + s2)]))  # fmt: skip
 
 
 def _col(v) -> list[list[float]]:
