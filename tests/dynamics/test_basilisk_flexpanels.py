@@ -3,7 +3,7 @@
 ``tests/data/basilisk_flexpanels_N<N>.npz`` hold the hub attitude and rate of
 Basilisk's three engines (``nHingedRigidBodyStateEffector``,
 ``spinningBodyNDOFStateEffector``, MuJoCo) and the hinge angles, over the 8 s window
-of Basilisk's flexible-panel dynamics-engine comparison, made by
+of Basilisk's flexible-panel dynamics-engine comparison (1 s for N = 32), made by
 ``bench/basilisk_flexpanels.py`` (Basilisk 2.12.1); the scenario is stated once in
 ``bench/flexpanels.py``. The test needs no Basilisk.
 """
