@@ -13,6 +13,7 @@ the appendage root), panel frame P_i (moves with the appendage); see
 
 from __future__ import annotations
 
+from importlib.metadata import entry_points
 from typing import Annotated, Any, Literal
 
 import numpy as np
@@ -30,10 +31,12 @@ from pydantic import (
 
 __all__ = [
     "APPENDAGE_CONFIGS",
+    "APPENDAGE_ENTRY_POINTS",
     "AppendageConfig",
     "HubConfig",
     "SatelliteConfig",
     "TargetFrequencies",
+    "load_appendage_plugins",
     "register_appendage_config",
 ]
 
@@ -225,6 +228,22 @@ APPENDAGE_CONFIGS: dict[str, type[BaseModel]] = {"plate": AppendageConfig}
 :mod:`flexsat.dynamics.appendages` adds to it)."""
 
 
+APPENDAGE_ENTRY_POINTS = "flexsat.appendages"
+"""Entry-point group of third-party appendage models: each entry point names a module
+whose import registers its model (``register_appendage_model``)."""
+_PLUGINS_LOADED = False
+
+
+def load_appendage_plugins() -> None:
+    """Import every module of the ``flexsat.appendages`` entry-point group, once."""
+    global _PLUGINS_LOADED
+    if _PLUGINS_LOADED:
+        return
+    _PLUGINS_LOADED = True
+    for point in entry_points(group=APPENDAGE_ENTRY_POINTS):
+        point.load()  # importing the module registers its model
+
+
 def register_appendage_config(model: str, config_class: type[BaseModel]) -> None:
     """Accept ``model = "<model>"`` appendage tables, validated as ``config_class``."""
     fields = config_class.model_fields
@@ -240,6 +259,8 @@ def _by_model(value: Any, handler: ValidatorFunctionWrapHandler) -> Any:
     model = value.get("model", "plate") if isinstance(value, dict) else "plate"
     if model == "plate":
         return handler(value)
+    if model not in APPENDAGE_CONFIGS:
+        load_appendage_plugins()
     if model not in APPENDAGE_CONFIGS:
         raise ValueError(
             f"model: unknown appendage model {model!r} (allowed: {', '.join(APPENDAGE_CONFIGS)})"

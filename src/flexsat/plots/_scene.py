@@ -91,7 +91,7 @@ class SatelliteDrawing:
         self.fill = None
         if fill or hub_fill:
             colours = [hub_fill] * len(hub_faces(geom)) if hub_fill else []
-            colours += [fill or "none"] * geom.n_appendages
+            colours += [fill or "none"] * len(geom.panels)
             self.fill = Poly3DCollection(self._faces(geom), facecolor=colours,
                                          alpha=fill_alpha, edgecolor="none")  # fmt: skip
             ax.add_collection3d(self.fill)

@@ -168,9 +168,11 @@ class SatelliteGeometry:
         the hub centre to the mount point leaves the hub) to the displaced root.
     roots : ndarray, shape (n, 3)
         Panel roots (origin of P_i).
-    panels : ndarray, shape (n, 4, 3)
-        Panel corners, in order: root at -W/2, root at +W/2, tip at +W/2, tip at
-        -W/2 (chord along X_P); a closed loop when the first is repeated.
+    panels : ndarray, shape (k, 4, 3)
+        Drawn quadrilaterals, each appendage's in config order (one per thesis plate,
+        one per segment of a chain: the model's ``outlines``). For the thesis plate:
+        root at -W/2, root at +W/2, tip at +W/2, tip at -W/2 (chord along X_P); a
+        closed loop when the first is repeated.
     tips : ndarray, shape (n, 3)
         Panel tips (mid-chord of the free edge).
     axes : ndarray, shape (3, 3)
@@ -190,7 +192,7 @@ class SatelliteGeometry:
 
     @property
     def n_appendages(self) -> int:
-        return int(self.panels.shape[0])
+        return int(self.roots.shape[0])
 
     def points(self) -> np.ndarray:
         """Every drawn point (hub, arms, panels, axis ends), shape (m, 3) [m]."""
@@ -224,6 +226,13 @@ def _shape_points(plant: Plant, q: np.ndarray) -> np.ndarray:
     rows = zip(plant.config.appendages, plant.models, plant.params, plant.layout.blocks,
                strict=True)  # fmt: skip
     return np.stack([m.shape_points(app, p, q[b.slice]) for app, m, p, b in rows])
+
+
+def _outlines(plant: Plant, q: np.ndarray) -> np.ndarray:
+    """Every drawn quadrilateral at q, hub frame B, shape (k, 4, 3) [m]."""
+    rows = zip(plant.config.appendages, plant.models, plant.params, plant.layout.blocks,
+               strict=True)  # fmt: skip
+    return np.concatenate([m.outlines(app, p, q[b.slice]) for app, m, p, b in rows])
 
 
 def satellite_geometry(plant: Plant, q: np.ndarray | None = None) -> SatelliteGeometry:
@@ -264,7 +273,7 @@ def satellite_geometry(plant: Plant, q: np.ndarray | None = None) -> SatelliteGe
         hub_lines=tuple(to_n(line) for line in outline.lines),
         arms=arms,
         roots=pts[:, 4, :].copy(),
-        panels=pts[:, 0:4, :].copy(),
+        panels=to_n(_outlines(plant, q)),
         tips=pts[:, 5, :].copy(),
         axes=_AXIS_SCALE * outline.half_size * R_NB.T,
     )

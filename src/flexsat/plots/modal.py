@@ -233,13 +233,8 @@ def _frequency_tick(mode: Mode) -> str:
 def _cantilever_targets(plant: Plant) -> dict[float, list[str]]:
     """Distinct clamped-root target frequencies [Hz] -> the joint DOFs that use them."""
     targets: dict[float, list[str]] = {}
-    for app in plant.config.appendages:
-        t = app.target_frequencies_hz
-        for label, value in (
-            ("flapping", t.flapping), ("in-plane", t.in_plane), ("torsion", t.torsion),
-            ("translation x", t.translation_x), ("translation y", t.translation_y),
-            ("translation z", t.translation_z),
-        ):  # fmt: skip
+    for app, model in zip(plant.config.appendages, plant.models, strict=True):
+        for label, value in model.target_frequencies(app):
             names = targets.setdefault(round(float(value), 9), [])
             if label not in names:
                 names.append(label)
@@ -256,12 +251,15 @@ def _cantilever_targets(plant: Plant) -> dict[float, list[str]]:
 
 
 def _panel_lengths(plant: Plant) -> np.ndarray:
-    return np.array([m.extent(a) for a, m in zip(plant.config.appendages, plant.models,
-                                                 strict=True)])  # fmt: skip
+    """Length of the appendage each drawn quadrilateral belongs to, (k,) [m]."""
+    rows = zip(plant.config.appendages, plant.models, plant.params, plant.layout.blocks,
+               strict=True)  # fmt: skip
+    return np.concatenate([np.full(len(m.outlines(a, p, np.zeros(b.count))), m.extent(a))
+                           for a, m, p, b in rows])  # fmt: skip
 
 
 def _panel_displacement(plant: Plant, q: np.ndarray, rest: SatelliteGeometry) -> np.ndarray:
-    """Largest displacement of each panel from ``rest`` (attained at a corner), (n,) [m]."""
+    """Largest displacement of each drawn quadrilateral from ``rest`` (at a corner), (k,) [m]."""
     moved = satellite_geometry(plant, q).panels - rest.panels
     return np.linalg.norm(moved, axis=-1).max(axis=-1)
 

@@ -18,8 +18,9 @@ from __future__ import annotations
 from typing import ClassVar
 
 import numpy as np
+from scipy.spatial.transform import Rotation
 
-from flexsat.dynamics.appendages.chain_config import DOF_NAMES, ChainConfig
+from flexsat.dynamics.appendages.chain_config import AXES, CHORD_THICKNESS, DOF_NAMES, ChainConfig
 from flexsat.dynamics.appendages.chain_kernels import (
     G_C,
     G_COM,
@@ -58,9 +59,20 @@ __all__ = ["ChainModel"]
 
 def _rotation(angles_xyz: np.ndarray) -> np.ndarray:
     """Rz(rz) Ry(ry) Rx(rx) of a joint's (rx, ry, rz) [rad]."""
-    from scipy.spatial.transform import Rotation
-
     return Rotation.from_euler("ZYX", angles_xyz[::-1]).as_matrix()
+
+
+def _scale_mass(table: dict, factor: float) -> None:
+    """Campaign path ``appendages[*].inertia``: scale the chain's mass and so its inertia
+    (every segment's of a listed chain; joints tuned to target frequencies keep them)."""
+    if table.get("segment_list") is not None:
+        for segment in table["segment_list"]:
+            segment["mass_kg"] = segment["mass_kg"] * factor
+            if segment.get("inertia_kg_m2") is not None:
+                segment["inertia_kg_m2"] = (np.asarray(segment["inertia_kg_m2"]) * factor).tolist()
+        return
+    field = "mass_kg" if table.get("mass_kg") is not None else "surface_density_kg_m2"
+    table[field] = table[field] * factor
 
 
 class ChainModel(AppendageModel):
@@ -70,7 +82,7 @@ class ChainModel(AppendageModel):
     config_class = ChainConfig
     kernels = AppendageKernels(pass1, pass2, mass_matrix, bias_forces, observe, joint_wrench, tips)
     transmits_inertia = True
-    modifiers: ClassVar[dict] = {}
+    modifiers: ClassVar[dict] = {"inertia": _scale_mass}
     work_size = WSEG
 
     # -- layout ---------------------------------------------------------------------------
@@ -269,8 +281,8 @@ class ChainModel(AppendageModel):
         out[4], out[5] = root, end
         return out
 
-    def segment_outlines(self, config: ChainConfig, params: np.ndarray, q_block: np.ndarray
-                         ) -> np.ndarray:  # fmt: skip
+    def outlines(self, config: ChainConfig, params: np.ndarray, q_block: np.ndarray
+                 ) -> np.ndarray:  # fmt: skip
         """Each segment's quadrilateral at ``q_block``, hub frame B [m], shape (N, 4, 3)."""
         rotations, points = self.segment_poses(params, q_block)
         chord = self._chord(config)
@@ -322,12 +334,22 @@ class ChainModel(AppendageModel):
     @staticmethod
     def _chord(config: ChainConfig) -> np.ndarray:
         """Half the chord, segment frame [m] (0 for a listed chain without width)."""
-        from flexsat.dynamics.appendages.chain_config import _AXES, _CHORD_THICKNESS
-
         half = np.zeros(3)
         if config.width_m is not None:
-            half[_AXES[_CHORD_THICKNESS[config.span_direction[1]][0]]] = 0.5 * config.width_m
+            half[AXES[CHORD_THICKNESS[config.span_direction[1]][0]]] = 0.5 * config.width_m
         return half
+
+    def target_frequencies(self, config: ChainConfig) -> tuple[tuple[str, float], ...]:
+        out = []
+        for seg in config.resolved_segments():
+            if seg.frequencies is None:
+                continue
+            for dof, value in zip(seg.dofs, seg.frequencies, strict=True):
+                kind = config.dof_kind(dof)
+                label = f"translation {dof}" if kind == "translation" else kind.replace("_", "-")
+                if (label, value) not in out:
+                    out.append((label, float(value)))
+        return tuple(out)
 
     def extent(self, config: ChainConfig) -> float:
         return float(np.linalg.norm(sum(s.next_joint for s in config.resolved_segments())))
@@ -355,3 +377,4 @@ def _with_point_mass(seg, tip_mass: float, point: np.ndarray):
     inertia = (seg.inertia + seg.mass * (d1 @ d1 * np.eye(3) - np.outer(d1, d1))
                + tip_mass * (d2 @ d2 * np.eye(3) - np.outer(d2, d2)))  # fmt: skip
     return mass, com, inertia
+

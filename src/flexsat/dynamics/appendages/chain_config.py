@@ -20,6 +20,7 @@ from typing import Annotated, Literal
 
 import numpy as np
 from pydantic import AllowInfNan, Field, Strict, model_validator
+from scipy.spatial.transform import Rotation
 
 from flexsat.config.models import (
     Angle,
@@ -36,7 +37,16 @@ from flexsat.config.models import (
     _Frozen,
 )
 
-__all__ = ["DOF_NAMES", "BeamConfig", "ChainConfig", "JointConfig", "Segment", "SegmentConfig"]
+__all__ = [
+    "AXES",
+    "CHORD_THICKNESS",
+    "DOF_NAMES",
+    "BeamConfig",
+    "ChainConfig",
+    "JointConfig",
+    "Segment",
+    "SegmentConfig",
+]
 
 DOF_NAMES = ("x", "y", "z", "rx", "ry", "rz")
 """The six relative DOFs of a joint, in coordinate order (translations, then ZYX angles)."""
@@ -45,7 +55,8 @@ Dof = Literal["x", "y", "z", "rx", "ry", "rz"]
 NonNegative = Annotated[float, Strict(), AllowInfNan(False), Field(ge=0.0, le=1e12)]
 Ratio = Annotated[float, Strict(), AllowInfNan(False), Field(ge=0.0, lt=1.0)]
 Modulus = Annotated[float, Strict(), AllowInfNan(False), Field(gt=0.0, le=1e15)]
-_AXES = {"x": 0, "y": 1, "z": 2}
+AXES = {"x": 0, "y": 1, "z": 2}
+"""Index of each segment-frame axis."""
 
 
 def _is_rotation(dof: str) -> bool:
@@ -211,7 +222,8 @@ _SPAN = Literal["+x", "-x", "+y", "-y", "+z", "-z"]
 # Chord (width) and thickness axes for each span axis: flapwise bending is about the
 # chord axis, in-plane bending about the thickness axis (the thesis: span Y, chord X,
 # thickness Z, so flapping about X and in-plane about Z).
-_CHORD_THICKNESS = {"x": ("y", "z"), "y": ("x", "z"), "z": ("x", "y")}
+CHORD_THICKNESS = {"x": ("y", "z"), "y": ("x", "z"), "z": ("x", "y")}
+"""(chord, thickness) axes of each span axis."""
 
 
 class ChainConfig(_Frozen):
@@ -295,14 +307,14 @@ class ChainConfig(_Frozen):
 
     def span_axis(self) -> tuple[int, float]:
         """Index (0, 1, 2) and sign of the span axis in the segment frames."""
-        return _AXES[self.span_direction[1]], (1.0 if self.span_direction[0] == "+" else -1.0)
+        return AXES[self.span_direction[1]], (1.0 if self.span_direction[0] == "+" else -1.0)
 
     def dof_kind(self, dof: str) -> str:
         """The modal kind of a joint DOF: flapping, in_plane, torsion or translation."""
         if not _is_rotation(dof):
             return "translation"
         span = self.span_direction[1]
-        chord, thickness = _CHORD_THICKNESS[span]
+        chord, thickness = CHORD_THICKNESS[span]
         return {chord: "flapping", thickness: "in_plane", span: "torsion"}[dof[1]]
 
     def _beam_stiffness(self, joint: JointConfig, factor: float) -> dict:
@@ -325,8 +337,6 @@ class ChainConfig(_Frozen):
 
     def mount_rotation(self) -> np.ndarray:
         """R_BM (mount frame -> hub frame), shape (3, 3)."""
-        from scipy.spatial.transform import Rotation
-
         if self.mount_matrix is not None:
             return np.array(self.mount_matrix, dtype=float)
         return Rotation.from_euler("ZYX", np.radians(self.mount_zyx_deg)).as_matrix()
@@ -339,11 +349,11 @@ class ChainConfig(_Frozen):
         n = self.segments
         axis, sign = self.span_axis()
         seg_length = self.length_m / n
-        chord, thickness = _CHORD_THICKNESS[self.span_direction[1]]
+        chord, thickness = CHORD_THICKNESS[self.span_direction[1]]
         edges = np.zeros(3)
         edges[axis] = seg_length
-        edges[_AXES[chord]] = self.width_m
-        edges[_AXES[thickness]] = self.thickness_m
+        edges[AXES[chord]] = self.width_m
+        edges[AXES[thickness]] = self.thickness_m
         mass = self.total_mass / n
         inertia = _box_inertia(mass, edges)  # eqs. 2.9-2.11 per segment
         step = np.zeros(3)

@@ -66,6 +66,7 @@ from flexsat.dynamics.linalg3 import (
     mv,
     rot_zyx,
     scale,
+    skew,
     sub,
     transpose,
 )
@@ -215,20 +216,48 @@ def _store_inertia(w, k, m, c, J):
 
 
 @njit(cache=True, error_model="numpy")
+def _block(a, k, r0, c0):
+    """The 3 x 3 block at (r0, c0) of the row-major 6 x 6 a[k:k+36]."""
+    b = k + 6 * r0 + c0
+    return ((a[b], a[b + 1], a[b + 2]), (a[b + 6], a[b + 7], a[b + 8]),
+            (a[b + 12], a[b + 13], a[b + 14]))  # fmt: skip
+
+
+@njit(cache=True, error_model="numpy")
+def _msum(a, b, sign):
+    """a + sign * b for 3 x 3 matrices."""
+    return (add(a[0], scale(sign, b[0])), add(a[1], scale(sign, b[1])),
+            add(a[2], scale(sign, b[2])))  # fmt: skip
+
+
+@njit(cache=True, error_model="numpy")
+def _add_block(dst, d, r0, c0, m, swap):
+    for r in range(3):
+        row = d + 6 * ((r0 + r + swap) % 6)
+        for c in range(3):
+            dst[row + (c0 + c + swap) % 6] += m[r][c]
+
+
+@njit(cache=True, error_model="numpy")
 def _add_congruence(src, s, R, pos, dst, d, swap):
     """dst[d:d+36] += X^T (src[s:s+36]) X, X the parent -> child motion transform.
 
+    X = diag(R^T, R^T) T with T = [[1, 0], [-[pos]x, 1]]: with the blocks of src
+    rotated to the parent's axes, [[A, B], [C, D]], the result is
+    [[A + [p]C - (B + [p]D)[p], B + [p]D], [C - D[p], D]] ([p] = [pos]x).
     ``swap`` = 3 writes it in the hub exchange order [force; torque] x [a; omega_dot].
     """
-    for j in range(6):
-        ua, ul = _unit(j)
-        xa, xl = _xm(R, pos, ua, ul)
-        n, f = _mul6(src, s, xa, xl)
-        zn, zf = _xft(R, pos, n, f)
-        col = (j + swap) % 6
-        for r in range(3):
-            dst[d + 6 * ((r + swap) % 6) + col] += zn[r]
-            dst[d + 6 * ((r + 3 + swap) % 6) + col] += zf[r]
+    Rt = transpose(R)
+    A = mm(R, mm(_block(src, s, 0, 0), Rt))
+    B = mm(R, mm(_block(src, s, 0, 3), Rt))
+    C = mm(R, mm(_block(src, s, 3, 0), Rt))
+    D = mm(R, mm(_block(src, s, 3, 3), Rt))
+    P = skew(pos)
+    upper_right = _msum(B, mm(P, D), 1.0)
+    _add_block(dst, d, 0, 0, _msum(_msum(A, mm(P, C), 1.0), mm(upper_right, P), -1.0), swap)
+    _add_block(dst, d, 0, 3, upper_right, swap)
+    _add_block(dst, d, 3, 0, _msum(C, mm(D, P), -1.0), swap)
+    _add_block(dst, d, 3, 3, D, swap)
 
 
 @njit(cache=True, error_model="numpy")
@@ -387,13 +416,14 @@ def pass1(q, qd, Q, members, params, work, hub, qdd):
                 for r in range(6):
                     w[b + W_PA + r] += w[b + W_U + 6 * a + r] * y
             for r in range(6):
-                for s in range(6):
-                    acc = 0.0
+                # row r of U D^-1 (D^-1 symmetric), then I^A[r, :] -= (U D^-1)[r, :] U^T
+                for e in range(nf):
+                    v = 0.0
                     for a in range(nf):
-                        ua = w[b + W_U + 6 * a + r]
-                        for e in range(nf):
-                            acc += ua * w[b + W_DI + 6 * a + e] * w[b + W_U + 6 * e + s]
-                    w[b + W_IA + 6 * r + s] -= acc
+                        v += w[b + W_U + 6 * a + r] * w[b + W_DI + 6 * a + e]
+                    if v != 0.0:
+                        for s in range(6):
+                            w[b + W_IA + 6 * r + s] -= v * w[b + W_U + 6 * e + s]
             ia_n, ia_f = _mul6(w, b + W_IA, load_seg(w, b + W_CA), load_seg(w, b + W_CA + 3))
             for r in range(3):
                 w[b + W_PA + r] += ia_n[r]

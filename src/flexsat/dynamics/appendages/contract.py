@@ -258,6 +258,18 @@ class AppendageModel(ABC):
         """
         return np.tile(self.rigid_body(params).r_B, (6, 1))
 
+    def target_frequencies(self, config: BaseModel) -> tuple[tuple[str, float], ...]:
+        """The clamped-root target frequencies its config asks for, as (label, Hz) pairs
+        (labels such as ``flapping``, ``in-plane``, ``translation x``). Default: none."""
+        return ()
+
+    def outlines(self, config: BaseModel, params: np.ndarray, q_block: np.ndarray
+                 ) -> np.ndarray:  # fmt: skip
+        """The quadrilaterals it is drawn as at ``q_block``, hub frame B [m], shape (k, 4, 3)
+        (a model of several bodies draws each). Default: the outline of
+        :meth:`shape_points`."""
+        return self.shape_points(config, params, q_block)[None, 0:4]
+
     def extent(self, config: BaseModel) -> float:
         """Characteristic length [m] that plots relate tip motion to; 0: none."""
         return 0.0

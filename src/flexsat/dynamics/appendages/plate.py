@@ -493,6 +493,14 @@ class PlateModel(AppendageModel):
         in_mount = q_block[:3] + local @ R_MP.T
         return params[P_MOUNT : P_MOUNT + 3] + in_mount @ self.mount_rotation(params).T
 
+    def target_frequencies(self, config: AppendageConfig) -> tuple[tuple[str, float], ...]:
+        t = config.target_frequencies_hz
+        return (
+            ("flapping", t.flapping), ("in-plane", t.in_plane), ("torsion", t.torsion),
+            ("translation x", t.translation_x), ("translation y", t.translation_y),
+            ("translation z", t.translation_z),
+        )  # fmt: skip
+
     def extent(self, config: AppendageConfig) -> float:
         return float(config.length_m)
 

@@ -1,12 +1,14 @@
 """The registry of appendage models: a new model is one module plus one registration line.
 
 Nothing outside a model's module names it: the plant, the records, the results and
-the plots look each appendage's model up here by its config's ``model`` key.
+the plots look each appendage's model up here by its config's ``model`` key. An
+installed package adds its models through the entry-point group
+``flexsat.appendages``: each entry point names a module whose import registers one.
 """
 
 from __future__ import annotations
 
-from flexsat.config.models import register_appendage_config
+from flexsat.config.models import load_appendage_plugins, register_appendage_config
 from flexsat.dynamics.appendages.contract import AppendageModel
 
 __all__ = ["appendage_model", "appendage_model_names", "register_appendage_model"]
@@ -25,7 +27,10 @@ def register_appendage_model(model: AppendageModel) -> AppendageModel:
 
 
 def appendage_model(name: str) -> AppendageModel:
-    """The registered model called ``name``."""
+    """The registered model called ``name`` (installed ``flexsat.appendages`` entry points
+    are imported on the first miss)."""
+    if name not in _MODELS:
+        load_appendage_plugins()
     try:
         return _MODELS[name]
     except KeyError:

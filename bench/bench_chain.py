@@ -1,0 +1,154 @@
+"""Benchmark and tables of the chain appendage model.
+
+Run with ``python bench/bench_chain.py`` (``--quick`` for fewer steps). Prints:
+
+1. the cost of one RK4 step against the number of segments N = 1 ... 32 of each of two
+   chains (hinge about the chord axis, as the Basilisk comparison scenario), the
+   least-squares line through it (slope per segment) and the largest deviation from
+   that line, which checks that the cost is linear in N;
+2. the clamped-root bending frequencies of a uniform cantilever as a chain of N = 2 ...
+   64 segments against Euler-Bernoulli, with the observed convergence order;
+3. the centrifugal stiffening of a spinning cantilever: frequency against spin rate up
+   to Omega/omega_0 = 2 for the chain (N = 16) and the single rigid plate, written to
+   ``docs/figures/chain_spin_stiffening.png`` (the figure of docs/model.md).
+"""
+
+from __future__ import annotations
+
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+from rich.console import Console
+from rich.table import Table
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))  # the cantilever definitions are the tests' own
+
+from tests.dynamics.chain_satellites import (  # noqa: E402
+    beam_frequency_hz,
+    cantilever_chain,
+)
+from tests.dynamics.test_chain_beam import clamped_frequencies_hz  # noqa: E402
+
+from flexsat.config import validate_config  # noqa: E402
+from flexsat.dynamics.integrators import rk4_hold  # noqa: E402
+from flexsat.dynamics.plant import Plant  # noqa: E402
+from flexsat.linear import linearize  # noqa: E402
+
+
+def _two_arrays(n: int) -> Plant:
+    """Hub 600 kg, diag(400, 380, 360) kg m^2; two 60 kg, 3 m arrays of n segments on
+    hinges about Y at +-0.8 m on X, k = 600 N m/rad, c = 5 N m s/rad per hinge."""
+    def array(name, x, span):
+        return {"name": name, "model": "chain", "mount_point_m": [x, 0.0, 0.0],
+                "span_direction": span, "segments": n, "length_m": 3.0, "width_m": 1.0,
+                "thickness_m": 0.01, "mass_kg": 60.0,
+                "joint": {"dofs": ["ry"], "stiffness": {"ry": 600.0},
+                          "damping": {"ry": 5.0}, "initial": {"ry": 8.0}}}  # fmt: skip
+
+    return Plant.from_config(validate_config({
+        "name": f"arrays-{n}",
+        "hub": {"mass_kg": 600.0, "inertia_kg_m2": [[400.0, 0, 0], [0, 380.0, 0], [0, 0, 360.0]]},
+        "appendages": [array("array_1", 0.8, "+x"), array("array_2", -0.8, "-x")],
+    }))  # fmt: skip
+
+
+def step_cost_table(console: Console, steps: int) -> None:
+    sizes = [1, 2, 4, 8, 16, 32]
+    costs = []
+    for n in sizes:
+        plant = _two_arrays(n)
+        x = np.zeros(2 * plant.n_dof + 2)
+        x[plant.n_dof + 3 : plant.n_dof + 6] = (0.01, -0.02, 0.015)
+        # The cost of a step does not depend on dt; 1 us keeps every N far from the RK4
+        # stability limit of its stiffest hinge mode, so every step is a full one.
+        rk4_hold(x.copy(), 1e-6, 10, (0.0, 0.0, 0.0), plant.packed)  # compile, warm
+        best = np.inf
+        for _ in range(5):
+            trial = x.copy()
+            start = time.perf_counter()
+            status, done = rk4_hold(trial, 1e-6, steps, (0.0, 0.0, 0.0), plant.packed)
+            if status != 0 or done != steps:
+                raise RuntimeError(f"N = {n}: the run stopped at step {done} (status {status})")
+            best = min(best, (time.perf_counter() - start) / steps)
+        costs.append(1e6 * best)
+    slope, intercept = np.polyfit(sizes, costs, 1)
+    table = Table(title="RK4 step cost, two chains of N hinged segments (best of 5)")
+    for column in ("N", "us per step", "linear fit", "deviation"):
+        table.add_column(column, justify="right")
+    for n, c in zip(sizes, costs, strict=True):
+        fit = slope * n + intercept
+        table.add_row(str(n), f"{c:.2f}", f"{fit:.2f}", f"{(c - fit) / fit:+.1%}")
+    console.print(table)
+    console.print(f"slope {slope:.3f} us per segment (two chains), intercept {intercept:.2f} us; "
+                  f"cost(32) / cost(16) = {costs[-1] / costs[-2]:.2f} (linear: ~2)")  # fmt: skip
+
+
+def beam_table(console: Console) -> None:
+    reference = np.array([beam_frequency_hz(n) for n in (1, 2, 3)])
+    table = Table(title="Clamped cantilever as a chain: error against Euler-Bernoulli")
+    for column in ("N", "mode 1", "mode 2", "mode 3", "order 1", "order 2", "order 3"):
+        table.add_column(column, justify="right")
+    previous = None
+    for n in (2, 4, 8, 16, 32, 64):
+        plant = Plant.from_config(validate_config(cantilever_chain(n)))
+        found = clamped_frequencies_hz(plant, 3)
+        errors = np.full(3, np.nan)
+        errors[: found.size] = found / reference[: found.size] - 1.0
+        orders = np.log2(previous / errors) if previous is not None else np.full(3, np.nan)
+        table.add_row(str(n), *(f"{e:+.3%}" for e in errors), *(f"{o:.2f}" for o in orders))
+        previous = errors
+    console.print(table)
+
+
+def spin_figure(console: Console) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    ratios = np.linspace(0.0, 2.0, 21)
+    fig, ax = plt.subplots(figsize=(6.4, 4.2))
+    for dof, label in (("rx", "flapwise"), ("rz", "in-plane")):
+        for segments, style in ((16, "-"), (1, "--")):
+            plant = Plant.from_config(validate_config(
+                cantilever_chain(segments, dofs=(dof,), hub_scale=1e5)))  # fmt: skip
+            omega_0 = 2.0 * np.pi * clamped_frequencies_hz(plant, 1)[0]
+            curve = []
+            for r in ratios:
+                if r == 0.0:
+                    curve.append(1.0)
+                    continue
+                model = linearize(plant, about=[0.0, 0.0, r * omega_0], outputs=("joint",))
+                rates = np.abs(np.linalg.eigvals(model.A).imag)
+                rates = rates[rates > 1.001 * r * omega_0]  # drop the spin's own lines
+                curve.append(float(rates.min() / omega_0) if rates.size else np.nan)
+            name = f"{label}, {'chain N = 16' if segments > 1 else 'one rigid plate'}"
+            ax.plot(ratios, curve, style, label=name)
+            k = (curve[5] ** 2 - 1.0) / ratios[5] ** 2
+            console.print(f"{name}: Southwell K at Omega/omega_0 = 0.5: {k:.4f}")
+    ax.plot(ratios, np.sqrt(1.0 + 1.193 * ratios**2), ":", color="grey",
+            label="beam, K = 1.193 (flapwise)")  # fmt: skip
+    ax.set_xlabel("spin rate Omega / omega_0 [-]")
+    ax.set_ylabel("first mode omega / omega_0 [-]")
+    ax.set_title("Centrifugal stiffening of a cantilever spinning about its root")
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8)
+    out = ROOT / "docs" / "figures" / "chain_spin_stiffening.png"
+    out.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(out, dpi=120, bbox_inches="tight")
+    console.print(f"wrote {out.relative_to(ROOT)}")
+
+
+def main() -> None:
+    console = Console()
+    quick = "--quick" in sys.argv
+    step_cost_table(console, 2_000 if quick else 20_000)
+    beam_table(console)
+    spin_figure(console)
+
+
+if __name__ == "__main__":
+    main()
