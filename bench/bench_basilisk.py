@@ -77,7 +77,6 @@ that a passing load on the machine hits both alike:
 
 from __future__ import annotations
 
-import importlib.metadata
 import os
 import platform
 import sys
@@ -91,6 +90,7 @@ from rich.console import Console
 from rich.table import Table
 from scipy import signal
 
+from flexpanels import import_basilisk
 from flexsat import Plant
 from flexsat.analysis.modal import modal_analysis
 from flexsat.config import nominal
@@ -189,27 +189,6 @@ def run_flexsat(plant: Plant, scenario: OpenLoopScenario) -> dict:
 
 
 # -- Basilisk ------------------------------------------------------------------------------
-
-
-def import_basilisk() -> SimpleNamespace:
-    """The Basilisk modules this benchmark uses; raises ImportError when not installed."""
-    from Basilisk.simulation import (
-        extForceTorque,
-        spacecraft,
-        spinningBodyNDOFStateEffector,
-        svIntegrators,
-    )
-    from Basilisk.utilities import SimulationBaseClass, macros
-
-    return SimpleNamespace(
-        extForceTorque=extForceTorque,
-        spacecraft=spacecraft,
-        spinningBodyNDOFStateEffector=spinningBodyNDOFStateEffector,
-        svIntegrators=svIntegrators,
-        SimulationBaseClass=SimulationBaseClass,
-        macros=macros,
-        version=importlib.metadata.version("bsk"),
-    )
 
 
 @dataclass

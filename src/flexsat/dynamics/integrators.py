@@ -6,6 +6,10 @@ work done by the applied torque and the energy dissipated by the joint dampers a
 integrated with the same RK4 stages as the motion, so the energy balance
 E(t) - E(0) - W_in(t) + W_diss(t) measures the integrator alone.
 
+The hub's Euler angles are relative to a reference frame R_NF (``frame``) that the
+loops re-base between steps (:func:`flexsat.dynamics.attitude.rebase`), so no run meets
+the ZYX singularity.
+
 Torque profile: piecewise-constant segments [start, end) with a body torque each,
 plus a constant disturbance torque, held over each step at its start value (zero-
 order hold, the same convention as a sampled controller).
@@ -17,6 +21,7 @@ import numpy as np
 from numba import njit
 
 from flexsat.dynamics.appendages.contract import HUB_DISSIPATION
+from flexsat.dynamics.attitude import rebase
 from flexsat.dynamics.kernels import accelerations
 from flexsat.dynamics.linalg3 import euler_rate_matrix, mtv
 from flexsat.dynamics.status import STATUS_NOT_FINITE, STATUS_OK
@@ -100,12 +105,16 @@ def rk4_step(x, dt, torque_B, n, Q, scratch, packed):
 
 
 @njit(cache=True)
-def rk4_hold(x, dt, n_steps, torque_B, packed):
-    """``n_steps`` RK4 steps under one held body torque (3-tuple). Returns (status, done)."""
+def rk4_hold(x, dt, n_steps, torque_B, packed, frame):
+    """``n_steps`` RK4 steps under one held body torque (3-tuple). Returns (status, done).
+
+    ``frame`` (9,) is the attitude reference R_NF, re-based before each step.
+    """
     n = packed.n_dof
     scratch = np.empty((5, x.shape[0]))
     Q = np.zeros(n)  # no joint actuators
     for k in range(n_steps):
+        rebase(x, n, frame)
         status = rk4_step(x, dt, torque_B, n, Q, scratch, packed)
         if status != STATUS_OK:
             return status, k
@@ -115,7 +124,7 @@ def rk4_hold(x, dt, n_steps, torque_B, packed):
 @njit(cache=True)
 def rk4_open_loop(
     x, t0, dt, n_steps, record_every, seg_start, seg_end, seg_torque, disturbance, packed,
-    rec_t, rec_x, rec_tau, rec_start,
+    frame, rec_t, rec_x, rec_tau, rec_frame, rec_start,
 ):  # fmt: skip
     """Advance x in place by ``n_steps`` RK4 steps, recording every ``record_every`` steps.
 
@@ -131,11 +140,14 @@ def rk4_open_loop(
     disturbance : ndarray, shape (3,)
     packed : PackedPlant
         ``Plant.packed``.
-    rec_t, rec_x, rec_tau : ndarray
-        Record buffers, shapes (m,), (m, 2 n_dof + 2), (m, 3); the state after step
-        k is written at row rec_start + (k + 1) / record_every - 1 when
+    frame : ndarray, shape (9,)
+        Attitude reference R_NF of x (row-major), re-based before each step and
+        updated in place (:mod:`flexsat.dynamics.attitude`).
+    rec_t, rec_x, rec_tau, rec_frame : ndarray
+        Record buffers, shapes (m,), (m, 2 n_dof + 2), (m, 3), (m, 9); the state after
+        step k is written at row rec_start + (k + 1) / record_every - 1 when
         (k + 1) is a multiple of ``record_every``, with the torque held during the
-        next step.
+        next step and the state's reference frame.
 
     Returns
     -------
@@ -151,6 +163,7 @@ def rk4_open_loop(
     for k in range(n_steps):
         t = t0 + k * dt
         torque = applied_torque(t, seg_start, seg_end, seg_torque, disturbance)
+        rebase(x, n, frame)
         status = rk4_step(x, dt, torque, n, Q, scratch, packed)
         if status != STATUS_OK:
             return status, k
@@ -158,6 +171,7 @@ def rk4_open_loop(
             t_next = t0 + (k + 1) * dt
             rec_t[row] = t_next
             rec_x[row, :] = x
+            rec_frame[row, :] = frame
             tau = applied_torque(t_next, seg_start, seg_end, seg_torque, disturbance)
             rec_tau[row, 0], rec_tau[row, 1], rec_tau[row, 2] = tau
             row += 1

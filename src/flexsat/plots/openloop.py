@@ -259,9 +259,11 @@ def plot_angular_acceleration(ds: xr.Dataset, analysis: ModalAnalysis | None = N
     decay_title = "decay of the ripple with no torque applied"
 
     title = f"Yaw ripple after the torque ends (t ≥ {free_from:.3g} s)"
+    f = 0.0
     if free.sum() >= 64:
         dt = float(t[1] - t[0])
         f = dominant_frequency(acc[free, 2], dt, _RIPPLE_MIN_HZ)
+    if f > 0.0:  # no line when the yaw acceleration has no ripple (none excited)
         title += f": dominant line {f:.4g} Hz"
         envelope = maximum_filter1d(ripple, size=max(3, round(1.0 / (f * dt))))
         style.line(

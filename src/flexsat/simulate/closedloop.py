@@ -14,6 +14,7 @@ from flexsat.control.laws import get_law
 from flexsat.control.quaternion import pointing_errors, target_quaternion
 from flexsat.control.stages import ACTUATORS, JOINT_ACTUATORS, REFERENCES, SENSORS
 from flexsat.control.stages.registry import no_derivative
+from flexsat.dynamics.attitude import identity_frame, inertial_view, is_identity, rebase
 from flexsat.dynamics.integrators import rk4_hold
 from flexsat.dynamics.plant import Plant
 from flexsat.dynamics.rigid import rigid_inertia
@@ -135,7 +136,9 @@ def run_slew(
     rec_t = np.full(n_records, np.nan)
     rec_x = np.full((n_records, layout.plant.size), np.nan)
     rec_ctrl = np.full((n_records, layout.record_size), np.nan)
+    rec_frame = np.full((n_records, 9), np.nan)
     x = np.concatenate([q0, qd0, [0.0, 0.0]])
+    frame = identity_frame()  # attitude reference R_NF (flexsat.dynamics.attitude)
     data = _loop_data(layout, scenario, J, plant)
     stages = LoopStages(
         tuple(s.step for s in layout.sensors), (law.step,),
@@ -147,18 +150,19 @@ def run_slew(
     start = time.perf_counter()
     with progress_bar(show, scenario.duration_s) as (bar, task):
         if controller is None:
-            status, done, rows = _compiled_loop(plant, scenario, x, stages, data, rec_t, rec_x,
-                                                rec_ctrl, bar, task, layout.continuous)  # fmt: skip
+            status, done, rows = _compiled_loop(plant, scenario, x, frame, stages, data, rec_t,
+                                                rec_x, rec_ctrl, rec_frame, bar, task,
+                                                layout.continuous)  # fmt: skip
         else:
-            status, done, rows = _python_loop(plant, scenario, x, stages, data, rec_t, rec_x,
-                                              rec_ctrl, bar, task, controller,
-                                              layout.continuous)  # fmt: skip
+            status, done, rows = _python_loop(plant, scenario, x, frame, stages, data, rec_t,
+                                              rec_x, rec_ctrl, rec_frame, bar, task,
+                                              controller, layout.continuous)  # fmt: skip
     wall = time.perf_counter() - start
     t_fail = done * scenario.dt_s if status else -1.0
     if status:  # keep the last good state as the final record
-        rec_t[rows], rec_x[rows], rec_ctrl[rows] = t_fail, x, data.held
+        rec_t[rows], rec_x[rows], rec_ctrl[rows], rec_frame[rows] = t_fail, x, data.held, frame
         rows += 1
-    rec_t, rec_x, rec_ctrl = rec_t[:rows], rec_x[:rows], rec_ctrl[:rows]
+    rec_t, rec_x, rec_ctrl, rec_frame = (a[:rows] for a in (rec_t, rec_x, rec_ctrl, rec_frame))
     attrs = run_attributes(plant, scenario, "closed-loop", status, t_fail, wall, done)
     attrs["controller"] = law.name if controller is None else "python"
     attrs["controller_label"] = law.label if controller is None else "Python law"
@@ -178,7 +182,7 @@ def run_slew(
     ds = build_dataset(
         plant, rec_t, rec_x[:, at.q], rec_x[:, at.qd], rec_x[:, at.work_in],
         rec_x[:, at.dissipated], rec_ctrl[:, layout.tau_cmd], rec_ctrl[:, layout.tau_applied],
-        attrs,
+        attrs, frames=rec_frame,
     )  # fmt: skip
     ta = ("time", "axis")
     for channel, columns in layout.channels():
@@ -186,7 +190,7 @@ def run_slew(
         attributes = {"units": channel.units, "description": channel.description}
         ds[channel.name] = (ta if channel.per_axis else "time", values, attributes)
     # of the true attitude, whatever the sensor measured
-    pointing = pointing_errors(target, np.ascontiguousarray(rec_x[:, at.attitude]))
+    pointing = pointing_errors(target, np.ascontiguousarray(ds["q"].values[:, at.attitude]))
     ds["pointing_error_deg"] = (
         "time", np.degrees(pointing),
         {"units": "deg", "description": "2 asin |q_v,e| of the true attitude from the "
@@ -271,8 +275,8 @@ def _loop_data(layout: LoopLayout, scenario: SlewScenario, J: np.ndarray,
     )
 
 
-def _compiled_loop(plant, scenario, x, stages, data, rec_t, rec_x, rec_ctrl, bar, task,
-                   continuous):  # fmt: skip
+def _compiled_loop(plant, scenario, x, frame, stages, data, rec_t, rec_x, rec_ctrl, rec_frame,
+                   bar, task, continuous):  # fmt: skip
     """The whole loop, stages and law included, in compiled chunks."""
     steps, every, control = scenario.n_steps, scenario.record_every, scenario.control_every
     chunk = chunk_steps(every, control)
@@ -283,7 +287,8 @@ def _compiled_loop(plant, scenario, x, stages, data, rec_t, rec_x, rec_ctrl, bar
         clock = LoopClock(done * scenario.dt_s, scenario.dt_s, n_chunk, final, control, every,
                           continuous)  # fmt: skip
         status, ran, written = rk4_closed_loop(
-            x, clock, stages, data, LoopRecords(rec_t, rec_x, rec_ctrl, rows), plant.packed
+            x, clock, stages, data, LoopRecords(rec_t, rec_x, rec_ctrl, rows, rec_frame),
+            plant.packed, frame,
         )
         done += ran
         rows += written
@@ -294,8 +299,8 @@ def _compiled_loop(plant, scenario, x, stages, data, rec_t, rec_x, rec_ctrl, bar
     return status, done, rows
 
 
-def _python_loop(plant, scenario, x, stages, d, rec_t, rec_x, rec_ctrl, bar, task, controller,
-                 continuous):  # fmt: skip
+def _python_loop(plant, scenario, x, frame, stages, d, rec_t, rec_x, rec_ctrl, rec_frame, bar,
+                 task, controller, continuous):  # fmt: skip
     """Python controller at each control instant between the compiled stages; the plant
     steps compiled in between."""
     n = plant.n_dof
@@ -304,11 +309,16 @@ def _python_loop(plant, scenario, x, stages, d, rec_t, rec_x, rec_ctrl, bar, tas
     control_dt = control * scenario.dt_s
     limit = scenario.actuator.reduction_factor * scenario.actuator.t_max_nm
     d.law_diag[:] = np.nan
+    view = np.empty_like(x)
     rows, status, k = 0, 0, 0
     while True:
         t = k * scenario.dt_s
         if k % control == 0:
-            status = run_sensors(x, n, t, stages, d)
+            sensed = x
+            if not is_identity(frame):  # re-based between steps: the sensors read N
+                inertial_view(x, n, frame, view)
+                sensed = view
+            status = run_sensors(sensed, n, t, stages, d)
             tau_cmd = np.asarray(controller(t, d.q_meas.copy(), d.omega_meas.copy()), dtype=float)
             if tau_cmd.shape != (3,) or not np.all(np.isfinite(tau_cmd)):
                 raise SimulationError(f"controller returned {tau_cmd!r} at t = {t:.6g} s")
@@ -317,16 +327,17 @@ def _python_loop(plant, scenario, x, stages, d, rec_t, rec_x, rec_ctrl, bar, tas
             if status:
                 return STATUS_CONTROL_FAILED, k, rows
         if k % every == 0:
-            rec_t[rows], rec_x[rows], rec_ctrl[rows] = t, x, d.held
+            rec_t[rows], rec_x[rows], rec_ctrl[rows], rec_frame[rows] = t, x, d.held, frame
             rows += 1
         if k == steps:
             return 0, k, rows
-        if continuous:
+        if continuous:  # re-based once per block (a few steps: far from the pole)
+            rebase(x, n, frame)
             status, ran = rk4_coupled_hold(x, t, scenario.dt_s, block, stages.derivative,
                                            d.actuator_params, d.flow, plant.packed)  # fmt: skip
         else:
             torque = (d.tau_applied[0], d.tau_applied[1], d.tau_applied[2])
-            status, ran = rk4_hold(x, scenario.dt_s, block, torque, plant.packed)
+            status, ran = rk4_hold(x, scenario.dt_s, block, torque, plant.packed, frame)
         k += ran
         if status:
             return status, k, rows

@@ -9,6 +9,11 @@ signatures, a user's own included. They run every ``control_every`` plant steps 
 their outputs are held in between (zero-order hold). An actuation stage with a
 derivative integrates its states with the plant inside each RK4 step
 (:mod:`flexsat.simulate.coupled`). Nothing is allocated inside the loop.
+
+The hub attitude is re-based between steps (:mod:`flexsat.dynamics.attitude`); once a
+run has switched, the sensing chain reads the plant state relative to the inertial
+frame N (:func:`~flexsat.dynamics.attitude.inertial_view`), so the laws' q_d and the
+sensors' outputs stay relative to N whatever the reference frame.
 """
 
 from __future__ import annotations
@@ -18,6 +23,7 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
+from flexsat.dynamics.attitude import inertial_view, is_identity, rebase
 from flexsat.dynamics.integrators import rk4_step
 from flexsat.dynamics.status import STATUS_CONTROL_FAILED, STATUS_OK
 from flexsat.simulate.coupled import LoopFlow, chain_wrench, rk4_coupled_step
@@ -101,6 +107,7 @@ class LoopRecords(NamedTuple):
     x: np.ndarray  # (m, x_size)
     ctrl: np.ndarray  # (m, record_size)
     start: int
+    frame: np.ndarray  # (m, 9) attitude reference R_NF of each recorded state
 
 
 @njit(cache=True)
@@ -142,15 +149,17 @@ def run_actuators(x, n, t, control_dt, continuous, stages, d):
 
 
 @njit(cache=True)
-def rk4_closed_loop(x, clock, stages, d, records, plant):
+def rk4_closed_loop(x, clock, stages, d, records, plant, frame):
     """Run ``clock.n_steps`` closed-loop steps from ``clock.t0``; ``x`` advanced in place.
 
-    At each step k (time t0 + k dt): run the reference, the sensing chain, the law,
+    At each step k (time t0 + k dt): re-base the attitude if due, run the reference,
+    the sensing chain, the law,
     the actuation chain and the joint actuator if k is a control instant, record if
     k is a record instant, then take one RK4 step under the held torque and joint
     forces ``d.Q`` (coupled with the chain's continuous states if any). Chunk
     boundaries must be multiples of ``control_every`` and ``record_every``.
-    ``plant`` is the plant's named structure (``Plant.packed``), passed to ``rk4_step``.
+    ``plant`` is the plant's named structure (``Plant.packed``), passed to ``rk4_step``;
+    ``frame`` (9,) the attitude reference R_NF of ``x``, updated in place.
 
     Returns
     -------
@@ -158,14 +167,20 @@ def rk4_closed_loop(x, clock, stages, d, records, plant):
     """
     n = plant.n_dof
     scratch = np.empty((5, x.shape[0]))
+    view = np.empty(x.shape[0])  # x relative to N, for the sensing chain, once switched
     control_dt = clock.control_every * clock.dt
     row = records.start
     for k in range(clock.n_steps + (1 if clock.final else 0)):
         t = clock.t0 + k * clock.dt
+        rebase(x, n, frame)
         if k % clock.control_every == 0:
             status = stages.reference[0](t, d.reference_params, d.reference_state, d.q_d,
                                          d.omega_d, d.omega_dot_d, d.reference_record)  # fmt: skip
-            status |= run_sensors(x, n, t, stages, d)
+            sensed = x
+            if not is_identity(frame):
+                inertial_view(x, n, frame, view)
+                sensed = view
+            status |= run_sensors(sensed, n, t, stages, d)
             status |= stages.law[0](
                 d.q_d, d.omega_d, d.omega_dot_d, d.q_meas, d.omega_meas, d.J_design,
                 d.law_gains, d.law_state, t, control_dt, d.tau_cmd, d.law_diag,
@@ -178,6 +193,7 @@ def rk4_closed_loop(x, clock, stages, d, records, plant):
         if k % clock.record_every == 0:
             records.t[row] = t
             records.x[row, :] = x
+            records.frame[row, :] = frame
             records.ctrl[row, :] = d.held
             row += 1
         if k == clock.n_steps:

@@ -8,13 +8,14 @@ import time
 import numpy as np
 from scipy.integrate import solve_ivp
 
+from flexsat.dynamics.attitude import SWITCH_PITCH, identity_frame, rebase
 from flexsat.dynamics.integrators import (
     STATUS_NOT_FINITE,
     applied_torque,
     augmented_derivative,
     rk4_open_loop,
 )
-from flexsat.dynamics.kernels import STATUS_HUB_GIMBAL_LOCK, STATUS_OK
+from flexsat.dynamics.kernels import STATUS_OK
 from flexsat.dynamics.linalg3 import euler_rate_matrix_inv
 from flexsat.dynamics.plant import Plant
 from flexsat.errors import ConfigError
@@ -124,9 +125,10 @@ def run_openloop(
     profile = _profile(scenario)
     start = time.perf_counter()
     if scenario.solver == "rk4":
-        t, X, tau, status, t_fail, steps = _run_rk4(plant, scenario, q0, qd0, profile, progress)
+        t, X, F, tau, status, t_fail, steps = _run_rk4(plant, scenario, q0, qd0, profile,
+                                                       progress)  # fmt: skip
     else:
-        t, X, tau, status, t_fail, steps = _run_dop853(plant, scenario, q0, qd0, profile)
+        t, X, F, tau, status, t_fail, steps = _run_dop853(plant, scenario, q0, qd0, profile)
     wall = time.perf_counter() - start
     lay = plant.layout
     seg_start, seg_end, seg_torque, _ = profile
@@ -137,7 +139,7 @@ def run_openloop(
     attrs["solver"] = scenario.solver
     dataset = build_dataset(
         plant, t, X[:, lay.q], X[:, lay.qd], X[:, lay.work_in], X[:, lay.dissipated], tau_cmd,
-        tau, attrs,
+        tau, attrs, frames=F,
     )  # fmt: skip
     return Result(dataset)
 
@@ -148,8 +150,10 @@ def _run_rk4(plant, scenario, q0, qd0, profile, progress):
     rec_t = np.empty(n_records)
     rec_x = np.empty((n_records, plant.layout.size))
     rec_tau = np.empty((n_records, 3))
+    rec_frame = np.empty((n_records, 9))
     x = np.concatenate([q0, qd0, [0.0, 0.0]])
-    rec_t[0], rec_x[0] = 0.0, x
+    frame = identity_frame()
+    rec_t[0], rec_x[0], rec_frame[0] = 0.0, x, frame
     rec_tau[0] = applied_torque(0.0, *profile)
     show = n_steps >= PROGRESS_MIN_STEPS if progress is None else progress
     chunk = chunk_steps(every)
@@ -158,8 +162,8 @@ def _run_rk4(plant, scenario, q0, qd0, profile, progress):
         while done < n_steps and status == 0:
             steps = min(chunk, n_steps - done)
             status, ran = rk4_open_loop(
-                x, done * dt, dt, steps, every, *profile, plant.packed,
-                rec_t, rec_x, rec_tau, done // every + 1,
+                x, done * dt, dt, steps, every, *profile, plant.packed, frame,
+                rec_t, rec_x, rec_tau, rec_frame, done // every + 1,
             )  # fmt: skip
             done += ran
             if bar is not None:
@@ -169,22 +173,19 @@ def _run_rk4(plant, scenario, q0, qd0, profile, progress):
     if status:
         # Keep the last good state too, even between two records.
         rec_t[kept - 1 : kept] = done * dt
-        rec_x[kept - 1] = x
+        rec_x[kept - 1], rec_frame[kept - 1] = x, frame
         rec_tau[kept - 1] = applied_torque(done * dt, *profile)
         rec_t, rec_x, rec_tau = rec_t[:kept], rec_x[:kept], rec_tau[:kept]
-    return rec_t, rec_x, rec_tau, status, t_fail, done
-
-
-_DOP853_MIN_COS = 1e-4
-"""DOP853 stops when cos(pitch) falls below this (pitch within 0.006 deg of +-90 deg):
-the ZYX rates S(Theta)^-1 grow as 1/cos(pitch), and the adaptive steps would shrink
-to nothing there instead of stopping as the RK4 kernel does."""
+        rec_frame = rec_frame[:kept]
+    return rec_t, rec_x, rec_frame, rec_tau, status, t_fail, done
 
 
 def _run_dop853(plant, scenario, q0, qd0, profile):
     """Adaptive DOP853 (scipy), integrated piecewise between torque switching times.
 
-    A run that reaches the pitch singularity or diverges stops there, like RK4: the
+    Each piece also ends where |pitch| reaches ``SWITCH_PITCH`` (a terminal event):
+    the attitude is re-based there (:func:`flexsat.dynamics.attitude.rebase`) and the
+    piece continues from the event. A run that diverges stops there, like RK4: the
     records up to the failure and the last good state are kept, with its status.
     """
     n = plant.n_dof
@@ -197,16 +198,22 @@ def _run_dop853(plant, scenario, q0, qd0, profile):
     x = np.concatenate([q0, qd0, [0.0, 0.0]])
     X = np.empty((t_rec.size, x.size))
     X[0] = x
+    frame = identity_frame()
+    F = np.empty((t_rec.size, 9))
     Q = np.zeros(n)  # no joint actuators
     evaluations = 0
     kernel_status = STATUS_OK
 
-    def pitch_lock(t, y, torque=None):  # cos(pitch) > 0 from the start (|pitch| < 89 deg)
-        return np.cos(y[4]) - _DOP853_MIN_COS
+    def switch(t, y, torque=None):  # positive after each rebase
+        return SWITCH_PITCH - abs(y[4])
 
-    pitch_lock.terminal = True
+    switch.terminal = True
+    switch.direction = -1.0
     status, t_fail = STATUS_OK, -1.0
-    for a, b in itertools.pairwise(breaks):
+    pieces = list(itertools.pairwise(breaks))
+    while pieces and not status:
+        a, b = pieces.pop(0)
+        rebase(x, n, frame)
         torque = applied_torque(0.5 * (a + b), *profile)
 
         def rhs(t, y, torque=torque):
@@ -221,20 +228,25 @@ def _run_dop853(plant, scenario, q0, qd0, profile):
 
         sol = solve_ivp(
             rhs, (a, b), x, method="DOP853", rtol=scenario.rtol, atol=scenario.atol,
-            dense_output=True, events=pitch_lock,
+            dense_output=True, events=switch,
         )  # fmt: skip
         t_end = float(sol.t[-1])
         inside = (t_rec >= a) & (t_rec <= t_end)
-        X[inside] = sol.sol(t_rec[inside]).T
-        x = sol.y[:, -1]
-        if sol.status != 0:  # 1: the pitch singularity; -1: the steps failed (diverged)
-            status = STATUS_HUB_GIMBAL_LOCK if sol.status == 1 else kernel_status
-            status = status or STATUS_NOT_FINITE
+        if inside.any():  # a piece cut short by a switch may hold no record
+            X[inside] = sol.sol(t_rec[inside]).T
+            F[inside] = frame
+        x = sol.y[:, -1].copy()
+        if sol.status == 1:  # the switching event: re-base, go on to b
+            rebase(x, n, frame, 0.0)
+            if t_end < b:
+                pieces.insert(0, (t_end, b))
+        elif sol.status == -1:  # the steps failed (diverged)
+            status = kernel_status or STATUS_NOT_FINITE
             t_fail = t_end
-            break
     if status:
         kept = int(np.searchsorted(t_rec, t_fail, side="right"))
         t_rec = np.append(t_rec[:kept], t_fail) if t_fail > t_rec[kept - 1] else t_rec[:kept]
         X = np.vstack([X[:kept], x]) if t_rec.size > kept else X[:kept]
+        F = np.vstack([F[:kept], frame]) if t_rec.size > kept else F[:kept]
     tau = np.array([applied_torque(t, *profile) for t in t_rec]).reshape(-1, 3)
-    return t_rec, X, tau, status, t_fail, evaluations
+    return t_rec, X, F, tau, status, t_fail, evaluations

@@ -15,6 +15,7 @@ import numpy as np
 import xarray as xr
 from scipy.spatial.transform import Rotation
 
+from flexsat.dynamics.attitude import inertial_records, vectors_to_inertial
 from flexsat.dynamics.plant import Plant
 from flexsat.dynamics.records import derive_records
 from flexsat.errors import SimulationError
@@ -80,6 +81,7 @@ def build_dataset(
     tau_cmd: np.ndarray,
     tau_applied: np.ndarray,
     attrs: dict,
+    frames: np.ndarray | None = None,
 ) -> xr.Dataset:
     """Derive every recorded quantity from the recorded states.
 
@@ -94,6 +96,10 @@ def build_dataset(
         Commanded and applied body torque held from each record time [N m].
     attrs : dict
         Dataset attributes (configs as JSON, status...).
+    frames : ndarray, shape (m, 9), optional
+        The attitude reference R_NF of each record (:mod:`flexsat.dynamics.attitude`);
+        the hub part of ``q`` and ``qd`` is relative to it. Default: the identity.
+        The dataset holds every attitude, position and momentum relative to N.
     """
     m, n = q.shape
     names = [a.name for a in plant.config.appendages]
@@ -106,13 +112,17 @@ def build_dataset(
     kinetic = np.empty(m)
     elastic = np.empty(m)
     tips = np.zeros((m, n_app, 3))
-    rotations = Rotation.from_euler("ZYX", q[:, 5:2:-1])  # R_NB = Rz(psi) Ry(theta) Rx(phi)
     # A diverged run keeps its last finite state, whose derived values may overflow.
     with np.errstate(over="ignore", invalid="ignore"):
         derive_records(
             np.ascontiguousarray(q), np.ascontiguousarray(qd), np.ascontiguousarray(tau_applied),
             plant.packed, omega, omega_dot, tau_flex, H, H_rigid, kinetic, elastic, tips,
         )  # fmt: skip
+    if frames is not None:  # relative to N: H_N = R_NF H_F (docs/model.md)
+        q, qd = inertial_records(q, qd, omega, frames)
+        H = vectors_to_inertial(H, frames)
+        H_rigid = vectors_to_inertial(H_rigid, frames)
+    rotations = Rotation.from_euler("ZYX", q[:, 5:2:-1])  # R_NB = Rz(psi) Ry(theta) Rx(phi)
     total = kinetic + elastic
     quat_scalar_last = rotations.as_quat()
     quaternion = np.column_stack([quat_scalar_last[:, 3], quat_scalar_last[:, :3]])

@@ -13,7 +13,9 @@ Sensor step, ``@njit(SENSOR_SIGNATURE, cache=True)``::
     status = step(x, n_dof, t, params, state, q_meas, omega_meas, record)
 
 reads the plant state ``x`` (q (n_dof), q_dot (n_dof), work, dissipation; the hub's
-ZYX Euler angles at q[3:6], their rates at q_dot[3:6]) and writes the measured
+ZYX Euler angles relative to the inertial frame N at q[3:6], their rates at
+q_dot[3:6]: once the integrator has re-based the attitude, the loop hands the sensor
+that view of its state, docs/model.md, 'Attitude parametrization') and writes the measured
 attitude quaternion ``q_meas`` (4,), scalar first, and body rate ``omega_meas``
 (3,) [rad/s].
 

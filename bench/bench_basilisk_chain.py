@@ -1,0 +1,130 @@
+"""Benchmark: flexsat chains against Basilisk's three engines, per step, N = 1 ... 32.
+
+The scenario is Basilisk's hinged flexible-panel comparison (:mod:`flexpanels`: hub
+and two arrays of N hinged segments, RK4 at dt = min(10 ms, T / 200)), timed as that
+comparison times it: for each engine and N, a discarded warm-up of
+``TIMING_WARMUP_STEPS`` steps, then ``TIMING_TRIALS`` trials of a fixed budget of
+``TIMING_STEPS`` steps, each on a freshly built model, and the median.
+
+* flexsat: ``run_openloop`` on the chain model; the time is the integration alone
+  (the dataset attribute ``wall_time_s``: the compiled RK4 loop, recording every
+  ``RECORD_EVERY`` steps); building the plant and the dataset is not timed.
+* Basilisk: ``ExecuteSimulation`` of ``nHingedRigidBodyStateEffector``,
+  ``spinningBodyNDOFStateEffector`` and, if the wheel ships it, MuJoCo, without
+  recorders; building and ``InitializeSimulation`` are not timed.
+
+Goal: at every N at least 10 times faster than the fastest Basilisk engine, and a
+cost linear in N (least-squares line of the per-step time against N: slope, R^2).
+Run ``python bench/bench_basilisk_chain.py`` (Basilisk: ``pip install -e '.[bench]'``).
+"""
+
+from __future__ import annotations
+
+import sys
+import time
+
+import numpy as np
+from rich.console import Console
+from rich.table import Table
+
+import flexpanels as fp
+from flexsat.config import validate_config
+from flexsat.dynamics.plant import Plant
+from flexsat.simulate import OpenLoopScenario, run_openloop
+
+INSTALL_HINT = "Basilisk not installed: pip install -e '.[bench]'"
+GOAL_RATIO = 10.0
+RECORD_EVERY = 10
+
+
+def time_flexsat(n: int) -> float:
+    """Median wall time of the fixed step budget [s] (integration only)."""
+    plant = Plant.from_config(validate_config(fp.flexsat_config(n)))
+    dt = fp.time_step(n)
+
+    def scenario(steps: int) -> OpenLoopScenario:
+        return OpenLoopScenario.model_validate(
+            fp.flexsat_scenario(n, duration_s=steps * dt, record_every=RECORD_EVERY)
+        )
+
+    run_openloop(plant, scenario(fp.TIMING_WARMUP_STEPS), progress=False)
+    budget = scenario(fp.TIMING_STEPS)
+    walls = [run_openloop(plant, budget, progress=False).dataset.attrs["wall_time_s"]
+             for _ in range(fp.TIMING_TRIALS)]  # fmt: skip
+    return float(np.median(walls))
+
+
+def time_basilisk(bsk, build, n: int) -> float:
+    """Median ``ExecuteSimulation`` time of the fixed step budget [s], as Basilisk's
+    comparison measures it (fresh model per trial, warm-up discarded)."""
+    dt = fp.time_step(n)
+    warm = build(bsk, n, dt, False)
+    warm.sim.ConfigureStopTime(bsk.macros.sec2nano(fp.TIMING_WARMUP_STEPS * dt))
+    warm.sim.ExecuteSimulation()
+    walls = []
+    for _ in range(fp.TIMING_TRIALS):
+        model = build(bsk, n, dt, False)
+        model.sim.ConfigureStopTime(bsk.macros.sec2nano(fp.TIMING_STEPS * dt))
+        start = time.perf_counter()
+        model.sim.ExecuteSimulation()
+        walls.append(time.perf_counter() - start)
+    return float(np.median(walls))
+
+
+def linear_fit(n: np.ndarray, us: np.ndarray) -> tuple[float, float, float]:
+    """Least-squares us = a + b N: slope b [us per segment], intercept a [us], R^2."""
+    b, a = np.polyfit(n, us, 1)
+    residual = us - (a + b * n)
+    r2 = 1.0 - float(residual @ residual) / float(((us - us.mean()) ** 2).sum())
+    return float(b), float(a), r2
+
+
+def compare(counts: tuple[int, ...] = fp.SEGMENT_COUNTS) -> dict:
+    """Per-step times [us] of flexsat and each Basilisk engine for each N."""
+    bsk = fp.import_basilisk()
+    engines = fp.engines(bsk)
+    rows = []
+    for n in counts:
+        row = {"N": n, "dof": 6 + 4 * n, "dt_s": fp.time_step(n),
+               "flexsat": 1e6 * time_flexsat(n) / fp.TIMING_STEPS}  # fmt: skip
+        for name, build in engines.items():
+            row[name] = 1e6 * time_basilisk(bsk, build, n) / fp.TIMING_STEPS
+        row["fastest"] = min(engines, key=lambda e: row[e])
+        row["ratio"] = row[row["fastest"]] / row["flexsat"]
+        rows.append(row)
+    ns = np.array(counts, dtype=float)
+    fits = {e: linear_fit(ns, np.array([r[e] for r in rows])) for e in ("flexsat", *engines)}
+    return {"version": bsk.version, "engines": list(engines), "rows": rows, "fits": fits}
+
+
+def main() -> int:
+    console = Console() if sys.stdout.isatty() else Console(width=200)
+    try:
+        fp.import_basilisk()
+    except ImportError:
+        print(INSTALL_HINT)
+        return 0
+    out = compare()
+    engines = out["engines"]
+    table = Table(
+        title=(f"Hinged flexible panels (Basilisk's comparison scenario), µs per RK4 step: "
+               f"median of {fp.TIMING_TRIALS} x {fp.TIMING_STEPS} steps, Basilisk "
+               f"{out['version']}"),
+        caption=f"ratio: fastest Basilisk engine / flexsat; goal >= {GOAL_RATIO:g}x",
+    )  # fmt: skip
+    for column in ("N", "DOF", "dt ms", "flexsat", *engines, "ratio", "goal"):
+        table.add_column(column, justify="right", no_wrap=True)
+    for r in out["rows"]:
+        table.add_row(
+            str(r["N"]), str(r["dof"]), f"{1e3 * r['dt_s']:.4g}", f"{r['flexsat']:.2f}",
+            *(f"{r[e]:.1f}" for e in engines), f"{r['ratio']:.1f}x ({r['fastest']})",
+            "met" if r["ratio"] >= GOAL_RATIO else "MISSED",
+        )  # fmt: skip
+    console.print(table)
+    for engine, (slope, intercept, r2) in out["fits"].items():
+        console.print(f"{engine}: {intercept:.2f} µs + {slope:.3f} µs per segment, R² = {r2:.4f}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
