@@ -33,6 +33,7 @@ from tests.dynamics.chain_satellites import (  # noqa: E402
 from tests.dynamics.test_chain_beam import clamped_frequencies_hz  # noqa: E402
 
 from flexsat.config import validate_config  # noqa: E402
+from flexsat.dynamics.attitude import identity_frame  # noqa: E402
 from flexsat.dynamics.integrators import rk4_hold  # noqa: E402
 from flexsat.dynamics.plant import Plant  # noqa: E402
 from flexsat.linear import linearize  # noqa: E402
@@ -64,12 +65,13 @@ def step_cost_table(console: Console, steps: int) -> None:
         x[plant.n_dof + 3 : plant.n_dof + 6] = (0.01, -0.02, 0.015)
         # The cost of a step does not depend on dt; 1 us keeps every N far from the RK4
         # stability limit of its stiffest hinge mode, so every step is a full one.
-        rk4_hold(x.copy(), 1e-6, 10, (0.0, 0.0, 0.0), plant.packed)  # compile, warm
+        rk4_hold(x.copy(), 1e-6, 10, (0.0, 0.0, 0.0), plant.packed, identity_frame())  # compile, warm
         best = np.inf
         for _ in range(5):
             trial = x.copy()
             start = time.perf_counter()
-            status, done = rk4_hold(trial, 1e-6, steps, (0.0, 0.0, 0.0), plant.packed)
+            status, done = rk4_hold(trial, 1e-6, steps, (0.0, 0.0, 0.0), plant.packed,
+                                    identity_frame())
             if status != 0 or done != steps:
                 raise RuntimeError(f"N = {n}: the run stopped at step {done} (status {status})")
             best = min(best, (time.perf_counter() - start) / steps)
