@@ -65,7 +65,8 @@ def step_cost_table(console: Console, steps: int) -> None:
         x[plant.n_dof + 3 : plant.n_dof + 6] = (0.01, -0.02, 0.015)
         # The cost of a step does not depend on dt; 1 us keeps every N far from the RK4
         # stability limit of its stiffest hinge mode, so every step is a full one.
-        rk4_hold(x.copy(), 1e-6, 10, (0.0, 0.0, 0.0), plant.packed, identity_frame())  # compile, warm
+        rk4_hold(x.copy(), 1e-6, 10, (0.0, 0.0, 0.0), plant.packed,
+                 identity_frame())  # compile, warm
         best = np.inf
         for _ in range(5):
             trial = x.copy()
