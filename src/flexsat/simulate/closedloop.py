@@ -154,20 +154,20 @@ def run_slew(
     ta = ("time", "axis")
     for channel, columns in layout.channels():
         values = rec_ctrl[:, columns] if channel.per_axis else rec_ctrl[:, columns.start]
-        attributes = {"units": channel.units, "description": channel.description}
+        attributes = {"units": channel.units, "long_name": channel.description}
         ds[channel.name] = (ta if channel.per_axis else "time", values, attributes)
     # of the true attitude, whatever the sensor measured
     pointing = pointing_errors(data.q_d, np.ascontiguousarray(rec_x[:, at.attitude]))
     ds["pointing_error_deg"] = (
         "time", np.degrees(pointing),
-        {"units": "deg", "description": "2 asin |q_v,e| of the true attitude: absolute "
+        {"units": "deg", "long_name": "2 asin |q_v,e| of the true attitude: absolute "
          "pointing error"},
     )  # fmt: skip
     with np.errstate(over="ignore", invalid="ignore"):  # a diverged run's last state
         rate_error = np.degrees(np.linalg.norm(ds["omega"].values, axis=1))
     ds["rate_error_deg_s"] = (
         "time", rate_error,
-        {"units": "deg/s", "description": "|omega - omega_d|: residual rate (jitter)"},
+        {"units": "deg/s", "long_name": "|omega - omega_d|: residual rate (jitter)"},
     )  # fmt: skip
     return Result(ds)
 

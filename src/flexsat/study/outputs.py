@@ -142,7 +142,8 @@ def fly_openloop(plant: Plant, scenario=None, out: Path | None = None, progress=
     return result, metrics
 
 
-def fly_slew(plant: Plant, scenario=None, out: Path | None = None, progress=None):
+def fly_slew(plant: Plant, scenario=None, out: Path | None = None, progress=None, *,
+             figures: bool = True):  # fmt: skip
     """Closed-loop slew and its requirement metrics; with ``out``, its files there.
 
     Parameters
@@ -152,6 +153,8 @@ def fly_slew(plant: Plant, scenario=None, out: Path | None = None, progress=None
         Default: the thesis's 45/45/45 deg ASMC slew.
     out : Path, optional
     progress : bool or None
+    figures : bool
+        With ``out``, also draw the figure set (result.nc and metrics.json always).
 
     Returns
     -------
@@ -165,10 +168,10 @@ def fly_slew(plant: Plant, scenario=None, out: Path | None = None, progress=None
     from flexsat.simulate import SlewScenario, run_slew
     from flexsat.simulate.common import check_run_size
 
-    def figures() -> list[Path]:
+    def draw() -> list[Path]:
         from flexsat.plots.slew import write_slew_figures
 
-        return write_slew_figures(result.dataset, Path(out))
+        return write_slew_figures(result.dataset, Path(out)) if figures else []
 
     scenario = scenario or SlewScenario()
     check_run_size(plant.n_dof, scenario)
@@ -179,7 +182,7 @@ def fly_slew(plant: Plant, scenario=None, out: Path | None = None, progress=None
     J = result.dataset.attrs["design_inertia"]
     metrics["design_inertia_kg_m2"] = [list(J[3 * i : 3 * i + 3]) for i in range(3)]
     if out is not None:
-        _write_run(result, metrics, Path(out), figures)
+        _write_run(result, metrics, Path(out), draw)
     return result, metrics
 
 
