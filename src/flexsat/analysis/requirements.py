@@ -194,8 +194,13 @@ def slew_metrics(ds: xr.Dataset, *, requirements: Requirements | None = None) ->
         Settling times are when each quantity enters its band for good (NaN if not
         by the end): ``settling_time_s`` is R1's, ``r2_settling_time_s`` R2's.
         ``lambda_switch_time_s`` is when Lambda first leaves its initial value (NaN
-        if it never does, or the law has no Lambda).
+        if it never does, or the law has no Lambda). A diverged run's metrics are
+        those of its finite part (:func:`flexsat.analysis.openloop.finite_part`);
+        ``finite_until_s`` says where that ends.
     """
+    from flexsat.analysis.openloop import finite_part
+
+    ds = finite_part(ds)
     stored = _stored_scenario(ds)
     req = requirements or Requirements.model_validate(stored.get("requirements", {}))
     t_max_nm = float(stored.get("actuator", {}).get("t_max_nm", 2.0))
@@ -239,6 +244,7 @@ def slew_metrics(ds: xr.Dataset, *, requirements: Requirements | None = None) ->
         "peak_tip_displacement_m": float(
             np.linalg.norm(ds["tip_displacement"].values, axis=-1).max()
         ),
+        "finite_until_s": float(t[-1]),
         "wall_time_s": float(ds.attrs["wall_time_s"]),
         "steps": int(ds.attrs["steps"]),
         "status": str(ds.attrs["status"]),

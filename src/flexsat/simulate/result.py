@@ -16,6 +16,7 @@ a result needs neither matplotlib nor the analysis modules.
 
 from __future__ import annotations
 
+import shutil
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -34,9 +35,15 @@ AXES = ("x", "y", "z")
 
 @dataclass(frozen=True)
 class Result:
-    """A simulation result wrapping its dataset (``result.dataset``)."""
+    """A simulation result wrapping its dataset (``result.dataset``).
+
+    ``path`` is the NetCDF file a streamed run's records were written to (the
+    dataset reads it lazily; :mod:`flexsat.simulate.stream`); None for a run held
+    in memory.
+    """
 
     dataset: xr.Dataset
+    path: Path | None = None
 
     @property
     def ok(self) -> bool:
@@ -201,8 +208,13 @@ class Result:
         """Write the dataset to NetCDF (written to a temporary name, then moved)."""
         path = Path(path)
         path.parent.mkdir(parents=True, exist_ok=True)
+        if self.path is not None and path.resolve() == self.path.resolve():
+            return path  # a streamed run already written there
         partial = path.with_suffix(path.suffix + ".partial")
-        self.dataset.to_netcdf(partial)
+        if self.path is not None:  # a streamed run: copy its file, never load it whole
+            shutil.copyfile(self.path, partial)
+        else:
+            self.dataset.to_netcdf(partial)
         partial.replace(path)
         return path
 
@@ -223,6 +235,7 @@ def build_dataset(
     tau_cmd: np.ndarray,
     tau_applied: np.ndarray,
     attrs: dict,
+    energy0: float | None = None,
 ) -> xr.Dataset:
     """Derive every recorded quantity from the recorded states.
 
@@ -237,6 +250,9 @@ def build_dataset(
         Commanded and applied body torque held from each record time [N m].
     attrs : dict
         Dataset attributes (configs as JSON, status...).
+    energy0 : float, optional
+        E(0) of the run [J], for a block of records that does not start at t = 0
+        (a streamed run); default: the first record's total energy.
     """
     m, n = q.shape
     names = [a.name for a in plant.config.appendages]
@@ -297,7 +313,7 @@ def build_dataset(
         "dissipated_energy": var("time", dissipated, "J", "cumulative damper dissipation"),
         "energy_balance_error": var(
             "time",
-            total - total[0] - work_in + dissipated,
+            total - (total[0] if energy0 is None else energy0) - work_in + dissipated,
             "J",
             "E(t) - E(0) - W_in(t) + W_diss(t): numerical error of the integration",
         ),

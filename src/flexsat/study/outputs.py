@@ -115,6 +115,7 @@ def fly_openloop(plant: Plant, scenario=None, out: Path | None = None, progress=
     scenario : OpenLoopScenario, optional
         Default: the thesis's 1 N m yaw pulse.
     out : Path, optional
+        A run whose records do not fit in memory streams them to ``out/result.nc``.
     progress : bool or None
         Progress bar: None shows it on a terminal only.
 
@@ -133,9 +134,15 @@ def fly_openloop(plant: Plant, scenario=None, out: Path | None = None, progress=
 
         return write_openloop_figures(result.dataset, modal_analysis(plant), Path(out))
 
+    from flexsat.simulate.common import check_run_size
+
+    scenario = scenario or OpenLoopScenario()
+    record_path = None
     if out is not None:
         prepare_output_dir(out)
-    result = run_openloop(plant, scenario or OpenLoopScenario(), progress=progress)
+        fits = check_run_size(plant.n_dof, scenario, can_stream=True).fits_in_memory
+        record_path = None if fits else Path(out) / "result.nc"  # streamed into place
+    result = run_openloop(plant, scenario, progress=progress, record_path=record_path)
     metrics = openloop_metrics(result.dataset)
     if out is not None:
         _write_run(result, metrics, Path(out), figures)
