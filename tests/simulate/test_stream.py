@@ -29,7 +29,8 @@ def test_a_streamed_run_records_what_a_run_in_memory_records(nominal_plant, tmp_
     # Same compiled chunks, same arithmetic: every record is bit-identical.
     for name, var in held.dataset.data_vars.items():
         assert np.array_equal(streamed.dataset[name].values, var.values), name
-    assert streamed.metrics() == {**held.metrics(), "wall_time_s": streamed.metrics()["wall_time_s"]}
+    timing = {"wall_time_s": streamed.metrics()["wall_time_s"]}
+    assert streamed.metrics() == {**held.metrics(), **timing}
     copy = streamed.to_netcdf(tmp_path / "copy.nc")  # copied, not loaded whole
     assert Result.from_netcdf(copy).dataset["q"].shape == held.dataset["q"].shape
 
