@@ -333,17 +333,17 @@ def animate_mode(
 ) -> Path:
     """Write a GIF of one mode shape oscillating over one period.
 
-    The satellite is drawn in 3-D at q(t) = a phi cos(2 pi t / T), t = k T / frames
-    for k = 0 .. frames-1, so the first frame (what a viewer that shows no
-    animation, or a printed page, shows) is the peak deformation (T = 1 / f; a
-    rigid-body mode, f = 0, is shown as the same oscillation with no time scale).
-    The undeformed satellite is dashed grey, the deformed one solid with shaded
-    panels, with the hub body axes X_B, Y_B, Z_B in red, green, blue. The axes (frame N, metres) have one scale on X, Y and Z
-    and limits fixed over the whole period, so the picture does not jump. The title
+    The satellite is drawn in 3-D at q(t) = a phi cos(2 pi t / T), t = k T / frames for
+    k = 0 .. frames-1, so the first frame (what a viewer that shows no animation, or a
+    printed page, shows) is the peak deformation (T = 1 / f; a rigid-body mode, f = 0,
+    is shown as the same oscillation with no time scale). The undeformed satellite is
+    dashed grey, the deformed one solid with shaded panels, with the hub body axes X_B,
+    Y_B, Z_B in red, green, blue. The axes (frame N, metres) have one scale on X, Y and
+    Z and limits fixed over the whole period, so the picture does not jump. The title
     gives the mode index, frequency, kind, symmetry, the hub DOF it drives and the
-    magnification of the motion; a footer gives the time within the period.
-    Rendered with Agg by blitting (560 x 448 px at the default size), written with
-    a :class:`matplotlib.animation.PillowWriter` and one shared 255-colour palette.
+    magnification of the motion; a footer gives the time within the period. Rendered
+    with Agg by blitting (560 x 448 px at the default size), written with a
+    :class:`matplotlib.animation.PillowWriter` and one shared 255-colour palette.
 
     Parameters
     ----------
