@@ -4,8 +4,8 @@
 tables of bench_dynamics, bench_openloop, bench_slew, bench_scaling, bench_startup,
 bench_campaigns, bench_figures, bench_demo and bench_basilisk (skipped with a line
 when Basilisk or the script is missing), then one table of the performance targets:
-each target, the measured value, and met / not met. A benchmark that fails is reported and the others still
-run; the exit status is then 1.
+each target, the measured value, and met / not met. A benchmark that fails is
+reported and the others still run; the exit status is then 1.
 
 Options: ``--quick`` passes ``--quick`` to bench_openloop (its plain NumPy baseline
 then runs shorter and is extrapolated: about 15 s instead of about 4 minutes); names
