@@ -54,9 +54,10 @@ EULER = (("roll", "φ"), ("pitch", "θ"), ("yaw", "ψ"))
 BAND = "tab:green"
 """Colour of requirement bands and settling markers."""
 MAX_LINE_POINTS = 3000
-"""Longer records are drawn as a min/max envelope of about this many points: a figure
-at most 14 in wide at 120 dpi has under 1700 pixel columns, and the envelope keeps a
-minimum and a maximum per column, so nothing it can show is lost."""
+"""Longer records are drawn as a min/max envelope of about this many points: the axes
+of a figure at most 14 in wide at 120 dpi span under 1500 pixel columns, and the
+envelope keeps a minimum and a maximum per 1/1500 of the record, so nothing a column
+can show is lost."""
 
 
 def figure(nrows: int, ncols: int = 1, *, size=(11.0, 7.5), sharex=True, **grid) -> tuple:
