@@ -120,6 +120,10 @@ def run_slew(
     data = _loop_data(layout, scenario, J)
     stages = LoopStages((layout.sensor.step,), (law.step,), (layout.actuator.step,))
     show = steps >= PROGRESS_MIN_STEPS if progress is None else progress
+    if controller is None:  # compile or load the loop now (0 steps): the wall time is the run's
+        idle = LoopClock(0.0, scenario.dt_s, 0, False, scenario.control_every, every)
+        rk4_closed_loop(x.copy(), idle, stages, data, LoopRecords(rec_t, rec_x, rec_ctrl, 0),
+                        plant.packed)  # fmt: skip
     start = time.perf_counter()
     with progress_bar(show, scenario.duration_s) as (bar, task):
         if controller is None:
