@@ -270,10 +270,13 @@ def _compile(ctx: StudyContext, console: Console) -> float:
                   "them from the disk cache)...", highlight=False)  # fmt: skip
     start = time.perf_counter()
     short = {"duration_s": 0.02, "record_dt_s": 0.01}
-    run_openloop(ctx.plant, OpenLoopScenario.model_validate(short), progress=False)
-    for kind in ctx.laws:
-        scenario = SlewScenario.model_validate({**short, "controller": {"kind": kind}})
-        run_slew(ctx.plant, scenario, progress=False)
+    try:
+        run_openloop(ctx.plant, OpenLoopScenario.model_validate(short), progress=False)
+        for kind in ctx.laws:
+            scenario = SlewScenario.model_validate({**short, "controller": {"kind": kind}})
+            run_slew(ctx.plant, scenario, progress=False)
+    except Exception:  # the part that needs it reports the problem
+        pass
     elapsed = time.perf_counter() - start
     console.print(f"compiled in {elapsed:.1f} s; the wall times below exclude it",
                   highlight=False)  # fmt: skip

@@ -11,8 +11,15 @@ its section; the sections of the other parts are written as usual.
 
 Sections follow the thesis: the configuration (section 3.1), the model's M(0) and
 rigid inertia (appendix B), the coupled modes (table 3.3), the open-loop validation
-(section 3.3), the ASMC slew and its requirements (section 5.1), the controller
-comparison, and the campaigns (chapter 5).
+(section 3.3), the ASMC slew and its requirements (section 5.1), the frequency-domain
+analysis of its law (loop margins with the flexible modes), the controller
+comparison, and the campaigns (chapter 5). :data:`SECTIONS` lists them; a new section
+is one drawing function and one entry there (docs/results.md, 'The study report').
+
+The page reads as a design review: a numbered table of contents, figures at full
+width that open at full size on a click, each mode's still at its peak deformation
+beside its animation, sortable tables, a caveat at the top of each section whose
+thesis comparison does not apply to the configuration, and a print layout.
 """
 
 from __future__ import annotations
