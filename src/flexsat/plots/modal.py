@@ -498,9 +498,12 @@ def write_modal_figures(
         _shape(analysis, k)  # validate every index before writing anything
     static = {"interaction_map": plot_interaction_map, "frequencies": plot_frequencies}
     written = style.write_figures(out, static, lambda name: static[name](analysis), dpi=150)
-    for k in chosen:
+    def animate(k: int) -> list[Path]:
         still = out / f"mode_{int(k)}.png"
         gif = animate_mode(analysis, int(k), out / f"mode_{int(k)}.gif", frames=frames, fps=fps,
                            still=still)  # fmt: skip
-        written += [still, gif]
+        return [still, gif]
+
+    for pair in style.forked_map(animate, chosen):  # drawn in parallel, listed in order
+        written += pair
     return written

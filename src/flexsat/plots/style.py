@@ -37,6 +37,7 @@ __all__ = [
     "figure",
     "figure_workers",
     "finish_time_axis",
+    "forked_map",
     "line",
     "positive",
     "save_figure",
@@ -158,18 +159,49 @@ def figure_workers() -> int:
     """
     if "fork" not in multiprocessing.get_all_start_methods():
         return 1
+    if multiprocessing.current_process().daemon:  # a pool's worker may not have children
+        return 1
     given = os.environ.get("FLEXSAT_FIGURE_WORKERS")
     if given is not None and given.strip().isdigit():
         return max(1, int(given))
     return max(1, min(2, os.cpu_count() or 1))
 
 
-_JOB: tuple | None = None  # (folder, draw, dpi) of the set being drawn, inherited by forks
+_JOB: Callable | None = None  # the job of the running map, inherited by the forks
 
 
-def _draw_one(name: str) -> Path:
-    out, draw, dpi = _JOB
-    return save_figure(draw(name), out / f"{name}.png", dpi=dpi)
+def _run_job(item):
+    return _JOB(item)
+
+
+def forked_map(job: Callable, items: Iterable, workers: int | None = None) -> list:
+    """``[job(item) for item in items]``, by forked processes when there are several.
+
+    Parameters
+    ----------
+    job : callable
+        Called once per item; a closure is fine (forked processes inherit it, only
+        the items and the results are pickled).
+    items : iterable
+    workers : int, optional
+        Processes; default :func:`figure_workers`, at most one per item.
+
+    Returns
+    -------
+    list
+        The results, in the order of ``items``.
+    """
+    global _JOB
+    items = list(items)
+    workers = min(figure_workers() if workers is None else workers, len(items))
+    if workers <= 1:
+        return [job(item) for item in items]
+    _JOB = job
+    try:
+        with multiprocessing.get_context("fork").Pool(workers) as pool:
+            return pool.map(_run_job, items, chunksize=1)
+    finally:
+        _JOB = None
 
 
 def write_figures(
@@ -203,16 +235,7 @@ def write_figures(
     list of Path
         The files written, in the order of ``names``.
     """
-    global _JOB
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
-    names = list(names)
-    workers = min(figure_workers() if workers is None else workers, len(names))
-    _JOB = (out, draw, dpi)
-    try:
-        if workers <= 1:
-            return [_draw_one(name) for name in names]
-        with multiprocessing.get_context("fork").Pool(workers) as pool:
-            return pool.map(_draw_one, names, chunksize=1)
-    finally:
-        _JOB = None
+    return forked_map(lambda name: save_figure(draw(name), out / f"{name}.png", dpi=dpi),
+                      names, workers)  # fmt: skip
