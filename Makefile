@@ -3,14 +3,21 @@ PYTHON ?= python3
 VENV   := .venv
 BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.installed
+DEV    := $(VENV)/.installed-dev
 
 .PHONY: demo test bench lint clean chromium
 
+# The demo installs what the study needs and nothing else (no test or lint tools).
 $(STAMP): pyproject.toml
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install --quiet --upgrade pip
-	$(BIN)/python -m pip install --quiet -e '.[dev]'
+	$(BIN)/python -m pip install --quiet -e .
 	touch $(STAMP)
+
+# Tests, lint and benchmarks add the dev extra (pytest, hypothesis, ruff, playwright).
+$(DEV): $(STAMP)
+	$(BIN)/python -m pip install --quiet -e '.[dev]'
+	touch $(DEV)
 
 demo: $(STAMP)
 	$(BIN)/flexsat study --quick --out out
@@ -26,14 +33,14 @@ chromium:
 	    { $$SUDO apt-get update -q && $$SUDO env DEBIAN_FRONTEND=noninteractive apt-get install -y -q chromium; }; } >/dev/null 2>&1 || \
 	  echo "Chromium could not be installed: the report's browser test will be skipped."; }
 
-test: $(STAMP) chromium
+test: $(DEV) chromium
 	$(BIN)/ruff check src tests bench examples
 	$(BIN)/python -m pytest -q
 	$(MAKE) docs
 
 # Every benchmark and the table of performance targets (docs/performance.md); the
 # optional `bench` extra adds Basilisk, the peer flexsat is compared with.
-bench: $(STAMP)
+bench: $(DEV)
 	$(BIN)/python -m pip install --quiet -e '.[dev,bench]'
 	$(BIN)/python bench/run_all.py
 
@@ -49,7 +56,7 @@ docs: $(DOCS_STAMP)
 	MPLBACKEND=Agg $(BIN)/python -m sphinx -W --keep-going -q docs docs/_build/html
 	@echo "Documentation: $(CURDIR)/docs/_build/html/index.html"
 
-lint: $(STAMP)
+lint: $(DEV)
 	$(BIN)/ruff check src tests bench examples
 
 clean:

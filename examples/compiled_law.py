@@ -24,7 +24,6 @@ from numba import njit
 from pydantic import Field
 
 from flexsat import Plant, nominal
-from flexsat.analysis import slew_metrics
 from flexsat.control import Channel, LawConfig, LawSpec, register_law
 from flexsat.control.laws import LAW_SIGNATURE
 from flexsat.control.quaternion import quaternion_error
@@ -120,7 +119,7 @@ DURATION_S = float(os.environ.get("FLEXSAT_EXAMPLE_DURATION_S", 120.0))  # [s]
 
 scenario = SlewScenario.model_validate({"duration_s": DURATION_S, "controller": {"kind": "qpid"}})
 result = run_slew(Plant.from_config(nominal()), scenario)
-metrics = slew_metrics(result.dataset)  # the requirements of the stored scenario
+metrics = result.metrics()  # the requirements of the stored scenario
 for key in ("final_pointing_error_deg", "settling_time_s", "r1_pass", "r2_pass", "r3_pass"):
     print(f"{key:26s} {metrics[key]}")
 plot_pointing(result.dataset)

@@ -230,3 +230,7 @@ def test_cli_campaign_json(tmp_path):
     )  # fmt: skip
     assert replay.returncode == 0, replay.stderr
     assert (tmp_path / "replays" / "random-00001.nc").exists()
+    # The replay prints the case's metrics, those the store holds for it.
+    stored = json.loads((tmp_path / "cases" / "random-00001.json").read_text())["metrics"]
+    assert "r1_pass" in replay.stdout and "final_pointing_error_deg" in replay.stdout
+    assert f"{stored['final_pointing_error_deg']:.6g}" in replay.stdout

@@ -125,11 +125,31 @@ def test_write_modal_figures(analysis: ModalAnalysis, tmp_path: Path) -> None:
     out = tmp_path / "new" / "figures"
     written = write_modal_figures(analysis, out, mode_indices=[9, 12], frames=3)
     assert [p.name for p in written] == [
-        "interaction_map.png", "frequencies.png", "mode_9.gif", "mode_12.gif",
+        "interaction_map.png", "frequencies.png", "mode_9.png", "mode_9.gif", "mode_12.png",
+        "mode_12.gif",
     ]  # fmt: skip
     assert all(p.parent == out and p.is_file() for p in written)
-    assert _is_png(written[0]) and _is_png(written[1])
-    assert _gif_frames(written[2]) == 3 and _gif_frames(written[3]) == 3
+    assert _is_png(written[0]) and _is_png(written[1]) and _is_png(written[2])
+    assert _gif_frames(written[3]) == 3 and _gif_frames(written[5]) == 3
+
+
+def test_the_still_and_the_first_frame_show_the_peak_deformation(
+    analysis: ModalAnalysis, tmp_path: Path
+) -> None:
+    # q = a phi cos(2 pi k / 4): frame 0 is the peak, frame 1 the undeformed satellite.
+    from PIL import Image, ImageSequence
+
+    gif = animate_mode(analysis, 7, tmp_path / "m7.gif", frames=4, still=tmp_path / "m7.png")
+    with Image.open(gif) as movie:
+        frames = [np.asarray(f.convert("L"), dtype=float) for f in ImageSequence.Iterator(movie)]
+    with Image.open(tmp_path / "m7.png") as still:
+        still_px = np.asarray(still.convert("L"), dtype=float)
+    assert still_px.shape == frames[0].shape
+    # The GIF's shared palette moves grey levels by up to 3 units out of 255 (white is
+    # 252): the still matches frame 0 within that, and the undeformed frame 1 not.
+    to_first = np.abs(still_px - frames[0])
+    assert np.percentile(to_first, 99) <= 4.0
+    assert (np.abs(still_px - frames[1]) > 40.0).mean() > 20 * (to_first > 40.0).mean() + 1e-3
     with pytest.raises(ValueError, match="1-based"):
         write_modal_figures(analysis, tmp_path / "bad", mode_indices=[99])
     assert not (tmp_path / "bad" / "interaction_map.png").exists()

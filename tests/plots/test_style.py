@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import numpy as np
+import pytest
 import xarray as xr
 
 from flexsat.plots import style
@@ -49,12 +50,26 @@ def test_write_figures_writes_in_order_and_creates_the_folder(tmp_path):
         return fig
 
     out = tmp_path / "a" / "b"
-    written = style.write_figures(out, ("second", "first"), draw, dpi=20)
-    assert drawn == ["second", "first"]
+    written = style.write_figures(out, ("second", "first"), draw, dpi=20, workers=1)
+    assert drawn == ["second", "first"]  # drawn here, in order
     assert written == [out / "second.png", out / "first.png"]
     assert all(p.read_bytes().startswith(PNG_MAGIC) for p in written)
     assert style.write_figures(tmp_path / "empty", (), draw, dpi=20) == []
     assert (tmp_path / "empty").is_dir()  # the folder exists even with nothing to draw
+
+
+@pytest.mark.skipif(style.figure_workers() < 2, reason="no forked drawing processes here")
+def test_figures_drawn_by_forked_processes_are_the_same_files(tmp_path):
+    def draw(name):  # a closure: forked workers inherit it, nothing is pickled
+        fig, axes = style.figure(1, 1, size=(2.0, 2.0))
+        style.line(axes[0, 0], np.arange(3.0), np.arange(3.0) * len(name))
+        return fig
+
+    names = ("c", "bb", "a", "dddd")
+    here = style.write_figures(tmp_path / "here", names, draw, dpi=20, workers=1)
+    forked = style.write_figures(tmp_path / "forked", names, draw, dpi=20, workers=2)
+    assert [p.name for p in forked] == [p.name for p in here] == [f"{n}.png" for n in names]
+    assert [p.read_bytes() for p in forked] == [p.read_bytes() for p in here]
 
 
 def test_save_figure_releases_the_figure(tmp_path):

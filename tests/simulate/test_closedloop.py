@@ -11,10 +11,8 @@ from flexsat.simulate import SlewScenario, design_inertia, run_slew
 from tests.conftest import config_from, variant
 
 
-def _metrics(result, scenario=None):
-    scenario = scenario or SlewScenario()
-    req = scenario.requirements
-    return slew_metrics(result.dataset, req.pointing_deg, req.jitter_deg_s, 2.0)
+def _metrics(result):
+    return slew_metrics(result.dataset)  # the stored scenario's requirements
 
 
 @pytest.fixture(scope="module")
@@ -90,7 +88,7 @@ def test_explicit_design_inertia_of_the_scenario_is_used(nominal_plant):
 @pytest.mark.parametrize("kind", ["smc", "pd"])
 def test_baselines_fly_the_same_slew(nominal_plant, kind):
     scenario = SlewScenario.model_validate({"controller": {"kind": kind}})
-    metrics = _metrics(run_slew(nominal_plant, scenario), scenario)
+    metrics = _metrics(run_slew(nominal_plant, scenario))
     assert metrics["r3_pass"]
     # Both converge near the target; the PD has no integral action, so the
     # constant disturbances leave it a standing error (~0.08 deg), which is the
@@ -100,7 +98,7 @@ def test_baselines_fly_the_same_slew(nominal_plant, kind):
 
 def test_lambda_dot_switch(nominal_plant):
     scenario = SlewScenario.model_validate({"controller": {"include_lambda_dot": True}})
-    metrics = _metrics(run_slew(nominal_plant, scenario), scenario)
+    metrics = _metrics(run_slew(nominal_plant, scenario))
     assert metrics["r1_pass"] and metrics["r3_pass"]
 
 
@@ -114,7 +112,7 @@ def test_slews_are_deterministic(nominal_plant):
 def test_control_sampling_slower_than_the_plant(nominal_plant):
     # A 10 ms controller (zero-order hold over 10 plant steps) still flies the slew.
     scenario = SlewScenario(control_dt_s=0.01)
-    metrics = _metrics(run_slew(nominal_plant, scenario), scenario)
+    metrics = _metrics(run_slew(nominal_plant, scenario))
     assert metrics["r1_pass"] and metrics["r3_pass"]
     held = run_slew(nominal_plant, SlewScenario(control_dt_s=0.01, duration_s=0.1))
     tau = held.dataset["tau_cmd"].values  # records every 10 ms: a new value each
@@ -147,7 +145,7 @@ def test_residual_disturbance_switch_still_meets_r1(nominal_plant):
     # residual roughly doubles the steady-state error, still inside R1 (measured
     # 4.6e-3 deg against 2.3e-3 deg).
     scenario = SlewScenario.model_validate({"disturbances": {"residual_nm": [0.005] * 3}})
-    metrics = _metrics(run_slew(nominal_plant, scenario), scenario)
+    metrics = _metrics(run_slew(nominal_plant, scenario))
     assert metrics["r1_pass"] and metrics["r3_pass"]
     assert 1.5e-3 < metrics["final_pointing_error_deg"] < 0.05
 

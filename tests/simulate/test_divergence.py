@@ -60,3 +60,33 @@ def test_the_pitch_pole_stops_neither_solver(nominal_plant, tmp_path, solver):
     assert pitch.max() > 89.99
     assert pitch[-1] == pytest.approx(82.0, abs=1e-9)
     assert _all_finite(metrics)
+
+
+# 1 MN m of constant environment torque on every axis against a 1e7 N m actuator:
+# the PD law cannot hold it and the state overflows within the first 0.1 s.
+_HUGE_DISTURBANCE = {
+    "duration_s": 20.0, "controller": {"kind": "pd"}, "actuator": {"t_max_nm": 1e7},
+    "disturbances": {"environment_nm": [1e6, 1e6, 1e6]},
+}  # fmt: skip
+
+
+def test_a_diverging_slew_keeps_its_history_and_metrics_of_its_finite_part(
+    nominal_plant, tmp_path
+):
+    from flexsat.simulate import SlewScenario
+    from flexsat.study.outputs import fly_slew
+
+    scenario = validate_config(_HUGE_DISTURBANCE, model=SlewScenario)
+    result, metrics = fly_slew(nominal_plant, scenario, tmp_path, progress=False)
+    stored = json.loads((tmp_path / "metrics.json").read_text())
+    history = Result.from_netcdf(tmp_path / "result.nc").dataset
+    assert not result.ok and "non-finite" in result.message
+    assert stored["status"] == "failed" and stored["finite_until_s"] <= history["time"][-1]
+    assert 0.0 < stored["finite_until_s"] < 0.1
+    assert not stored["r1_pass"] and not stored["r2_pass"]  # stopped before the window
+    # NaN is a quantity that does not exist (a settling time, the APE of a window the run
+    # never reached); nothing is infinite: the metrics read the finite records only.
+    numbers = [v for value in metrics.values()
+               for v in (value if isinstance(value, list) else [value]) if isinstance(v, float)]
+    assert not any(math.isinf(v) for v in numbers)
+    assert math.isnan(metrics["ape_deg"]) and math.isnan(metrics["settling_time_s"])

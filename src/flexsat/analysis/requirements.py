@@ -222,14 +222,7 @@ def _stored_scenario(ds: xr.Dataset) -> dict:
     return json.loads(text) if text else {}
 
 
-def slew_metrics(
-    ds: xr.Dataset,
-    pointing_deg: float | None = None,
-    jitter_deg_s: float | None = None,
-    t_max_nm: float | None = None,
-    *,
-    requirements: Requirements | None = None,
-) -> dict:
+def slew_metrics(ds: xr.Dataset, *, requirements: Requirements | None = None) -> dict:
     """Requirement verdicts and figures of merit of a closed-loop run.
 
     Parameters
@@ -237,14 +230,11 @@ def slew_metrics(
     ds : xarray.Dataset
         Closed-loop result (``pointing_error_deg``, ``rate_error_deg_s``,
         ``quaternion``, torques, ``lambda_act``; ``attrs["scenario"]``, the stored
-        slew scenario, gives the requirements, T_max and the planned duration).
-    pointing_deg, jitter_deg_s : float, optional
-        R1 [deg] and R2 [deg/s] bands; default the stored scenario's.
-    t_max_nm : float, optional
-        R3 limit T_max per axis [N m]; default the stored scenario's actuator's.
+        slew scenario, gives the requirements, T_max and the planned duration:
+        nothing is asked again).
     requirements : Requirements, optional
-        Bands and observation window; default the stored scenario's (the thesis's
-        when the dataset stores none). ``pointing_deg``/``jitter_deg_s`` override it.
+        Other bands and observation window than the stored scenario's (a what-if);
+        default the stored scenario's (the thesis's when the dataset stores none).
 
     Returns
     -------
@@ -260,16 +250,16 @@ def slew_metrics(
         Settling times are when each quantity enters its band for good (NaN if not
         by the end): ``settling_time_s`` is R1's, ``r2_settling_time_s`` R2's.
         ``lambda_switch_time_s`` is when Lambda first leaves its initial value (NaN
-        if it never does, or the law has no Lambda).
+        if it never does, or the law has no Lambda). A diverged run's metrics are
+        those of its finite part (:func:`flexsat.analysis.openloop.finite_part`);
+        ``finite_until_s`` says where that ends.
     """
+    from flexsat.analysis.openloop import finite_part
+
+    ds = finite_part(ds)
     stored = _stored_scenario(ds)
     req = requirements or Requirements.model_validate(stored.get("requirements", {}))
-    bands = {"pointing_deg": pointing_deg, "jitter_deg_s": jitter_deg_s}
-    req = Requirements.model_validate(
-        {**req.model_dump(), **{k: v for k, v in bands.items() if v is not None}}
-    )
-    if t_max_nm is None:
-        t_max_nm = float(stored.get("actuator", {}).get("t_max_nm", 2.0))
+    t_max_nm = float(stored.get("actuator", {}).get("t_max_nm", 2.0))
     t = ds["time"].values
     pointing = ds["pointing_error_deg"].values
     jitter = ds["rate_error_deg_s"].values
@@ -312,6 +302,7 @@ def slew_metrics(
         "peak_tip_displacement_m": float(
             np.linalg.norm(ds["tip_displacement"].values, axis=-1).max()
         ),
+        "finite_until_s": float(t[-1]),
         "wall_time_s": float(ds.attrs["wall_time_s"]),
         "steps": int(ds.attrs["steps"]),
         "status": str(ds.attrs["status"]),

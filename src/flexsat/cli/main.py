@@ -434,6 +434,55 @@ def animate(
 
 
 @app.command()
+def plot(
+    result: Annotated[Path, typer.Argument(help="A result file written by flexsat (NetCDF).")],
+    kind: Annotated[
+        list[str] | None,
+        typer.Option("--kind", "-k", help="Figure to draw (repeatable); default: every one."),
+    ] = None,
+    out: Annotated[
+        Path | None, typer.Option(help="Folder of the PNG files (default: beside RESULT).")
+    ] = None,
+    list_kinds: Annotated[
+        bool, typer.Option("--list", help="List the figures this result can draw and stop.")
+    ] = False,
+) -> None:
+    """Draw the figures of a stored run (open loop or slew): OUT/KIND.png.
+
+    The run's kind (open loop or slew) and the law that flew it decide which
+    figures exist: --list shows them.
+    """
+    from flexsat.simulate.result import Result
+
+    if not result.is_file():
+        raise FlexsatError(f"RESULT {result}: no such file")
+    try:
+        loaded = Result.from_netcdf(result)
+    except (OSError, ValueError) as exc:
+        raise FlexsatError(f"RESULT {result}: not a NetCDF result ({exc})") from None
+    if "q" not in loaded.dataset or "config" not in loaded.dataset.attrs:
+        raise FlexsatError(f"RESULT {result}: not a flexsat simulation result")
+    names = loaded.figure_kinds()
+    if list_kinds:
+        for name in names:
+            _console.print(name)
+        return
+    chosen = tuple(kind or names)
+    unknown = [k for k in chosen if k not in names]
+    if unknown:
+        raise FlexsatError(
+            f"--kind {unknown[0]}: not a figure of this {loaded.kind} run; choose one of "
+            + ", ".join(names)
+        )
+    from flexsat.plots.results import write_result_figures
+    from flexsat.study.outputs import prepare_output_dir
+
+    folder = prepare_output_dir(out if out is not None else result.parent)
+    for path in write_result_figures(loaded.dataset, folder, chosen):
+        _console.print(f"wrote {path}")
+
+
+@app.command()
 def campaign(
     name: Annotated[
         str,
@@ -489,7 +538,12 @@ def campaign(
         result = replay_case(store, case_id)
         target = Path(store) / "replays" / f"{case_id}.nc"
         result.to_netcdf(target)
-        _console.print(f"replayed {case_id}: {result.dataset.attrs['status']}; wrote {target}")
+        metrics = result.metrics()  # R1-R3 from the case's stored scenario
+        if json_output:
+            typer.echo(json.dumps(jsonable({**metrics, "files": [str(target)]})))
+            return
+        _print_metrics({**metrics, "files": [str(target)]}, f"Replay of {case_id}")
+        _console.print(f"replayed {case_id}: {result.dataset.attrs['status']}")
         return
     if scheduler and dask_local:
         raise FlexsatError("give either --scheduler or --dask-local, not both")
@@ -658,14 +712,34 @@ def config_show(config: ConfigOption = None, json_output: JsonOption = False) ->
 
 @config_app.command("preset")
 def config_preset(
-    name: Annotated[str, typer.Argument(help="Preset name, e.g. 'nominal'.")] = "nominal",
+    name: Annotated[
+        str, typer.Argument(help="Template name (see --list), e.g. 'nominal' or 'slew'.")
+    ] = "nominal",
     output: Annotated[
-        Path | None, typer.Option("--output", "-o", help="Copy the preset to this file.")
+        Path | None, typer.Option("--output", "-o", help="Copy the template to this file.")
     ] = None,
+    list_templates: Annotated[
+        bool, typer.Option("--list", help="List the templates: satellite, scenarios, campaigns.")
+    ] = False,
 ) -> None:
-    """Print a shipped preset, or copy it to a file you can edit."""
-    from flexsat.config import preset_path
+    """Print a shipped template (satellite, scenario, campaign), or copy it to edit.
 
+    Every template is commented line by line: units, allowed ranges, and which
+    command reads it. --list names them all.
+    """
+    from flexsat.campaigns.definition import CAMPAIGN_PRESETS
+    from flexsat.config import TEMPLATES, preset_path
+
+    if list_templates:
+        table = Table(title="Templates (flexsat config preset NAME -o FILE)")
+        table.add_column("name", no_wrap=True)
+        table.add_column("what it is")
+        for key, what in TEMPLATES.items():
+            table.add_row(key, what)
+        _console.print(table)
+        _console.print("The thesis's campaigns run by name: flexsat campaign "
+                       + " | ".join(CAMPAIGN_PRESETS))  # fmt: skip
+        return
     source = preset_path(name)
     if output is None:
         typer.echo(source.read_text())

@@ -1,10 +1,18 @@
 """Validated satellite configuration: models, presets and TOML loading."""
 
-from flexsat.config.load import PRESETS, load_config, nominal, preset_path, validate_config
+from flexsat.config.load import (
+    PRESETS,
+    TEMPLATES,
+    load_config,
+    nominal,
+    preset_path,
+    validate_config,
+)
 from flexsat.config.models import AppendageConfig, HubConfig, SatelliteConfig, TargetFrequencies
 
 __all__ = [
     "PRESETS",
+    "TEMPLATES",
     "AppendageConfig",
     "HubConfig",
     "SatelliteConfig",

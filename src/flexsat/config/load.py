@@ -13,19 +13,41 @@ from pydantic import BaseModel, Tag, ValidationError
 from flexsat.config.models import SatelliteConfig
 from flexsat.errors import ConfigError, shorten
 
-__all__ = ["PRESETS", "load_config", "nominal", "preset_path", "read_toml", "validate_config"]
+__all__ = [
+    "PRESETS",
+    "TEMPLATES",
+    "load_config",
+    "nominal",
+    "preset_path",
+    "read_toml",
+    "validate_config",
+]
 
+TEMPLATES = {
+    "nominal": "satellite: the thesis's case study, table 3.1 (--config FILE)",
+    "chain": "satellite: the nominal hub, each panel an 8-segment chain (--config FILE)",
+    "openloop": "open-loop scenario: the thesis's 1 N m yaw pulse (openloop --scenario FILE)",
+    "slew": "slew scenario, every loop stage documented (slew --scenario FILE)",
+    "avionics-slew": "slew scenario with gyro, star tracker, MEKF and reaction wheels "
+    "(slew --scenario FILE)",
+    "campaign-cases": "campaign of explicit cases, one change each (campaign FILE)",
+    "campaign-grid": "campaign crossing the levels of several axes (campaign FILE)",
+    "campaign-random": "Monte Carlo campaign, values drawn per case (campaign FILE)",
+}
+"""Every shipped TOML template, commented line by line: name -> what it is (and the
+option that reads it)."""
 PRESETS = ("nominal", "chain")
+"""The satellite presets among :data:`TEMPLATES`."""
 _MAX_REPORTED = 3  # problems listed in one error message
 
 
 def preset_path(name: str) -> Path:
-    """Path of a shipped preset TOML file (copy it to start your own).
+    """Path of a shipped template TOML file (a name of :data:`TEMPLATES`; copy it to edit).
 
     Parameters
     ----------
     name : str
-        The preset's name, e.g. ``"nominal"``.
+        The template's name, e.g. ``"nominal"``.
 
     Returns
     -------
@@ -34,10 +56,10 @@ def preset_path(name: str) -> Path:
     Raises
     ------
     ConfigError
-        If no preset has that name (the message lists them).
+        If ``name`` is not a template; the message lists them.
     """
-    if name not in PRESETS:
-        raise ConfigError(f"unknown preset {name!r}; available: {', '.join(PRESETS)}")
+    if name not in TEMPLATES:
+        raise ConfigError(f"unknown preset {name!r}; available: {', '.join(TEMPLATES)}")
     return Path(str(resources.files("flexsat.config") / "presets" / f"{name}.toml"))
 
 

@@ -21,6 +21,7 @@ from matplotlib.axes import Axes
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
+from PIL import Image
 
 from flexsat.analysis.modal import ModalAnalysis, Mode
 from flexsat.dynamics.plant import Plant
@@ -329,19 +330,21 @@ def animate_mode(
     amplitude: float | None = None,
     frames: int = 48,
     fps: int = 24,
+    still: str | Path | None = None,
 ) -> Path:
     """Write a GIF of one mode shape oscillating over one period.
 
-    The satellite is drawn in 3-D at q(t) = a phi sin(2 pi t / T), t = k T / frames
-    for k = 0 .. frames-1 (T = 1 / f; a rigid-body mode, f = 0, is shown as the
-    same oscillation with no time scale). The undeformed satellite is dashed grey,
-    the deformed one solid with shaded panels, with the hub body axes X_B, Y_B, Z_B
-    in red, green, blue. The axes (frame N, metres) have one scale on X, Y and Z
-    and limits fixed over the whole period, so the picture does not jump. The title
+    The satellite is drawn in 3-D at q(t) = a phi cos(2 pi t / T), t = k T / frames for
+    k = 0 .. frames-1, so the first frame (what a viewer that shows no animation, or a
+    printed page, shows) is the peak deformation (T = 1 / f; a rigid-body mode, f = 0,
+    is shown as the same oscillation with no time scale). The undeformed satellite is
+    dashed grey, the deformed one solid with shaded panels, with the hub body axes X_B,
+    Y_B, Z_B in red, green, blue. The axes (frame N, metres) have one scale on X, Y and
+    Z and limits fixed over the whole period, so the picture does not jump. The title
     gives the mode index, frequency, kind, symmetry, the hub DOF it drives and the
-    magnification of the motion; a footer gives the time within the period.
-    Rendered with Agg by blitting (560 x 448 px at the default size), written with
-    a :class:`matplotlib.animation.PillowWriter` and one shared 255-colour palette.
+    magnification of the motion; a footer gives the time within the period. Rendered
+    with Agg by blitting (560 x 448 px at the default size), written with a
+    :class:`matplotlib.animation.PillowWriter` and one shared 255-colour palette.
 
     Parameters
     ----------
@@ -360,6 +363,8 @@ def animate_mode(
     fps : int
         Playback rate [frames/s]; one period lasts ``frames / fps`` seconds on
         screen whatever the mode's real period.
+    still : str or Path, optional
+        Also write the first frame, the peak deformation, as this PNG.
 
     Returns
     -------
@@ -377,7 +382,7 @@ def animate_mode(
     a = mode_amplitude(analysis, mode_index) if amplitude is None else float(amplitude)
 
     rest = satellite_geometry(plant)
-    phases = np.sin(2.0 * np.pi * np.arange(frames) / frames)
+    phases = np.cos(2.0 * np.pi * np.arange(frames) / frames)  # frame 0: the peak
     shots = [satellite_geometry(plant, a * s * phi) for s in phases]
     peaks = [_panel_displacement(plant, sign * a * phi, rest) for sign in (1.0, -1.0)]
     peak = np.maximum(*peaks)
@@ -422,6 +427,9 @@ def animate_mode(
             clock.set_text(f"{when}   (playback {frames / fps:.3g} s per period)")
             fig.draw_artist(clock)
             writer.grab_frame()
+            if k == 0 and still is not None:
+                Image.frombuffer("RGBA", canvas.get_width_height(), canvas.buffer_rgba(),
+                                 "raw", "RGBA", 0, 1).convert("RGB").save(still)  # fmt: skip
     fig.clear()
     return path
 
@@ -476,8 +484,9 @@ def write_modal_figures(
     """Write the modal figures of an analysis into a folder.
 
     Files: ``interaction_map.png`` (:func:`plot_interaction_map`),
-    ``frequencies.png`` (:func:`plot_frequencies`) and ``mode_<k>.gif``
-    (:func:`animate_mode`, default amplitude) for each chosen mode.
+    ``frequencies.png`` (:func:`plot_frequencies`) and, for each chosen mode,
+    ``mode_<k>.png`` (its peak deformation) and ``mode_<k>.gif``
+    (:func:`animate_mode`, default amplitude).
 
     Parameters
     ----------
@@ -503,7 +512,12 @@ def write_modal_figures(
         _shape(analysis, k)  # validate every index before writing anything
     static = {"interaction_map": plot_interaction_map, "frequencies": plot_frequencies}
     written = style.write_figures(out, static, lambda name: static[name](analysis), dpi=150)
-    for k in chosen:
-        written.append(animate_mode(analysis, int(k), out / f"mode_{int(k)}.gif",
-                                    frames=frames, fps=fps))  # fmt: skip
+    def animate(k: int) -> list[Path]:
+        still = out / f"mode_{int(k)}.png"
+        gif = animate_mode(analysis, int(k), out / f"mode_{int(k)}.gif", frames=frames, fps=fps,
+                           still=still)  # fmt: skip
+        return [still, gif]
+
+    for pair in style.forked_map(animate, chosen):  # drawn in parallel, listed in order
+        written += pair
     return written

@@ -47,7 +47,10 @@ from flexsat.analysis.spectrogram import (
 from flexsat.plots import style
 
 __all__ = [
+    "MEANINGFUL_FRACTION",
     "OPENLOOP_FIGURES",
+    "OPENLOOP_MAKERS",
+    "meaningful_components",
     "plot_angular_acceleration",
     "plot_angular_momentum",
     "plot_attitude",
@@ -110,11 +113,14 @@ def _torque_patches(ds: xr.Dataset) -> list[Patch]:
 
 
 def plot_attitude(ds: xr.Dataset) -> Figure:
-    """Hub ZYX Euler angles [deg] (top row) and body rates omega [deg/s] (bottom row).
+    """Hub ZYX Euler angles [deg] and body rates omega [deg/s], one panel per signal.
 
-    One column per body axis (roll/x, pitch/y, yaw/z), each with its own scale, so
-    the small off-axis motion of an asymmetric satellite stays visible next to the
-    large yaw slew.
+    A signal is drawn when its peak exceeds :data:`MEANINGFUL_FRACTION` of the
+    largest peak of its kind (angles, rates); the others (the roll and pitch of a
+    symmetric satellite under a yaw torque, numerically zero) are named in the
+    title with their peak instead of getting a flat panel. Each panel has its own
+    scale, so the small off-axis motion of an asymmetric satellite stays visible
+    next to the large yaw slew.
 
     Parameters
     ----------
@@ -128,25 +134,46 @@ def plot_attitude(ds: xr.Dataset) -> Figure:
     t = style.time_s(ds)
     euler = np.asarray(ds["euler_deg"].values)
     rate = np.degrees(np.asarray(ds["omega"].values))
-    fig, axes = style.figure(2, 3, size=(13.0, 6.5))
+    signals, omitted = [], []
+    for values, unit, names in (
+        (euler, "deg", [f"{name} {symbol}" for name, symbol in style.EULER]),
+        (rate, "deg/s", [f"body rate ω_{a} (frame B)" for a in style.AXES]),
+    ):
+        shown = meaningful_components(values)
+        for k in range(3):
+            if k in shown:
+                signals.append((values[:, k], unit, names[k], k))
+            else:
+                peak = float(np.nanmax(np.abs(values[:, k])))
+                omitted.append(f"{names[k].split(' (')[0]} (peak {peak:.1g} {unit})")
+    fig, axes = style.figure(len(signals), 1, size=(11.0, 1.9 + 1.6 * len(signals)))
     _shade_torque(axes, ds)
-    for k in range(3):
-        name, symbol = style.EULER[k]
-        style.line(
-            axes[0, k], t, euler[:, k], color=style.AXIS_COLOURS[k], label=f"{symbol} ({name})"
-        )
-        axes[0, k].set_ylabel(f"{name} {symbol} [deg]")
-        axes[0, k].set_title(f"{name} angle {symbol}", fontsize=10)
-        style.line(
-            axes[1, k], t, rate[:, k], color=style.AXIS_COLOURS[k], label=f"ω_{style.AXES[k]}"
-        )
-        axes[1, k].set_ylabel(f"ω_{style.AXES[k]} [deg/s]")
-        axes[1, k].set_title(f"body rate ω_{style.AXES[k]} (frame B)", fontsize=10)
+    for ax, (values, unit, name, k) in zip(axes[:, 0], signals, strict=True):
+        style.line(ax, t, values, color=style.AXIS_COLOURS[k], label=name)
+        ax.set_ylabel(f"[{unit}]")
+        ax.set_title(name, fontsize=10, loc="left")
     if _shaded(ds):
         axes[0, 0].legend(handles=_torque_patches(ds), loc="upper left", fontsize=8)
     style.finish_time_axis(axes, t)
-    style.suptitle(fig, ds, "Hub attitude (ZYX Euler angles) and body rates")
+    title = "Hub attitude (ZYX Euler angles) and body rates"
+    if omitted:
+        title += "\nnot drawn, numerically zero: " + ", ".join(omitted)
+    style.suptitle(fig, ds, title)
     return fig
+
+
+MEANINGFUL_FRACTION = 1e-6
+"""A component whose peak is below this fraction of the largest one's is not drawn."""
+
+
+def meaningful_components(values: np.ndarray) -> list[int]:
+    """Columns of ``values`` (shape (m, n)) worth a panel: peak above a fraction of the top.
+
+    The column with the largest peak is always kept, so a flat record still shows.
+    """
+    peaks = np.nan_to_num(np.nanmax(np.abs(values), axis=0), nan=0.0)
+    top = float(peaks.max())
+    return [k for k in range(peaks.size) if peaks[k] > MEANINGFUL_FRACTION * top or peaks[k] == top]
 
 
 def plot_quaternion(ds: xr.Dataset) -> Figure:
@@ -710,17 +737,20 @@ def plot_spectrogram(
 # -- everything at once ----------------------------------------------------------------
 
 
-OPENLOOP_FIGURES = (
-    "attitude",
-    "quaternion",
-    "angular_acceleration",
-    "torques",
-    "root_deformation",
-    "tip_displacement",
-    "angular_momentum",
-    "energy",
-    "spectrogram",
-)
+OPENLOOP_MAKERS = {
+    "attitude": lambda ds, analysis: plot_attitude(ds),
+    "quaternion": lambda ds, analysis: plot_quaternion(ds),
+    "angular_acceleration": plot_angular_acceleration,
+    "torques": lambda ds, analysis: plot_torques(ds),
+    "root_deformation": lambda ds, analysis: plot_root_deformation(ds),
+    "tip_displacement": lambda ds, analysis: plot_tip_displacement(ds),
+    "angular_momentum": lambda ds, analysis: plot_angular_momentum(ds),
+    "energy": lambda ds, analysis: plot_energy(ds),
+    "spectrogram": lambda ds, analysis: plot_spectrogram(ds, analysis, "z"),
+}
+"""Each open-loop figure's drawing function, ``(dataset, modal analysis or None) -> Figure``."""
+
+OPENLOOP_FIGURES = tuple(OPENLOOP_MAKERS)
 """Names (without ``.png``) of the files :func:`write_openloop_figures` writes, in order."""
 
 
@@ -756,15 +786,6 @@ def write_openloop_figures(
     list of Path
         The files written.
     """
-    makers = {
-        "attitude": lambda: plot_attitude(ds),
-        "quaternion": lambda: plot_quaternion(ds),
-        "angular_acceleration": lambda: plot_angular_acceleration(ds, analysis),
-        "torques": lambda: plot_torques(ds),
-        "root_deformation": lambda: plot_root_deformation(ds),
-        "tip_displacement": lambda: plot_tip_displacement(ds),
-        "angular_momentum": lambda: plot_angular_momentum(ds),
-        "energy": lambda: plot_energy(ds),
-        "spectrogram": lambda: plot_spectrogram(ds, analysis, "z"),
-    }
-    return style.write_figures(out_dir, OPENLOOP_FIGURES, lambda name: makers[name](), dpi=dpi)
+    return style.write_figures(
+        out_dir, OPENLOOP_FIGURES, lambda name: OPENLOOP_MAKERS[name](ds, analysis), dpi=dpi
+    )

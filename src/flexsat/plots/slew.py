@@ -60,6 +60,7 @@ __all__ = [
     "plot_flex_torque",
     "plot_phase_plane",
     "plot_pointing",
+    "plot_slew",
     "plot_slew_attitude",
     "plot_slew_energy",
     "plot_slew_quaternion",
@@ -68,6 +69,7 @@ __all__ = [
     "plot_sliding_variables",
     "plot_torque_breakdown",
     "plot_torque_limits",
+    "slew_figure_names",
     "write_slew_figures",
 ]
 
@@ -879,23 +881,6 @@ def plot_flex_torque(ds: xr.Dataset) -> Figure:
 # -- everything at once ----------------------------------------------------------------
 
 
-SLEW_FIGURES = (
-    "attitude",
-    "quaternion",
-    "pointing",
-    "phase_plane",
-    "sliding_variables",
-    "adaptation",
-    "disturbances",
-    "torque_limits",
-    "torque_breakdown",
-    "root_deformation",
-    "tip_displacement",
-    "flex_torque",
-    "energy",
-)
-"""Names (without ``.png``) of the files :func:`write_slew_figures` writes, in order."""
-
 _MAKERS = {
     "attitude": plot_slew_attitude,
     "quaternion": plot_slew_quaternion,
@@ -912,11 +897,32 @@ _MAKERS = {
     "energy": plot_slew_energy,
 }
 
+SLEW_FIGURES = tuple(_MAKERS)
+"""Names (without ``.png``) of every slew figure, in order (:func:`slew_figure_names`)."""
+
+_SURFACE_FIGURES = ("sliding_variables", "adaptation")
+
+
+def slew_figure_names(ds: xr.Dataset) -> tuple[str, ...]:
+    """The figures a run has something to show in, in the order of :data:`SLEW_FIGURES`.
+
+    A law without a sliding surface (PD, a plain-Python controller) records no
+    sliding variable, slope or robust gain: its run has no figure of them.
+    """
+    has_surface = _surface(ds) is not None and "sliding_variable" in ds
+    return tuple(n for n in SLEW_FIGURES if has_surface or n not in _SURFACE_FIGURES)
+
+
+def plot_slew(ds: xr.Dataset, name: str) -> Figure:
+    """The slew figure ``name`` (one of :data:`SLEW_FIGURES`) of a closed-loop run."""
+    return _MAKERS[name](ds)
+
 
 def write_slew_figures(ds: xr.Dataset, out_dir: str | Path, *, dpi: int = 120) -> list[Path]:
     """Write every figure of a closed-loop slew into a folder as PNG.
 
-    Files, in the order of :data:`SLEW_FIGURES`: ``attitude.png``
+    Files, in the order of :data:`SLEW_FIGURES` (those of :func:`slew_figure_names`:
+    no sliding-surface figures for a law without one): ``attitude.png``
     (:func:`plot_slew_attitude`), ``quaternion.png``, ``pointing.png``,
     ``phase_plane.png``, ``sliding_variables.png``, ``adaptation.png``,
     ``disturbances.png``, ``torque_limits.png``, ``torque_breakdown.png``,
@@ -940,4 +946,5 @@ def write_slew_figures(ds: xr.Dataset, out_dir: str | Path, *, dpi: int = 120) -
         The files written.
     """
     _scenario(ds)  # fail early on a dataset that is not a slew
-    return style.write_figures(out_dir, SLEW_FIGURES, lambda name: _MAKERS[name](ds), dpi=dpi)
+    names = slew_figure_names(ds)
+    return style.write_figures(out_dir, names, lambda name: _MAKERS[name](ds), dpi=dpi)

@@ -147,6 +147,10 @@ def run_slew(
         (layout.reference.step,), (layout.joint_actuator.step,),
     )  # fmt: skip
     show = steps >= PROGRESS_MIN_STEPS if progress is None else progress
+    if controller is None:  # compile or load the loop now (0 steps): the wall time is the run's
+        idle = LoopClock(0.0, scenario.dt_s, 0, False, scenario.control_every, every)
+        rk4_closed_loop(x.copy(), idle, stages, data, LoopRecords(rec_t, rec_x, rec_ctrl, 0),
+                        plant.packed)  # fmt: skip
     start = time.perf_counter()
     with progress_bar(show, scenario.duration_s) as (bar, task):
         if controller is None:
@@ -187,20 +191,20 @@ def run_slew(
     ta = ("time", "axis")
     for channel, columns in layout.channels():
         values = rec_ctrl[:, columns] if channel.per_axis else rec_ctrl[:, columns.start]
-        attributes = {"units": channel.units, "description": channel.description}
+        attributes = {"units": channel.units, "long_name": channel.description}
         ds[channel.name] = (ta if channel.per_axis else "time", values, attributes)
     # of the true attitude, whatever the sensor measured
     pointing = pointing_errors(target, np.ascontiguousarray(ds["q"].values[:, at.attitude]))
     ds["pointing_error_deg"] = (
         "time", np.degrees(pointing),
-        {"units": "deg", "description": "2 asin |q_v,e| of the true attitude from the "
+        {"units": "deg", "long_name": "2 asin |q_v,e| of the true attitude from the "
          "target: absolute pointing error"},
     )  # fmt: skip
     with np.errstate(over="ignore", invalid="ignore"):  # a diverged run's last state
         rate_error = np.degrees(np.linalg.norm(ds["omega"].values, axis=1))
     ds["rate_error_deg_s"] = (
         "time", rate_error,
-        {"units": "deg/s", "description": "|omega - omega_d|: residual rate (jitter)"},
+        {"units": "deg/s", "long_name": "|omega - omega_d|: residual rate (jitter)"},
     )  # fmt: skip
     return Result(ds)
 

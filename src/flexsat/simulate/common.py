@@ -95,15 +95,24 @@ class LongRunWarning(UserWarning):
 
 @dataclass(frozen=True)
 class RunEstimate:
-    """What a run will cost: steps, records, peak memory [bytes] and wall time [s]."""
+    """What a run will cost: steps, records, peak memory [bytes] and wall time [s].
+
+    ``fits_in_memory`` is False for a run whose records must be streamed to disk;
+    ``record_bytes`` is the size of one record [bytes] and ``available_bytes`` the
+    memory the records may use.
+    """
 
     steps: int
     records: int
     memory_bytes: float
     wall_time_s: float
+    fits_in_memory: bool = True
+    record_bytes: float = 0.0
+    available_bytes: float = 0.0
 
 
-def check_run_size(n_dof: int, scenario, available_bytes: float | None = None) -> RunEstimate:
+def check_run_size(n_dof: int, scenario, available_bytes: float | None = None, *,
+                   can_stream: bool = False) -> RunEstimate:  # fmt: skip
     """Estimate a run's cost before it starts; refuse what cannot fit in memory.
 
     Parameters
@@ -112,12 +121,18 @@ def check_run_size(n_dof: int, scenario, available_bytes: float | None = None) -
         Generalized coordinates of the plant.
     scenario : OpenLoopScenario or SlewScenario
     available_bytes : float, optional
-        Memory the run may use; default: half the machine's physical memory.
+        Memory the records may use; default: half the machine's physical memory.
+    can_stream : bool
+        The caller streams records that do not fit to disk
+        (:mod:`flexsat.simulate.stream`): such a run is not refused, its estimate
+        says ``fits_in_memory = False``.
 
     Raises
     ------
     ConfigError
-        If the records would not fit; the message gives the estimate and the fix.
+        If the records would not fit and cannot be streamed, or even streamed one
+        variable of them would not fit (what metrics and figures read at a time);
+        the message gives the estimate and the fix.
 
     Warns
     -----
@@ -127,20 +142,26 @@ def check_run_size(n_dof: int, scenario, available_bytes: float | None = None) -
     steps = scenario.n_steps
     records = steps // scenario.record_every + 1
     per_record = _BYTES_PER_RECORD + _BYTES_PER_RECORD_PER_DOF * n_dof
-    estimate = RunEstimate(
-        steps, records, _COPIES * per_record * records, _SECONDS_PER_STEP_PER_DOF * n_dof * steps
-    )
     limit = available_bytes if available_bytes is not None else 0.5 * _physical_memory()
-    if estimate.memory_bytes > limit:
+    memory = _COPIES * per_record * records
+    estimate = RunEstimate(
+        steps, records, memory, _SECONDS_PER_STEP_PER_DOF * n_dof * steps, memory <= limit,
+        per_record, limit,
+    )  # fmt: skip
+    # Streamed, the records' metrics and figures still read one variable (q, the
+    # widest) at a time: that column has to fit in the machine's memory.
+    column = _COPIES * 8.0 * n_dof * records
+    if not estimate.fits_in_memory and (not can_stream or column > 0.5 * _physical_memory()):
         raise ConfigError(
             f"record_dt_s: the run would keep {records:.3g} records, about "
             f"{estimate.memory_bytes / 2**30:.3g} GiB in memory (at most {limit / 2**30:.3g} "
             "GiB here); record less often (a larger record_dt_s) or shorten duration_s"
         )
     if estimate.wall_time_s > LONG_RUN_S:
+        kept = "keeps" if estimate.fits_in_memory else "streams to disk"
         warnings.warn(
             f"this run takes {steps:.3g} steps, about {estimate.wall_time_s / 60:.0f} min, "
-            f"and keeps about {estimate.memory_bytes / 2**30:.2g} GiB of records",
+            f"and {kept} about {per_record * records / 2**30:.2g} GiB of records",
             LongRunWarning,
             stacklevel=2,
         )

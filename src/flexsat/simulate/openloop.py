@@ -3,9 +3,13 @@
 from __future__ import annotations
 
 import itertools
+import os
+import tempfile
 import time
+from pathlib import Path
 
 import numpy as np
+import xarray as xr
 from scipy.integrate import solve_ivp
 
 from flexsat.dynamics.attitude import SWITCH_PITCH, identity_frame, rebase
@@ -28,6 +32,7 @@ from flexsat.simulate.common import (
 )
 from flexsat.simulate.result import Result, build_dataset
 from flexsat.simulate.scenario import OpenLoopScenario, thesis_openloop
+from flexsat.simulate.stream import RecordStream, check_disk_space
 
 __all__ = ["initial_state", "run_openloop"]
 
@@ -93,7 +98,12 @@ def _profile(scenario: OpenLoopScenario):
 
 
 def run_openloop(
-    plant: Plant, scenario: OpenLoopScenario | None = None, progress: bool | None = None
+    plant: Plant,
+    scenario: OpenLoopScenario | None = None,
+    progress: bool | None = None,
+    *,
+    record_path: str | Path | None = None,
+    record_budget_bytes: float | None = None,
 ) -> Result:
     """Simulate the plant under the scenario's torque profile.
 
@@ -105,79 +115,148 @@ def run_openloop(
         Default: the thesis's scenario (1 N m about Z for 10 s, free to 120 s).
     progress : bool, optional
         Show a progress bar; default: only for runs of at least 200 000 steps.
+    record_path : str or Path, optional
+        Stream the records to this NetCDF file while the run goes (RK4 only); by
+        default only a run whose records do not fit in memory is streamed, to a
+        temporary file.
+    record_budget_bytes : float, optional
+        Memory the records may use before they are streamed; default: half the
+        machine's memory (:func:`flexsat.simulate.common.check_run_size`).
 
     Returns
     -------
     Result
         Recorded every ``record_dt_s``. A diverging run stops at the failing step and
         returns its history up to there with ``status = "failed"`` and a message
-        that names the time; it does not raise.
+        that names the time; it does not raise. A streamed run's dataset reads its
+        file lazily (``result.path``).
 
     Raises
     ------
     ConfigError
-        Before it starts, if its records would not fit in memory
-        (:func:`flexsat.simulate.common.check_run_size`).
+        Before it starts, if its records fit neither in memory nor (RK4) on the
+        disk they would be streamed to.
     """
     scenario = scenario or thesis_openloop()
-    check_run_size(plant.n_dof, scenario)
+    rk4 = scenario.solver == "rk4"
+    estimate = check_run_size(plant.n_dof, scenario, record_budget_bytes, can_stream=rk4)
+    stream = None
+    if rk4 and (record_path is not None or not estimate.fits_in_memory):
+        path = Path(record_path) if record_path is not None else _temporary_record_file()
+        check_disk_space(path.parent, estimate.record_bytes * estimate.records)
+        stream = RecordStream(path)
     q0, qd0 = initial_state(plant, scenario)
     profile = _profile(scenario)
+    attrs = run_attributes(plant, scenario, "open-loop", 0, -1.0, 0.0, 0)
+    attrs["solver"] = scenario.solver
+    blocks: list[xr.Dataset] = []
+
+    def keep(t, X, tau, F) -> None:
+        block = _block(plant, t, X, tau, F, profile, attrs, stream)
+        if stream is None:
+            blocks.append(block)
+        else:
+            stream.append(block)
+
+    if rk4:  # compile or load the kernel now: the run's wall time is the integration's
+        scratch = np.zeros((1, plant.layout.size))
+        rk4_open_loop(scratch[0], 0.0, scenario.dt_s, 0, 1, *profile, plant.packed,
+                      identity_frame(), np.zeros(1), scratch, np.zeros((1, 3)),
+                      np.zeros((1, 9)), 0)  # fmt: skip
     start = time.perf_counter()
-    if scenario.solver == "rk4":
-        t, X, F, tau, status, t_fail, steps = _run_rk4(plant, scenario, q0, qd0, profile,
-                                                       progress)  # fmt: skip
+    if rk4:
+        capacity = None
+        if stream is not None:  # a quarter of the budget per buffer, whole chunks of records
+            capacity = max(1, int(0.25 * estimate.available_bytes / estimate.record_bytes))
+        status, t_fail, steps = _run_rk4(plant, scenario, q0, qd0, profile, progress, keep,
+                                         capacity)  # fmt: skip
     else:
         t, X, F, tau, status, t_fail, steps = _run_dop853(plant, scenario, q0, qd0, profile)
+        keep(t, X, tau, F)
     wall = time.perf_counter() - start
+    final = run_attributes(plant, scenario, "open-loop", status, t_fail, wall, steps)
+    if stream is not None:
+        return Result(stream.finish(final), stream.path)
+    (dataset,) = blocks  # held in memory: one block of every record
+    dataset.attrs.update(final)
+    return Result(dataset)
+
+
+def _temporary_record_file() -> Path:
+    handle, name = tempfile.mkstemp(prefix="flexsat-openloop-", suffix=".nc")
+    os.close(handle)
+    return Path(name)
+
+
+def _block(plant, t, X, tau, F, profile, attrs, stream) -> xr.Dataset:
+    """The dataset of consecutive records (all of a run's, or one streamed block)."""
     lay = plant.layout
     seg_start, seg_end, seg_torque, _ = profile
     tau_cmd = np.array(
         [applied_torque(tk, seg_start, seg_end, seg_torque, np.zeros(3)) for tk in t]
     ).reshape(-1, 3)
-    attrs = run_attributes(plant, scenario, "open-loop", status, t_fail, wall, steps)
-    attrs["solver"] = scenario.solver
-    dataset = build_dataset(
+    energy0 = None if stream is None else stream.energy0
+    return build_dataset(
         plant, t, X[:, lay.q], X[:, lay.qd], X[:, lay.work_in], X[:, lay.dissipated], tau_cmd,
-        tau, attrs, frames=F,
+        tau, dict(attrs), energy0, frames=F,
     )  # fmt: skip
-    return Result(dataset)
 
 
-def _run_rk4(plant, scenario, q0, qd0, profile, progress):
+def _run_rk4(plant, scenario, q0, qd0, profile, progress, keep, capacity=None):
+    """The compiled RK4 loop in chunks; ``keep(t, X, tau, F)`` takes each block of records
+    (F: the attitude reference of each record).
+
+    With ``capacity`` None every record is held and handed over once at the end;
+    otherwise the buffer holds about ``capacity`` records (whole chunks of them) and
+    is handed over each time it is full. The chunks, and so the arithmetic, are
+    the same either way. Returns (status, t_fail, steps done).
+    """
     n_steps, every, dt = scenario.n_steps, scenario.record_every, scenario.dt_s
     n_records = n_steps // every + 1
-    rec_t = np.empty(n_records)
-    rec_x = np.empty((n_records, plant.layout.size))
-    rec_tau = np.empty((n_records, 3))
-    rec_frame = np.empty((n_records, 9))
+    chunk = chunk_steps(every)
+    per_chunk = chunk // every
+    size = n_records if capacity is None else min(n_records, max(capacity, per_chunk + 1))
+    rec_t = np.empty(size)
+    rec_x = np.empty((size, plant.layout.size))
+    rec_tau = np.empty((size, 3))
+    rec_frame = np.empty((size, 9))
     x = np.concatenate([q0, qd0, [0.0, 0.0]])
     frame = identity_frame()
     rec_t[0], rec_x[0], rec_frame[0] = 0.0, x, frame
     rec_tau[0] = applied_torque(0.0, *profile)
+    base = 0  # index in the run of the buffer's first record
+    handed_t = -1.0  # time of the last record handed over [s]
     show = n_steps >= PROGRESS_MIN_STEPS if progress is None else progress
-    chunk = chunk_steps(every)
     done, status = 0, 0
     with progress_bar(show, scenario.duration_s) as (bar, task):
         while done < n_steps and status == 0:
             steps = min(chunk, n_steps - done)
+            row = done // every + 1 - base
+            if row + -(-steps // every) > size:  # the buffer is full: hand it over
+                keep(rec_t[:row].copy(), rec_x[:row].copy(), rec_tau[:row].copy(),
+                     rec_frame[:row].copy())
+                handed_t = float(rec_t[row - 1])
+                base += row
+                row = 0
             status, ran = rk4_open_loop(
                 x, done * dt, dt, steps, every, *profile, plant.packed, frame,
-                rec_t, rec_x, rec_tau, rec_frame, done // every + 1,
+                rec_t, rec_x, rec_tau, rec_frame, row,
             )  # fmt: skip
             done += ran
             if bar is not None:
                 bar.update(task, completed=done * dt)
-    kept = done // every + 1
+    kept = done // every + 1 - base
     t_fail = done * dt if status else -1.0
-    if status:
+    if status and kept == 0 and done * dt > handed_t:  # failed before the block's first record
+        kept = 1
+    if status and kept > 0:
         # Keep the last good state too, even between two records.
         rec_t[kept - 1 : kept] = done * dt
         rec_x[kept - 1], rec_frame[kept - 1] = x, frame
         rec_tau[kept - 1] = applied_torque(done * dt, *profile)
-        rec_t, rec_x, rec_tau = rec_t[:kept], rec_x[:kept], rec_tau[:kept]
-        rec_frame = rec_frame[:kept]
-    return rec_t, rec_x, rec_frame, rec_tau, status, t_fail, done
+    if kept > 0:
+        keep(rec_t[:kept], rec_x[:kept], rec_tau[:kept], rec_frame[:kept])
+    return status, t_fail, done
 
 
 def _run_dop853(plant, scenario, q0, qd0, profile):

@@ -1,13 +1,22 @@
 """Simulation results: an ``xarray.Dataset`` with units, the configs that made it, a status.
 
-Every variable carries a ``units`` attribute; the dataset's attributes hold the
-satellite config and the scenario as JSON, the flexsat version, the solver, the
-wall time and the run's status. A run that stopped early (diverged) keeps its
-history up to the failure, with ``status = "failed"`` and the message.
+Every variable carries the CF attributes ``units`` and ``long_name``; the dataset's
+attributes hold the satellite config and the scenario as JSON, the flexsat version,
+the solver, the wall time (of the integration alone, compilation excluded) and the
+run's status. A run that stopped early (diverged) keeps its history up to the
+failure, with ``status = "failed"`` and the message.
+
+:class:`Result` works the way python-control's ``TimeResponseData`` does: it plots
+itself (:meth:`Result.plot`, every figure of its run's kind), gives a tidy table
+(:meth:`Result.to_pandas`), computes its metrics from the scenario it stores
+(:meth:`Result.metrics`) and summarizes itself (:meth:`Result.summary`, and an HTML
+table in a notebook). Figures and metrics are imported when first used, so reading
+a result needs neither matplotlib nor the analysis modules.
 """
 
 from __future__ import annotations
 
+import shutil
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -34,9 +43,13 @@ class Result:
     dataset : xarray.Dataset
         The recorded run: every variable with its ``units``, the config and the
         scenario in the attributes.
+    path : Path, optional
+        The NetCDF file a streamed run's records were written to (the dataset reads
+        it lazily; :mod:`flexsat.simulate.stream`); None for a run held in memory.
     """
 
     dataset: xr.Dataset
+    path: Path | None = None
 
     @property
     def ok(self) -> bool:
@@ -48,7 +61,149 @@ class Result:
 
     @property
     def time(self) -> np.ndarray:
+        """Record times [s], shape (m,)."""
         return self.dataset["time"].values
+
+    @property
+    def kind(self) -> str:
+        """``"slew"`` for a closed-loop run, ``"openloop"`` for an open-loop one."""
+        return "slew" if "pointing_error_deg" in self.dataset else "openloop"
+
+    def figure_kinds(self) -> tuple[str, ...]:
+        """The figures :meth:`plot` can draw for this run, in the order they are written."""
+        from flexsat.plots.results import figure_names
+
+        return figure_names(self.dataset)
+
+    def plot(self, kind: str = "attitude", *, analysis=None):
+        """Draw one of the run's figures.
+
+        Parameters
+        ----------
+        kind : str
+            A name of :meth:`figure_kinds` (open loop: ``attitude``, ``quaternion``,
+            ``angular_acceleration``, ``torques``, ``root_deformation``,
+            ``tip_displacement``, ``angular_momentum``, ``energy``, ``spectrogram``;
+            slew: ``attitude``, ``quaternion``, ``pointing``, ``phase_plane``, the
+            sliding-surface figures when the law has one, ``disturbances``,
+            ``torque_limits``, ``torque_breakdown``, ``root_deformation``,
+            ``tip_displacement``, ``flex_torque``, ``energy``).
+        analysis : flexsat.analysis.modal.ModalAnalysis, optional
+            For the modal lines of the open-loop figures; default: computed from
+            the stored config when the figure needs it.
+
+        Returns
+        -------
+        matplotlib.figure.Figure
+            Created without pyplot (in a notebook it displays as the cell's value).
+
+        Raises
+        ------
+        FlexsatError
+            If ``kind`` is not a figure of this run (the message lists them).
+        """
+        from flexsat.plots.results import plot_result
+
+        return plot_result(self.dataset, kind, analysis)
+
+    def to_pandas(self):
+        """The records as one tidy table: a row per time, variable and component.
+
+        Returns
+        -------
+        pandas.DataFrame
+            Columns ``time_s`` [s], ``variable`` (the dataset's name), ``component``
+            (the non-time coordinates joined by ``.``, e.g. ``p1.z``; empty for a
+            scalar), ``value`` (in ``units``), ``units`` and ``long_name``. Filter
+            it like any long table: ``df[df.variable == "omega"]``.
+        """
+        import pandas as pd
+
+        frames = []
+        for name, var in self.dataset.data_vars.items():
+            if "time" not in var.dims:
+                continue
+            other = [d for d in var.dims if d != "time"]
+            values = var.transpose("time", *other).values.reshape(var.sizes["time"], -1)
+            labels = [""]
+            for dim in other:
+                coords = [str(c) for c in self.dataset[dim].values]
+                labels = [f"{a}.{b}" if a else b for a in labels for b in coords]
+            frames.append(pd.DataFrame({
+                "time_s": np.repeat(self.time, len(labels)),
+                "variable": name,
+                "component": np.tile(labels, var.sizes["time"]),
+                "value": values.ravel(),
+                "units": var.attrs.get("units", ""),
+                "long_name": var.attrs.get("long_name", ""),
+            }))  # fmt: skip
+        table = pd.concat(frames, ignore_index=True)
+        for column in ("variable", "component", "units", "long_name"):
+            table[column] = table[column].astype("category")
+        return table
+
+    def metrics(self) -> dict:
+        """The run's metrics, from the requirements and limits of its stored scenario.
+
+        Returns
+        -------
+        dict
+            A slew: :func:`flexsat.analysis.requirements.slew_metrics` (R1-R3 against
+            the stored scenario's bands and T_max); an open-loop run:
+            :func:`flexsat.analysis.openloop.openloop_metrics`. A failed run's
+            metrics are those of its finite part (``finite_until_s`` where it
+            applies). Keys end in their unit.
+        """
+        if self.kind == "slew":
+            from flexsat.analysis.requirements import slew_metrics
+
+            return slew_metrics(self.dataset)
+        from flexsat.analysis.openloop import openloop_metrics
+
+        return openloop_metrics(self.dataset)
+
+    def summary(self):
+        """A rich table of the run: what ran, its status and its metrics.
+
+        Returns
+        -------
+        rich.table.Table
+            Print it with ``rich.print(result.summary())``; in a notebook the
+            result itself displays as the same table in HTML (``_repr_html_``).
+        """
+        from rich.table import Table
+
+        table = Table(title=str(self.dataset.attrs.get("title", "flexsat run")))
+        table.add_column("quantity", no_wrap=True)
+        table.add_column("value", justify="right")
+        for key, value in self._summary_rows():
+            table.add_row(key, value)
+        return table
+
+    def _summary_rows(self) -> list[tuple[str, str]]:
+        attrs = self.dataset.attrs
+        rows = [
+            ("status", str(attrs.get("status", ""))),
+            ("records", str(self.dataset.sizes["time"])),
+            ("simulated [s]", f"{float(self.time[-1]):.6g}"),
+            ("wall time [s] (compilation excluded)", f"{float(attrs.get('wall_time_s', 0)):.3g}"),
+        ]
+        if self.message:
+            rows.append(("message", self.message))
+        skip = ("files", "status", "message", "steps", "wall_time_s")
+        rows += [(k, _shown(v)) for k, v in self.metrics().items() if k not in skip]
+        return rows
+
+    def _repr_html_(self) -> str:
+        import html
+
+        body = "".join(
+            f"<tr><th style='text-align:left'>{html.escape(k)}</th>"
+            f"<td style='text-align:right'>{html.escape(v)}</td></tr>"
+            for k, v in self._summary_rows()
+        )
+        title = html.escape(str(self.dataset.attrs.get("title", "flexsat run")))
+        return f"<table><caption>{title}</caption><tbody>{body}</tbody></table>"
 
     def raise_for_status(self) -> None:
         """Raise the run's :class:`SimulationError` if it failed."""
@@ -59,8 +214,13 @@ class Result:
         """Write the dataset to NetCDF (written to a temporary name, then moved)."""
         path = Path(path)
         path.parent.mkdir(parents=True, exist_ok=True)
+        if self.path is not None and path.resolve() == self.path.resolve():
+            return path  # a streamed run already written there
         partial = path.with_suffix(path.suffix + ".partial")
-        self.dataset.to_netcdf(partial)
+        if self.path is not None:  # a streamed run: copy its file, never load it whole
+            shutil.copyfile(self.path, partial)
+        else:
+            self.dataset.to_netcdf(partial)
         partial.replace(path)
         return path
 
@@ -81,6 +241,7 @@ def build_dataset(
     tau_cmd: np.ndarray,
     tau_applied: np.ndarray,
     attrs: dict,
+    energy0: float | None = None,
     frames: np.ndarray | None = None,
 ) -> xr.Dataset:
     """Derive every recorded quantity from the recorded states.
@@ -96,6 +257,9 @@ def build_dataset(
         Commanded and applied body torque held from each record time [N m].
     attrs : dict
         Dataset attributes (configs as JSON, status...).
+    energy0 : float, optional
+        E(0) of the run [J], for a block of records that does not start at t = 0
+        (a streamed run); default: the first record's total energy.
     frames : ndarray, shape (m, 9), optional
         The attitude reference R_NF of each record (:mod:`flexsat.dynamics.attitude`);
         the hub part of ``q`` and ``qd`` is relative to it. Default: the identity.
@@ -131,8 +295,8 @@ def build_dataset(
     root = [model.root_motion(q[:, b.slice], b.names) for model, b in blocks]
     root_rate = [model.root_motion(qd[:, b.slice], b.names) for model, b in blocks]
 
-    def var(dims, data, units, description):
-        return (dims, data, {"units": units, "description": description})
+    def var(dims, data, units, long_name):
+        return (dims, data, {"units": units, "long_name": long_name})
 
     ta, tpa = ("time", "axis"), ("time", "appendage", "axis")
     data_vars = {
@@ -164,13 +328,13 @@ def build_dataset(
         "dissipated_energy": var("time", dissipated, "J", "cumulative damper dissipation"),
         "energy_balance_error": var(
             "time",
-            total - total[0] - work_in + dissipated,
+            total - (total[0] if energy0 is None else energy0) - work_in + dissipated,
             "J",
             "E(t) - E(0) - W_in(t) + W_diss(t): numerical error of the integration",
         ),
     }
     coords = {
-        "time": ("time", t, {"units": "s"}),
+        "time": ("time", t, {"units": "s", "long_name": "time since the start of the run"}),
         "axis": list(AXES),
         "euler": ["roll", "pitch", "yaw"],
         "quat": ["q0", "q1", "q2", "q3"],
@@ -178,6 +342,15 @@ def build_dataset(
         "dof": plant.dof_names(),
     }
     return xr.Dataset(data_vars, coords=coords, attrs=attrs)
+
+
+def _shown(value) -> str:
+    """A metric as text: 6 significant digits, vectors comma separated."""
+    if isinstance(value, (list, tuple)):
+        return ", ".join(_shown(v) for v in value)
+    if isinstance(value, float):
+        return f"{value:.6g}"
+    return str(value)
 
 
 def _stack(per_appendage: list[tuple[np.ndarray, np.ndarray]], k: int, m: int) -> np.ndarray:

@@ -115,6 +115,7 @@ def fly_openloop(plant: Plant, scenario=None, out: Path | None = None, progress=
     scenario : OpenLoopScenario, optional
         Default: the thesis's 1 N m yaw pulse.
     out : Path, optional
+        A run whose records do not fit in memory streams them to ``out/result.nc``.
     progress : bool or None
         Progress bar: None shows it on a terminal only.
 
@@ -133,16 +134,23 @@ def fly_openloop(plant: Plant, scenario=None, out: Path | None = None, progress=
 
         return write_openloop_figures(result.dataset, modal_analysis(plant), Path(out))
 
+    from flexsat.simulate.common import check_run_size
+
+    scenario = scenario or OpenLoopScenario()
+    record_path = None
     if out is not None:
         prepare_output_dir(out)
-    result = run_openloop(plant, scenario or OpenLoopScenario(), progress=progress)
+        fits = check_run_size(plant.n_dof, scenario, can_stream=True).fits_in_memory
+        record_path = None if fits else Path(out) / "result.nc"  # streamed into place
+    result = run_openloop(plant, scenario, progress=progress, record_path=record_path)
     metrics = openloop_metrics(result.dataset)
     if out is not None:
         _write_run(result, metrics, Path(out), figures)
     return result, metrics
 
 
-def fly_slew(plant: Plant, scenario=None, out: Path | None = None, progress=None):
+def fly_slew(plant: Plant, scenario=None, out: Path | None = None, progress=None, *,
+             figures: bool = True):  # fmt: skip
     """Closed-loop slew and its requirement metrics; with ``out``, its files there.
 
     Parameters
@@ -152,6 +160,8 @@ def fly_slew(plant: Plant, scenario=None, out: Path | None = None, progress=None
         Default: the thesis's 45/45/45 deg ASMC slew.
     out : Path, optional
     progress : bool or None
+    figures : bool
+        With ``out``, also draw the figure set (result.nc and metrics.json always).
 
     Returns
     -------
@@ -165,10 +175,10 @@ def fly_slew(plant: Plant, scenario=None, out: Path | None = None, progress=None
     from flexsat.simulate import SlewScenario, run_slew
     from flexsat.simulate.common import check_run_size
 
-    def figures() -> list[Path]:
+    def draw() -> list[Path]:
         from flexsat.plots.slew import write_slew_figures
 
-        return write_slew_figures(result.dataset, Path(out))
+        return write_slew_figures(result.dataset, Path(out)) if figures else []
 
     scenario = scenario or SlewScenario()
     check_run_size(plant.n_dof, scenario)
@@ -179,7 +189,7 @@ def fly_slew(plant: Plant, scenario=None, out: Path | None = None, progress=None
     J = result.dataset.attrs["design_inertia"]
     metrics["design_inertia_kg_m2"] = [list(J[3 * i : 3 * i + 3]) for i in range(3)]
     if out is not None:
-        _write_run(result, metrics, Path(out), figures)
+        _write_run(result, metrics, Path(out), draw)
     return result, metrics
 
 

@@ -11,8 +11,15 @@ its section; the sections of the other parts are written as usual.
 
 Sections follow the thesis: the configuration (section 3.1), the model's M(0) and
 rigid inertia (appendix B), the coupled modes (table 3.3), the open-loop validation
-(section 3.3), the ASMC slew and its requirements (section 5.1), the controller
-comparison, and the campaigns (chapter 5).
+(section 3.3), the ASMC slew and its requirements (section 5.1), the frequency-domain
+analysis of its law (loop margins with the flexible modes), the controller
+comparison, and the campaigns (chapter 5). :data:`SECTIONS` lists them; a new section
+is one drawing function and one entry there (docs/results.md, 'The study report').
+
+The page reads as a design review: a numbered table of contents, figures at full
+width that open at full size on a click, each mode's still at its peak deformation
+beside its animation, sortable tables, a caveat at the top of each section whose
+thesis comparison does not apply to the configuration, and a print layout.
 """
 
 from __future__ import annotations
@@ -22,6 +29,7 @@ import html
 import json
 import platform
 from collections.abc import Callable
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -29,7 +37,7 @@ import numpy as np
 from flexsat.control.laws import get_law, law_names
 from flexsat.study import thesis
 
-__all__ = ["format_value", "write_report"]
+__all__ = ["SECTIONS", "Section", "format_value", "write_report"]
 
 _MIME = {".png": "image/png", ".gif": "image/gif", ".svg": "image/svg+xml"}
 
@@ -97,8 +105,14 @@ def _esc(text) -> str:
     return html.escape(str(text))
 
 
-def _table(header: list[str], rows: list[list[str]], caption: str = "") -> str:
-    """Rows are lists of ready cells (``<td>...</td>``) or plain text (escaped)."""
+def _table(
+    header: list[str], rows: list[list[str]], caption: str = "", sortable: bool = False
+) -> str:
+    """Rows are lists of ready cells (``<td>...</td>``) or plain text (escaped).
+
+    A sortable table sorts by a column when its header is clicked (numbers by value,
+    from ``data-value``; text alphabetically), again to reverse.
+    """
 
     def cell(item: str) -> str:
         return item if item.startswith(("<td", "<th")) else f"<td>{_esc(item)}</td>"
@@ -106,23 +120,53 @@ def _table(header: list[str], rows: list[list[str]], caption: str = "") -> str:
     head = "".join(f"<th>{_esc(h)}</th>" for h in header)
     body = "".join("<tr>" + "".join(cell(c) for c in row) + "</tr>" for row in rows)
     cap = f"<caption>{_esc(caption)}</caption>" if caption else ""
-    return f"<table>{cap}<thead><tr>{head}</tr></thead><tbody>{body}</tbody></table>"
+    css = ' class="sortable"' if sortable else ""
+    return f"<table{css}>{cap}<thead><tr>{head}</tr></thead><tbody>{body}</tbody></table>"
 
 
 def _figure(root: Path, relative: str, caption: str = "") -> str:
+    """One figure, full width; a click opens it at full size (see ``_SCRIPT``)."""
     path = root / relative
     data = base64.b64encode(path.read_bytes()).decode("ascii")
     mime = _MIME[path.suffix.lower()]
     text = caption or path.stem.replace("_", " ")
     return (
-        f'<figure><img src="data:{mime};base64,{data}" alt="{_esc(text)}" loading="eager">'
-        f"<figcaption>{_esc(text)} <span class='file'>({_esc(relative)})</span></figcaption>"
-        "</figure>"
+        f'<figure><img src="data:{mime};base64,{data}" alt="{_esc(text)}" loading="eager" '
+        f'title="click to enlarge"><figcaption>{_esc(text)} '
+        f"<span class='file'>({_esc(relative)})</span></figcaption></figure>"
     )
 
 
+_STILL_CAPTION = "at its peak deformation (still)"
+_ANIMATED_CAPTION = "over one period (animation)"
+
+
 def _figures(root: Path, files: list[str]) -> str:
-    return '<div class="figures">' + "".join(_figure(root, f) for f in files) + "</div>"
+    """The figures in order; a PNG and a GIF of the same name (a mode's still at its peak
+    deformation and its animation) side by side."""
+    stems = {}
+    for f in files:
+        stems.setdefault(Path(f).with_suffix("").as_posix(), []).append(f)
+    parts, done = [], set()
+    for f in files:
+        stem = Path(f).with_suffix("").as_posix()
+        if stem in done:
+            continue
+        done.add(stem)
+        group = stems[stem]
+        pngs = [g for g in group if g.endswith(".png")]
+        gifs = [g for g in group if g.endswith(".gif")]
+        if pngs and gifs:
+            name = Path(stem).name.replace("_", " ")
+            parts.append(
+                '<div class="pair">'
+                + _figure(root, pngs[0], f"{name} {_STILL_CAPTION}")
+                + _figure(root, gifs[0], f"{name} {_ANIMATED_CAPTION}")
+                + "</div>"
+            )
+        else:
+            parts += [_figure(root, g) for g in group]
+    return '<div class="figures">' + "".join(parts) + "</div>"
 
 
 # -- sections -------------------------------------------------------------------------
@@ -251,14 +295,7 @@ def _modal(root: Path, outputs: dict, context: dict) -> str:
         "thesis hub DOF",
     ]
     caption = "Coupled modes at q = 0 beside thesis table 3.3 (rigid-body modes omitted)"
-    parts = [_table(header, rows, caption)]
-    if not context["nominal"]:
-        parts.append(
-            "<p class='note'>The thesis columns are its nominal case; this "
-            "configuration differs from it.</p>"
-        )
-    parts.append(_figures(root, outputs["figures"]))
-    return "".join(parts)
+    return _table(header, rows, caption) + _figures(root, outputs["figures"])
 
 
 def _compare_rows(src: _Source, reference: dict) -> list[list[str]]:
@@ -357,6 +394,51 @@ def _animation(root: Path, outputs: dict, context: dict) -> str:
     )
 
 
+def _frequency(root: Path, outputs: dict, context: dict) -> str:
+    src = _Source(root, outputs["json"])
+    keys = [
+        ("phase_margin_deg", "phase margin [deg]"),
+        ("gain_crossover_hz", "at [Hz]"),
+        ("gain_margin", "gain margin [-] (— : infinite)"),
+        ("phase_crossover_hz", "at [Hz]"),
+        ("delay_margin_s", "delay margin [s]"),
+        ("delay_crossover_hz", "at [Hz]"),
+        ("crossovers_hz", "every gain crossover [Hz]"),
+    ]
+    rows = [[axis, *(src.cell("axes", axis, key) for key, _ in keys)] for axis in src.get("axes")]
+    law = _esc(str(src.get("law")).upper())
+    return "".join([
+        f"<p>The nominal slew's law ({law}) linearized about rest and closed around the "
+        "flexible plant, one axis at a time (the loop broken at that axis's torque, the "
+        "others closed); the sliding-mode laws inside their boundary layer with Λ and JK "
+        "at their steady-state values. Bode plots compare the flexible plant with its "
+        "rigid model (alternating pole–zero pairs of the flexible modes); the loop-gain "
+        "figure marks the flexible modes (dotted) and every 0 dB crossover, so a "
+        "flexible peak that crosses 0 dB shows as an extra crossover and a smaller "
+        "margin.</p>",
+        _table(["axis", *(label for _, label in keys)], rows,
+               f"Loop margins of the {law} law per axis", sortable=True),
+        _figures(root, outputs["figures"]),
+    ])  # fmt: skip
+
+
+def _campaign_cases(root: Path, store: str) -> str:
+    """Every case of a stored campaign, one row each, sortable by any column."""
+    keys = ("final_pointing_error_deg", "ape_deg", "max_rate_error_deg_s", "settling_time_s",
+            "r1_pass", "r2_pass", "r3_pass")  # fmt: skip
+    rows = []
+    for path in sorted((root / store / "cases").glob("*.json")):
+        case = _Source(root, path.relative_to(root).as_posix())
+        metrics = case.get("metrics") or {}
+        cells = [case.cell("metrics", k) if k in metrics else "" for k in keys]
+        rows.append([case.cell("case_id"), case.cell("status"), *cells])
+    return _table(["case", "status", *keys], rows,
+                  "Every case (click a column header to sort)", sortable=True)  # fmt: skip
+
+
+_SUMMARY_TABLE_FIGURE = "summary_table.png"  # shown as the HTML tables above instead
+
+
 def _campaigns(root: Path, outputs: dict, context: dict) -> str:
     parts = []
     for name, rel in outputs["summaries"].items():
@@ -388,7 +470,10 @@ def _campaigns(root: Path, outputs: dict, context: dict) -> str:
                 f"Campaign {name} (store {store}: results.parquet, results.csv)",
             )
         )
-        parts.append(_figures(root, [f for f in outputs["figures"] if f.startswith(store + "/")]))
+        parts.append(_campaign_cases(root, store))
+        figures = [f for f in outputs["figures"]
+                   if f.startswith(store + "/") and not f.endswith(_SUMMARY_TABLE_FIGURE)]
+        parts.append(_figures(root, figures))  # fmt: skip
     return "".join(parts)
 
 
@@ -449,37 +534,68 @@ def _avionics(root: Path, outputs: dict, context: dict) -> str:
     ])  # fmt: skip
 
 
-_SECTIONS: dict[str, Callable[[Path, dict, dict], str]] = {
-    "configuration": _configuration,
-    "model": _model,
-    "modal": _modal,
-    "openloop": _openloop,
-    "slew": _slew,
-    "comparison": _comparison,
-    "animation": _animation,
-    "avionics": _avionics,
-    "campaigns": _campaigns,
-    "laws": _laws,
-}
+@dataclass(frozen=True)
+class Section:
+    """One section of the report: what it draws, from which part's outputs.
 
-# The model section is drawn from the modal part's outputs (M(0) and J_tot are there).
-_SECTION_PART = {"model": "modal"}
-_SECTION_TITLE = {"model": "Model: M(0) and rigid inertia"}
+    ``draw(root, outputs, context) -> html`` gets the study folder, the part's
+    outputs (the manifest's ``outputs`` of part ``part``) and the context
+    (``source``, ``nominal``); ``caveat`` is shown at the top of the section when
+    the configuration is not the thesis's nominal case (its thesis values then do
+    not apply as they are).
+    """
+
+    name: str
+    draw: Callable[[Path, dict, dict], str]
+    part: str | None = None  # default: the section's name
+    title: str | None = None  # default: the part's title
+    caveat: str | None = None
+
+
+_THESIS_CAVEAT = (
+    "This configuration is not the thesis's nominal case: the thesis's values beside "
+    "flexsat's are those of its nominal satellite, given for orientation only."
+)
+
+SECTIONS: list[Section] = [
+    Section("configuration", _configuration),
+    Section("model", _model, part="modal", title="Model: M(0) and rigid inertia",
+            caveat="Appendix B's matrix is the nominal satellite's: no comparison is made."),
+    Section("modal", _modal, caveat=_THESIS_CAVEAT),
+    Section("openloop", _openloop, caveat=_THESIS_CAVEAT),
+    Section("slew", _slew, caveat=_THESIS_CAVEAT),
+    Section("frequency", _frequency),
+    Section("comparison", _comparison),
+    Section("animation", _animation),
+    Section("avionics", _avionics),
+    Section("campaigns", _campaigns,
+            caveat="The campaigns vary this configuration, not the thesis's nominal one: "
+                   "their pass rates are not the thesis's chapter 5 results."),
+    Section("laws", _laws,
+            caveat="The laws fly this configuration's campaigns, not the thesis's nominal "
+                   "ones."),
+]  # fmt: skip
+"""The report's sections, in order. A new section is one function and one entry here
+(and, for new outputs, one part in :data:`flexsat.study.pipeline.PARTS`)."""
 
 
 # -- page -----------------------------------------------------------------------------
 
 
-def _section(root: Path, name: str, entry: dict | None, context: dict) -> str:
-    title = _SECTION_TITLE.get(name, entry["title"] if entry else name)
+def _section(root: Path, section: Section, number: int, entry: dict | None,
+             context: dict) -> str:  # fmt: skip
+    name = section.name
+    title = f"{number}. {_title(section, entry)}"
     anchor = f'<section id="{name}"><h2>{_esc(title)}</h2>'
     if entry is None:
         return anchor + "<p class='error'>This part did not run (the study stopped).</p></section>"
     status = entry["status"]
     head = (
         f"<p class='meta'><span class='badge {status}'>{status}</span> "
-        f"wall time {entry['wall_time_s']:.1f} s</p>"
+        f"wall time {entry['wall_time_s']:.1f} s (compilation excluded)</p>"
     )
+    if section.caveat and not context["nominal"]:
+        head += f"<p class='caveat'>{_esc(section.caveat)}</p>"
     if status == "skipped":
         return anchor + head + f"<p class='note'>{_esc(entry['error'])}</p></section>"
     if status == "failed":
@@ -489,10 +605,14 @@ def _section(root: Path, name: str, entry: dict | None, context: dict) -> str:
             f"</p>{trace}</div></section>"
         )
     try:
-        body = _SECTIONS[name](root, entry["outputs"], context)
+        body = section.draw(root, entry["outputs"], context)
     except Exception as exc:  # an unreadable output is shown, the report still written
         body = f"<div class='error'><p>This section could not be drawn: {_esc(repr(exc))}</p></div>"
     return anchor + head + body + "</section>"
+
+
+def _title(section: Section, entry: dict | None) -> str:
+    return section.title or (entry["title"] if entry else section.name)
 
 
 def _summary(manifest: dict) -> str:
@@ -507,7 +627,11 @@ def _summary(manifest: dict) -> str:
             ]
         )
     rows.append(["total", "", f"{manifest.get('total_wall_time_s', 0.0):.1f}"])
-    return _table(["part", "status", "wall time [s]"], rows, "Parts of the study")
+    if "compilation_s" in manifest:
+        rows.append(["compilation, before the parts (not in their times)", "",
+                     f"{manifest['compilation_s']:.1f}"])  # fmt: skip
+    return _table(["part", "status", "wall time [s], compilation excluded"], rows,
+                  "Parts of the study")  # fmt: skip
 
 
 def write_report(study_dir: str | Path) -> Path:
@@ -534,14 +658,18 @@ def write_report(study_dir: str | Path) -> Path:
     if config_entry and config_entry["status"] == "ok":
         data = _Source(root, config_entry["outputs"]["json"]).get("config")
         context["nominal"] = SatelliteConfig.model_validate(data) == nominal()
+    present = [
+        (section, entries.get(section.part or section.name))
+        for section in SECTIONS
+        if (section.part or section.name) in entries
+    ]
     sections = [
-        _section(root, name, entries.get(_SECTION_PART.get(name, name)), context)
-        for name in _SECTIONS
+        _section(root, section, k, entry, context)
+        for k, (section, entry) in enumerate(present, start=1)
     ]
     toc = "".join(
-        f"<li><a href='#{name}'>{_esc(_SECTION_TITLE.get(name, entry['title']))}</a></li>"
-        for name in _SECTIONS
-        if (entry := entries.get(_SECTION_PART.get(name, name))) is not None
+        f"<li><a href='#{section.name}'>{_esc(_title(section, entry))}</a></li>"
+        for section, entry in present
     )
     failed = [e["title"] for e in manifest["parts"] if e["status"] == "failed"]
     banner = (
@@ -558,11 +686,13 @@ def write_report(study_dir: str | Path) -> Path:
 <p class="meta">flexsat {_esc(manifest["flexsat_version"])} · Python
 {_esc(platform.python_version())} · {_esc(manifest["created_utc"])} ·
 configuration from {_esc(manifest["config_source"])}{" · quick study" if manifest["quick"] else ""}
-</p>{banner}{_summary(manifest)}<nav><ol>{toc}</ol></nav></header>
-<main>{"".join(sections)}</main>
+</p>{banner}</header>
+<nav aria-label="contents"><h2>Contents</h2><ol>{toc}</ol></nav>
+<main>{_summary(manifest)}{"".join(sections)}</main>
+<div id="lightbox" hidden></div>
 <footer><p>Every number above is read from the JSON files next to this report
 (data-source and data-path on each cell). Units are SI unless a key or heading says
-otherwise.</p></footer></body></html>
+otherwise.</p></footer><script>{_SCRIPT}</script></body></html>
 """
     path = root / "report.html"
     partial = path.with_suffix(".html.partial")
@@ -572,15 +702,30 @@ otherwise.</p></footer></body></html>
 
 
 _CSS = """
-body{font-family:system-ui,sans-serif;margin:0 auto;max-width:1200px;padding:1rem 2rem;
-  color:#222;line-height:1.4}
-h1{font-size:1.7rem;margin-bottom:.2rem}
+body{font-family:system-ui,sans-serif;margin:0;color:#222;line-height:1.45}
+header,main,footer{max-width:1400px;margin:0 auto;padding:0 2rem;width:100%;
+  box-sizing:border-box}
+@media (min-width:1500px){
+  body{display:grid;grid-template-columns:17rem minmax(0,1fr);grid-template-areas:
+    "nav header" "nav main" "nav footer"}
+  header{grid-area:header} main{grid-area:main} footer{grid-area:footer}
+  nav{grid-area:nav;position:sticky;top:0;align-self:start;max-height:100vh;overflow:auto;
+    border-right:1px solid #dde;padding:1rem}
+}
+nav{padding:0 2rem;font-size:.9rem}
+nav h2{font-size:1rem;border:none;margin:.5rem 0}
+nav ol{padding-left:1.4rem;margin:0}
+h1{font-size:1.8rem;margin-bottom:.2rem}
 h2{border-bottom:2px solid #ccd;padding-bottom:.2rem;margin-top:2.5rem}
 h3{margin-top:1.5rem}
-table{border-collapse:collapse;margin:1rem 0;font-size:.85rem}
+table{border-collapse:collapse;margin:1rem 0;font-size:.9rem}
 caption{text-align:left;font-weight:600;padding:.3rem 0}
 th,td{border:1px solid #ccd;padding:.2rem .5rem;vertical-align:top}
 th{background:#eef}
+table.sortable th{cursor:pointer;user-select:none}
+table.sortable th::after{content:" ⇅";color:#99a;font-size:.8em}
+table.sortable th[aria-sort=ascending]::after{content:" ▲";color:#334}
+table.sortable th[aria-sort=descending]::after{content:" ▼";color:#334}
 td.num{text-align:right;font-variant-numeric:tabular-nums}
 td.pass{color:#0a6b2d;font-weight:600}
 td.fail{color:#b00020;font-weight:600}
@@ -592,12 +737,69 @@ td.fail{color:#b00020;font-weight:600}
 .error pre{color:#222;background:#fbeaea;padding:.5rem;overflow-x:auto;font-size:.75rem}
 .success{color:#0a6b2d}
 .note{color:#555;font-style:italic}
+.caveat{background:#fff6e0;border-left:4px solid #a66a00;padding:.4rem .7rem}
 .meta{color:#555}
 .check{font-weight:600}
-.figures{display:grid;grid-template-columns:repeat(auto-fill,minmax(520px,1fr));gap:1rem}
+.figures{display:flex;flex-direction:column;gap:1.5rem;margin:1rem 0}
+.pair{display:grid;grid-template-columns:repeat(auto-fit,minmax(420px,1fr));gap:1rem}
 figure{margin:0}
-figure img{max-width:100%;height:auto;border:1px solid #eee}
-figcaption{font-size:.8rem;color:#555}
+figure img{display:block;width:100%;max-width:1300px;height:auto;border:1px solid #eee;
+  cursor:zoom-in}
+.pair figure img{max-width:700px}
+figcaption{font-size:.85rem;color:#555}
 .file{color:#999}
+#lightbox{position:fixed;inset:0;background:rgba(20,20,30,.88);display:flex;
+  align-items:center;justify-content:center;z-index:10;cursor:zoom-out}
+#lightbox[hidden]{display:none}
+#lightbox img{max-width:98vw;max-height:98vh;background:#fff}
 footer{margin-top:3rem;color:#777;font-size:.8rem}
+@media print{
+  nav,#lightbox{display:none}
+  header,main,footer{max-width:none;padding:0}
+  body{font-size:10pt}
+  h2{break-before:page;margin-top:0}
+  figure,table,.pair{break-inside:avoid}
+  figure img{max-width:100%;cursor:auto;border:none}
+  .pair{grid-template-columns:1fr 1fr}
+  table.sortable th::after{content:""}
+}
+"""
+
+# Click a figure: the same image at full size over the page (click or Esc closes it).
+# Click a sortable table's header: its rows sorted by that column (numbers by value).
+_SCRIPT = """
+(function(){
+  var box=document.getElementById('lightbox');
+  function close(){box.hidden=true;box.textContent='';}
+  document.querySelectorAll('figure img').forEach(function(img){
+    img.addEventListener('click',function(){
+      var big=new Image();big.src=img.src;big.alt=img.alt;
+      box.textContent='';box.appendChild(big);box.hidden=false;});
+  });
+  box.addEventListener('click',close);
+  document.addEventListener('keydown',function(e){if(e.key==='Escape')close();});
+  function key(cell){
+    if(!cell)return [1,''];
+    var v=cell.getAttribute('data-value');
+    if(v!==null){try{var x=JSON.parse(v);if(typeof x==='number')return [0,x];
+      if(typeof x==='boolean')return [0,x?1:0];}catch(err){}}
+    return [1,cell.textContent.trim().toLowerCase()];
+  }
+  document.querySelectorAll('table.sortable').forEach(function(table){
+    table.querySelectorAll('thead th').forEach(function(th,col){
+      th.addEventListener('click',function(){
+        var up=th.getAttribute('aria-sort')!=='ascending';
+        table.querySelectorAll('thead th').forEach(function(o){o.removeAttribute('aria-sort');});
+        th.setAttribute('aria-sort',up?'ascending':'descending');
+        var body=table.tBodies[0];
+        var rows=Array.prototype.slice.call(body.rows);
+        rows.sort(function(a,b){
+          var p=key(a.cells[col]),q=key(b.cells[col]);
+          var c=p[0]-q[0]||(p[1]<q[1]?-1:p[1]>q[1]?1:0);
+          return up?c:-c;});
+        rows.forEach(function(r){body.appendChild(r);});
+      });
+    });
+  });
+})();
 """
