@@ -148,9 +148,11 @@ def run_slew(
     )  # fmt: skip
     show = steps >= PROGRESS_MIN_STEPS if progress is None else progress
     if controller is None:  # compile or load the loop now (0 steps): the wall time is the run's
-        idle = LoopClock(0.0, scenario.dt_s, 0, False, scenario.control_every, every)
-        rk4_closed_loop(x.copy(), idle, stages, data, LoopRecords(rec_t, rec_x, rec_ctrl, 0),
-                        plant.packed)  # fmt: skip
+        idle = LoopClock(0.0, scenario.dt_s, 0, False, scenario.control_every, every,
+                         layout.continuous)  # fmt: skip
+        rk4_closed_loop(x.copy(), idle, stages, data,
+                        LoopRecords(rec_t, rec_x, rec_ctrl, 0, rec_frame), plant.packed,
+                        identity_frame())  # fmt: skip
     start = time.perf_counter()
     with progress_bar(show, scenario.duration_s) as (bar, task):
         if controller is None:
