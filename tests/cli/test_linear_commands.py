@@ -44,6 +44,19 @@ def test_linearize_about_a_spin_reports_the_equilibrium():
     assert summary["output_names"] == ["omega_x", "omega_y", "omega_z"]
 
 
+def test_linearize_adds_an_input_per_actuated_coordinate(tmp_path):
+    result = run("linearize", "--actuated", "panel_1.eta_rz", "--actuated", "eta_x",
+                 "--json", "--out", str(tmp_path))  # fmt: skip
+    assert result.returncode == 0, result.stderr
+    summary = json.loads(result.stdout)
+    assert summary["input_names"] == ["tau_x", "tau_y", "tau_z", "Q_panel_1.eta_rz",
+                                      "Q_panel_1.eta_x", "Q_panel_2.eta_x"]  # fmt: skip
+    assert summary["input_units"] == ["N m"] * 4 + ["N"] * 2
+    model = np.load(tmp_path / "model.npz")
+    assert model["B"].shape == (36, 6) and list(model["input_names"])[3] == "Q_panel_1.eta_rz"
+    assert (tmp_path / "singular_values.png").stat().st_size > 0  # torque inputs only
+
+
 def test_margins_table_and_files(tmp_path):
     result = run("margins", "--out", str(tmp_path))
     assert result.returncode == 0, result.stderr
@@ -61,6 +74,7 @@ def test_margins_table_and_files(tmp_path):
         (("linearize", "--outputs", "rate,tips"), "unknown output 'tips'"),
         (("linearize", "--reduce", "balanced:99"), "order: must be between 12"),
         (("linearize", "--reduce", "hankel:8"), "--reduce: expected"),
+        (("linearize", "--actuated", "rho_q"), "actuated: unknown coordinate 'rho_q'"),
     ],
 )
 def test_bad_requests_exit_2_with_one_message(args, fragment):

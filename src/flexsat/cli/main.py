@@ -148,6 +148,11 @@ def linearize(
     reduce: Annotated[
         str | None, typer.Option(help="Also a reduced model: 'balanced:N' or 'modal:N'.")
     ] = None,
+    actuated: Annotated[
+        list[str] | None,
+        typer.Option(help="An appendage coordinate with a root actuator ('<appendage>."
+                     "<coordinate>' or '<coordinate>'): one more input. Repeatable."),
+    ] = None,
     json_output: JsonOption = False,
     out: Annotated[
         Path | None,
@@ -164,7 +169,7 @@ def linearize(
     groups = None if outputs is None else [g.strip() for g in outputs.split(",")]
     _announce_compilation()
     plant = Plant.from_config(load_config(config))
-    _, summary = write_linearize(plant, spin, groups, reduction, out)
+    _, summary = write_linearize(plant, spin, groups, reduction, out, actuated)
     if json_output:
         typer.echo(json.dumps(jsonable(summary)))
         return

@@ -14,7 +14,10 @@ motion (:mod:`flexsat.dynamics.integrators`).
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
+
+from flexsat.errors import ConfigError
 
 __all__ = ["HUB_DOFS", "HUB_UNITS", "CoordinateBlock", "StateLayout"]
 
@@ -110,6 +113,36 @@ class StateLayout:
         for b in self.blocks:
             names += [f"{b.appendage}.{n}" for n in b.names]
         return names
+
+    def appendage_indices(self, names: Sequence[str], field: str) -> list[int]:
+        """Indices in q of named appendage coordinates, each once, in the order named.
+
+        Parameters
+        ----------
+        names : sequence of str
+            ``"<appendage>.<coordinate>"``, or ``"<coordinate>"`` for that coordinate
+            of every appendage that has it.
+        field : str
+            The configuration field or argument the names come from (for the message).
+
+        Raises
+        ------
+        ConfigError
+            For a name that is no appendage coordinate; the message lists them.
+        """
+        all_names = self.dof_names()
+        out: list[int] = []
+        for name in names:
+            if "." in name:
+                found = [all_names.index(name)] if name in all_names[6:] else []
+            else:
+                found = [i for i, full in enumerate(all_names) if full.split(".", 1)[-1] == name
+                         and "." in full]  # fmt: skip
+            if not found:
+                raise ConfigError(f"{field}: unknown coordinate {name!r} (the plant's appendage "
+                                  f"coordinates: {', '.join(all_names[6:])})")  # fmt: skip
+            out += [i for i in found if i not in out]
+        return out
 
     def dof_units(self) -> list[str]:
         units = list(HUB_UNITS)

@@ -18,9 +18,11 @@ Complex-step differentiation does not pass through the numba kernels (compiled
 for float64), and the kernels carry no automatic derivatives. So:
 
 - **about rest**, A and B are the exact analytic form of the linearized eq. 2.50:
-  ``A = [[0, I], [-M0^-1 K, -M0^-1 C]]``, ``B = [0; M0^-1 [0; I_3; 0]]``, from
-  the plant's own M(0), K_sys and C_damp (the bias forces h are quadratic in the
-  rates and vanish to first order; S(0) = I so the Euler rates are the body rate);
+  ``A = [[0, I], [-M0^-1 K, -M0^-1 C]]``, ``B = [0; M0^-1 G]``, from the plant's
+  own M(0), K_sys and C_damp (the bias forces h are quadratic in the rates and
+  vanish to first order; S(0) = I so the Euler rates are the body rate). G holds
+  one unit column per input: ``[0; I_3; 0]`` for the body torque, and the unit
+  vector of the coordinate for each actuated appendage coordinate;
 - **about a spin**, the centrifugal and gyroscopic terms come from the plant's
   compiled ``accelerations`` by central differences with one Richardson
   extrapolation (truncation error O(h^4)); with h = 1e-4 in the scaled state it is
@@ -29,6 +31,13 @@ for float64), and the kernels carry no automatic derivatives. So:
 
 The output matrices C, D (tip displacements, tau_flex) are obtained by the same
 Richardson differences of the plant's output maps at the equilibrium.
+
+Inputs
+------
+``u = [tau_B (3), Q_a (len(actuated))]``: the body torque [N m], then one
+generalized force per actuated appendage coordinate (a root actuator's torque on a
+rotation [N m], force on a translation [N]), added to Q[j] of eq. 2.50 exactly as
+the closed loop's joint actuator applies it.
 """
 
 from __future__ import annotations
@@ -52,13 +61,17 @@ _EQUILIBRIUM_MAX_ITER = 30
 _SPIN_MIN = 1e-12  # [rad/s] a spin vector shorter than this is "zero length"
 
 
-def signal_names(plant: Plant) -> dict[str, tuple[tuple[str, ...], tuple[str, ...]]]:
+def signal_names(
+    plant: Plant, actuated: Sequence[str] = ()
+) -> dict[str, tuple[tuple[str, ...], tuple[str, ...]]]:
     """Names and units of the states, inputs and of each output group.
 
     Parameters
     ----------
     plant : Plant
         The satellite.
+    actuated : sequence of str
+        Actuated appendage coordinates, as for :func:`linearize`.
 
     Returns
     -------
@@ -70,6 +83,8 @@ def signal_names(plant: Plant) -> dict[str, tuple[tuple[str, ...], tuple[str, ..
     # Each appendage's own coordinates, as the plant's layout names them.
     eta = plant.layout.dof_names()[6:]
     eta_units = plant.layout.dof_units()[6:]
+    acted = plant.layout.appendage_indices(actuated, "actuated")
+    all_names, all_units = plant.layout.dof_names(), plant.layout.dof_units()
     states = (
         [f"r_B_{a}" for a in _AXES] + ["phi", "theta", "psi"] + eta
         + [f"v_B_{a}" for a in _AXES] + [f"omega_{a}" for a in _AXES]
@@ -81,13 +96,21 @@ def signal_names(plant: Plant) -> dict[str, tuple[tuple[str, ...], tuple[str, ..
     )  # fmt: skip
     return {
         "states": (tuple(states), tuple(state_units)),
-        "inputs": (tuple(f"tau_{a}" for a in _AXES), ("N m",) * 3),
+        "inputs": (
+            tuple(f"tau_{a}" for a in _AXES) + tuple(f"Q_{all_names[j]}" for j in acted),
+            ("N m",) * 3 + tuple(_force_unit(all_units[j]) for j in acted),
+        ),
         "attitude": (("phi", "theta", "psi"), ("rad",) * 3),
         "rate": (tuple(f"omega_{a}" for a in _AXES), ("rad/s",) * 3),
         "tip": (tuple(f"{a}.tip_{x}" for a in apps for x in _AXES), ("m",) * (3 * len(apps))),
         "joint": (tuple(eta), tuple(eta_units)),
         "tau_flex": (tuple(f"tau_flex_{a}" for a in _AXES), ("N m",) * 3),
     }
+
+
+def _force_unit(unit: str) -> str:
+    """SI unit of the generalized force work-conjugate to a coordinate in ``unit``."""
+    return {"m": "N", "rad": "N m"}.get(unit, f"J/({unit})")
 
 
 def _split(plant: Plant, x: np.ndarray):
@@ -117,9 +140,13 @@ def _plant_state(plant: Plant, x: np.ndarray) -> tuple[np.ndarray, np.ndarray, n
 
 
 def body_frame_derivative(
-    plant: Plant, x: np.ndarray, torque_B: np.ndarray, spin: np.ndarray
+    plant: Plant,
+    x: np.ndarray,
+    torque_B: np.ndarray,
+    spin: np.ndarray,
+    actuated: Sequence[int] = (),
 ) -> np.ndarray:
-    """Time derivative of the body-frame state x under body torque ``torque_B``.
+    """Time derivative of the body-frame state x under the input ``torque_B``.
 
     Parameters
     ----------
@@ -127,10 +154,13 @@ def body_frame_derivative(
     x : ndarray, shape (2 n_dof,)
         Body-frame state (module docstring); its attitude is relative to a reference
         spinning at the constant body rate ``spin``, taken at the identity.
-    torque_B : ndarray, shape (3,)
-        Torque on the hub, hub frame B [N m].
+    torque_B : ndarray, shape (3 + len(actuated),)
+        Torque on the hub, hub frame B [N m], then the generalized forces on the
+        actuated coordinates [N or N m].
     spin : ndarray, shape (3,)
         Body rate of the reference motion W [rad/s].
+    actuated : sequence of int
+        Indices in q of the actuated appendage coordinates.
 
     Returns
     -------
@@ -138,7 +168,7 @@ def body_frame_derivative(
     """
     r_B, dTheta, _, v_B, omega, eta_dot = _split(plant, x)
     q, qd, R_IB = _plant_state(plant, x)
-    qdd = plant.accelerations(q, qd, plant.generalized_forces(q, torque_B))  # eq. 2.50
+    qdd = plant.accelerations(q, qd, _forces(plant, q, torque_B, actuated))  # eq. 2.50
     S = _euler_rate_matrix(dTheta[0], dTheta[1])
     Theta_dot = qd[3:6]
     # d/dt (S Theta_dot) = S Theta_ddot + S_dot Theta_dot; S_dot from eq. 2.28.
@@ -161,10 +191,20 @@ def body_frame_derivative(
     ])  # fmt: skip
 
 
+def _forces(plant: Plant, q: np.ndarray, u: np.ndarray, actuated: Sequence[int]) -> np.ndarray:
+    """Q of eq. 2.50 for u = [tau_B, Q_a]: the torque's, plus Q_a on the actuated q."""
+    Q = plant.generalized_forces(q, u[:3])
+    Q[list(actuated)] += u[3:]
+    return Q
+
+
 def output_map(
-    plant: Plant, groups: Sequence[str]
+    plant: Plant, groups: Sequence[str], actuated: Sequence[int] = ()
 ) -> Callable[[np.ndarray, np.ndarray], np.ndarray]:
     """y(x, u) of the named output groups (see :data:`OUTPUT_GROUPS`), concatenated.
+
+    ``u = [tau_B, Q_a]`` as in :func:`body_frame_derivative` (``actuated``: the
+    indices in q of the actuated coordinates).
 
     Raises
     ------
@@ -177,7 +217,7 @@ def output_map(
                 f"outputs: unknown output {g!r} (allowed: {', '.join(OUTPUT_GROUPS)})"
             )
 
-    def y(x: np.ndarray, torque_B: np.ndarray) -> np.ndarray:
+    def y(x: np.ndarray, u: np.ndarray) -> np.ndarray:
         _, dTheta, eta, _, omega, _ = _split(plant, x)
         q, qd, _ = _plant_state(plant, x)
         parts = {
@@ -185,9 +225,7 @@ def output_map(
             "rate": lambda: omega,
             "tip": lambda: plant.tip_displacement(q).ravel(),
             "joint": lambda: eta,
-            "tau_flex": lambda: plant.joint_wrench_on_hub(
-                q, qd, plant.generalized_forces(q, torque_B)
-            )[1],
+            "tau_flex": lambda: plant.joint_wrench_on_hub(q, qd, _forces(plant, q, u, actuated))[1],
         }
         return np.concatenate([parts[g]() for g in groups])
 
@@ -254,6 +292,7 @@ def linearize(
     about: str | Sequence[float] = "rest",
     outputs: Sequence[str] = ("attitude", "rate", "tip", "joint", "tau_flex"),
     jacobian: str = "auto",
+    actuated: Sequence[str] = (),
 ) -> LinearModel:
     """Linear model of the plant about rest or about a steady spin.
 
@@ -271,17 +310,25 @@ def linearize(
         deflections, tau_flex (torque of the appendages on the hub [N m]).
     jacobian : {"auto", "analytic", "richardson"}
         ``"auto"``: analytic at rest, Richardson differences about a spin.
+    actuated : sequence of str
+        Appendage coordinates driven by a root actuator, named as the closed loop's
+        joint actuator names them: ``"<appendage>.<coordinate>"``, or
+        ``"<coordinate>"`` for that coordinate of every appendage. Each adds the input
+        ``Q_<appendage>.<coordinate>``, its generalized force [N on a translation,
+        N m on a rotation].
 
     Returns
     -------
     LinearModel
-        States, inputs (body torque [N m]) and outputs named as in :func:`signal_names`.
+        States, inputs (body torque [N m], then the actuated coordinates' forces) and
+        outputs named as in :func:`signal_names`.
 
     Raises
     ------
     ConfigError
-        Unknown output group or Jacobian method, a spin vector that is not three
-        finite numbers or has zero length, an analytic Jacobian about a spin.
+        Unknown output group, Jacobian method or actuated coordinate, a spin vector
+        that is not three finite numbers or has zero length, an analytic Jacobian
+        about a spin.
     """
     spin = _spin(about)
     if jacobian not in ("auto", "analytic", "richardson"):
@@ -290,25 +337,28 @@ def linearize(
         )
     if jacobian == "analytic" and spin is not None:
         raise ConfigError("jacobian: 'analytic' exists about rest only; use 'richardson'")
-    y = output_map(plant, list(outputs))
+    acted = plant.layout.appendage_indices(actuated, "actuated")
+    y = output_map(plant, list(outputs), acted)
     n = plant.n_dof
     W = np.zeros(3) if spin is None else spin
     if spin is None:
         x0, u0 = np.zeros(2 * n), np.zeros(3)
     else:
         x0, u0 = _relative_equilibrium(plant, spin)
+    u0 = np.concatenate([u0, np.zeros(len(acted))])  # the actuators hold no force
     if jacobian == "richardson" or spin is not None:
         method = "richardson"
         scale = _state_scale(plant, W)
-        A = _jacobian(lambda x: body_frame_derivative(plant, x, u0, W), x0, scale)
-        B = _jacobian(lambda u: body_frame_derivative(plant, x0, u, W), u0, np.ones(3))
+        A = _jacobian(lambda x: body_frame_derivative(plant, x, u0, W, acted), x0, scale)
+        B = _jacobian(lambda u: body_frame_derivative(plant, x0, u, W, acted), u0,
+                      np.ones(u0.size))  # fmt: skip
     else:
         method = "analytic"
-        A, B = _rest_matrices(plant)
+        A, B = _rest_matrices(plant, acted)
     scale = _state_scale(plant, W)
     C = _jacobian(lambda x: y(x, u0), x0, scale)
-    D = _jacobian(lambda u: y(x0, u), u0, np.ones(3))
-    names = signal_names(plant)
+    D = _jacobian(lambda u: y(x0, u), u0, np.ones(u0.size))
+    names = signal_names(plant, actuated)
     out_names = tuple(s for g in outputs for s in names[g][0])
     out_units = tuple(s for g in outputs for s in names[g][1])
     return LinearModel(
@@ -319,7 +369,7 @@ def linearize(
     )  # fmt: skip
 
 
-def _rest_matrices(plant: Plant) -> tuple[np.ndarray, np.ndarray]:
+def _rest_matrices(plant: Plant, actuated: Sequence[int]) -> tuple[np.ndarray, np.ndarray]:
     """Exact A, B about rest from M(0), K_sys, C_damp (linearized eq. 2.50)."""
     n = plant.n_dof
     M0 = plant.mass_matrix()
@@ -327,9 +377,10 @@ def _rest_matrices(plant: Plant) -> tuple[np.ndarray, np.ndarray]:
     A[:n, n:] = np.eye(n)
     A[n:, :n] = -np.linalg.solve(M0, plant.stiffness_matrix())
     A[n:, n:] = -np.linalg.solve(M0, plant.damping_matrix())
-    G = np.zeros((n, 3))
-    G[3:6] = np.eye(3)  # Q_Theta = S(0)^T tau = tau
-    B = np.vstack([np.zeros((n, 3)), np.linalg.solve(M0, G)])
+    G = np.zeros((n, 3 + len(actuated)))
+    G[3:6, :3] = np.eye(3)  # Q_Theta = S(0)^T tau = tau
+    G[list(actuated), np.arange(3, G.shape[1])] = 1.0  # Q_j = u_j on an actuated q_j
+    B = np.vstack([np.zeros_like(G), np.linalg.solve(M0, G)])
     return A, B
 
 

@@ -13,7 +13,7 @@ name                content
 ``C``               (n_y, n_x) output matrix
 ``D``               (n_y, n_u) feedthrough matrix
 ``x0``              (n_x,) equilibrium state (body-frame variables, SI)
-``u0``              (n_u,) equilibrium input (the torque holding a spin, zero at rest) [N m]
+``u0``              (n_u,) equilibrium input (the torque holding a spin, zero at rest) [SI]
 ``spin``            (3,) body rate of the reference motion, hub frame B [rad/s]
 ``state_names``     names, one string per row (likewise ``input_names``, ``output_names``)
 ``state_units``     SI units of each (likewise ``input_units``, ``output_units``)

@@ -78,11 +78,12 @@ def plot_bode(flexible: LinearModel, rigid: LinearModel, output: str = "rate") -
 def plot_singular_values(flexible: LinearModel, rigid: LinearModel) -> Figure:
     """Singular values of the 3 x 3 torque -> rate response, flexible and rigid."""
     f = frequency_grid_hz()
-    rate = ["omega_x", "omega_y", "omega_z"]
+    rate, torque = ["omega_x", "omega_y", "omega_z"], ["tau_x", "tau_y", "tau_z"]
     fig, axes = style.figure(1, 1, size=(9.0, 5.5))
     ax = axes[0, 0]
     for model, label, ls in ((flexible, "flexible", "-"), (rigid, "rigid", "--")):
-        sv = np.linalg.svd(model.select(outputs=rate).frequency_response(f), compute_uv=False)
+        G = model.select(outputs=rate, inputs=torque).frequency_response(f)
+        sv = np.linalg.svd(G, compute_uv=False)
         for k in range(sv.shape[1]):
             ax.loglog(f, sv[:, k], ls, color=style.AXIS_COLOURS[k], label=f"{label} σ{k + 1}")
     ax.set_xlabel("frequency [Hz]")

@@ -75,8 +75,12 @@ def write_linearize(
     outputs: list[str] | None = None,
     reduction: tuple[str, int] | None = None,
     out: Path | None = None,
+    actuated: list[str] | None = None,
 ) -> tuple[object, dict]:
     """Linearize; with ``out``, ``model.npz``, ``model.mat``, ``linear.json``, figures.
+
+    ``actuated`` names appendage coordinates given an input each, as in
+    :func:`flexsat.linear.linearize`.
 
     Returns
     -------
@@ -90,7 +94,7 @@ def write_linearize(
     from flexsat.linear.frequency import effective_inertia, rigid_model
     from flexsat.linear.reduce import balanced_truncation, modal_truncation
 
-    model = linearize(plant, about, outputs=outputs or OUTPUT_GROUPS)
+    model = linearize(plant, about, outputs=outputs or OUTPUT_GROUPS, actuated=actuated or ())
     f_eff, J_eff, J_res = effective_inertia(plant)
     summary = {
         "config_name": plant.config.name,
@@ -101,6 +105,7 @@ def write_linearize(
         "n_states": model.n_states,
         "state_names": list(model.state_names),
         "input_names": list(model.input_names),
+        "input_units": list(model.input_units),
         "output_names": list(model.output_names),
         "modes": _mode_table(model),
         "effective_inertia": {

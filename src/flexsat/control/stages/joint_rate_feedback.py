@@ -35,7 +35,6 @@ from flexsat.control.stages.registry import (
     JointActuatorConfig,
     StageSpec,
 )
-from flexsat.errors import ConfigError
 
 __all__ = ["JOINT_RATE_FEEDBACK", "JointRateFeedbackConfig"]
 
@@ -64,20 +63,7 @@ class JointRateFeedbackConfig(JointActuatorConfig):
 
     def indices(self, layout) -> list[int]:
         """Indices in q of the actuated coordinates (ConfigError naming an unknown one)."""
-        names = layout.dof_names()
-        out: list[int] = []
-        for name in self.coordinates:
-            if "." in name:
-                found = [names.index(name)] if name in names else []
-            else:
-                found = [i for i, full in enumerate(names) if full.split(".", 1)[-1] == name
-                         and "." in full]  # fmt: skip
-            if not found:
-                allowed = ", ".join(names[6:])
-                raise ConfigError(f"joint_actuator.coordinates: unknown coordinate {name!r} "
-                                  f"(the plant's appendage coordinates: {allowed})")  # fmt: skip
-            out += [i for i in found if i not in out]
-        return out
+        return layout.appendage_indices(self.coordinates, "joint_actuator.coordinates")
 
     def packed(self, scenario, plant=None) -> np.ndarray:
         """k, Q_max, f_b [Hz], engage threshold [rad] (-1: always), count, indices."""
