@@ -17,6 +17,7 @@ import argparse
 from rich.console import Console
 from rich.table import Table
 
+from bench_slew import interleaved_best  # the benchmarks run with bench/ on sys.path
 from flexsat import Plant, nominal
 from flexsat.control.laws import get_law, law_names
 from flexsat.simulate import SlewScenario, run_slew
@@ -36,20 +37,6 @@ def _variants() -> dict[str, dict]:
     return rows
 
 
-def _interleaved_best(fns, repeats: int = 3) -> list[float]:
-    import time
-
-    for fn in fns:
-        fn()  # compile / warm up
-    best = [float("inf")] * len(fns)
-    for _ in range(repeats):
-        for k, fn in enumerate(fns):
-            start = time.perf_counter()
-            fn()
-            best[k] = min(best[k], time.perf_counter() - start)
-    return best
-
-
 def main(argv: list[str] | None = None) -> dict:
     """Print the table; return microseconds per step and the ratio to the ASMC per row."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
@@ -59,7 +46,7 @@ def main(argv: list[str] | None = None) -> dict:
     variants = _variants()
     scenarios = {name: SlewScenario.model_validate({"duration_s": args.duration, **fields})
                  for name, fields in variants.items()}  # fmt: skip
-    walls = _interleaved_best([lambda s=s: run_slew(plant, s, progress=False)
+    walls = interleaved_best([lambda s=s: run_slew(plant, s, progress=False)
                                for s in scenarios.values()])  # fmt: skip
     steps = args.duration / 1e-3
     per_step = {name: 1e6 * wall / steps for name, wall in zip(scenarios, walls, strict=True)}

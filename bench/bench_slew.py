@@ -39,10 +39,10 @@ def _register_user_law() -> str:
 
 
 def _best(fn, repeats: int = 3) -> float:
-    return _interleaved_best([fn], repeats)[0]
+    return interleaved_best([fn], repeats)[0]
 
 
-def _interleaved_best(fns, repeats: int = 3) -> list[float]:
+def interleaved_best(fns, repeats: int = 3) -> list[float]:
     """Best wall time of each function, the repeats taken in turn (a load change on a
     shared machine then affects every function alike, not the last one timed)."""
     for fn in fns:
@@ -67,7 +67,7 @@ def main(argv: list[str] | None = None) -> dict:
     user = _register_user_law()
     kinds = (*builtin, user)
     scenarios = [SlewScenario.model_validate({"controller": {"kind": k}}) for k in kinds]
-    walls = _interleaved_best([lambda s=s: run_slew(plant, s) for s in scenarios])
+    walls = interleaved_best([lambda s=s: run_slew(plant, s) for s in scenarios])
     for kind, wall in zip(kinds, walls, strict=True):
         origin = "user's own law" if kind == user else "compiled"
         rows.append((f"{get_law(kind).label}, {origin}", 120.0, wall))
