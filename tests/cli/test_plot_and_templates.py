@@ -5,7 +5,7 @@ from __future__ import annotations
 import pytest
 
 from flexsat.campaigns import load_campaign
-from flexsat.config import TEMPLATES, load_config, nominal, preset_path
+from flexsat.config import PRESETS, TEMPLATES, load_config, nominal, preset_path
 from flexsat.simulate import OpenLoopScenario, SlewScenario, load_scenario, load_slew
 from flexsat.simulate.result import Result
 from tests.cli.harness import flexsat
@@ -65,6 +65,9 @@ def test_every_template_is_the_documented_default_and_commented(tmp_path, capsys
         "nominal": (load_config, nominal()),
         "openloop": (load_scenario, OpenLoopScenario()),
         "slew": (load_slew, SlewScenario()),
+        # presets beyond the thesis's defaults: they load to what they document
+        "chain": (load_config, load_config(preset_path("chain"))),
+        "avionics-slew": (load_slew, load_slew(preset_path("avionics-slew"))),
     }
     for name in TEMPLATES:
         target = tmp_path / f"{name}.toml"
@@ -76,7 +79,7 @@ def test_every_template_is_the_documented_default_and_commented(tmp_path, capsys
             assert load(target) == default, name
         else:
             assert load_campaign(str(target)).name.startswith("my-")
-        if name != "nominal":  # the satellite's second panel repeats the first's comments
+        if name not in PRESETS:  # a satellite's second panel repeats the first's comments
             # Commented line by line: the settings carry their unit and range beside them
             # (a few, like a case id's modifier list, are explained by the block above).
             settings = [ln for ln in text.splitlines() if "=" in ln and not ln.startswith("#")]

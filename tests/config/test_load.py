@@ -14,7 +14,7 @@ from flexsat.simulate import SlewScenario
     [
         ({"controller": {"kind": "asmc", "lamda_max": 4.0}},
          "did you mean 'lambda_max'? (allowed here: include_lambda_dot, jk_min_nm, kind, "
-         "lambda_max,"),
+         "lambda_adaptation, lambda_max,"),
         ({"controller": {"kind": "pd", "k_p": 1.0}}, "(allowed here: "),
         ({"initial": {"appendages": [{"name": "panel_1", "rho_dg": [0, 0, 0]}]}},
          "did you mean 'rho_deg'?"),

@@ -26,9 +26,19 @@ __all__ = ["BeamModel", "euler_bernoulli_hub_frequencies", "uniform_beam"]
 class BeamModel:
     """FE matrices of a free-free beam and where its interface and tip live.
 
-    ``M``, ``K`` (n, n) sparse; ``interface_dofs`` (6,) and ``interface_map`` (6, 6),
-    the arguments of :func:`flexsat.fe.craig_bampton`; ``tip_dofs`` (3,) the tip's
-    translation DOFs x, y, z and ``tip_position_m`` its place from the interface, frame M.
+    Attributes
+    ----------
+    M, K : scipy.sparse.csr_matrix, shape (n, n)
+        Mass and stiffness matrices, the arguments of :func:`flexsat.fe.craig_bampton`
+        [kg, kg m^2; N/m, N m/rad by DOF kind].
+    interface_dofs : ndarray, shape (6,)
+        The interface node's DOFs (indices into the matrices) [-].
+    interface_map : ndarray, shape (6, 6)
+        T_b, boundary displacement per unit interface motion [-].
+    tip_dofs : ndarray, shape (3,)
+        The tip's translation DOFs x, y, z (indices) [-].
+    tip_position_m : tuple of float
+        The tip's place from the interface, frame M [m].
     """
 
     M: sp.csr_matrix
@@ -130,6 +140,23 @@ def euler_bernoulli_hub_frequencies(hub_inertia_kg_m2: float, root_radius_m: flo
     Y(0) = R Theta, Y'(0) = Theta, Y''(L) = Y'''(L) = 0 and the angular momentum
     J Theta + 2 rho A int_0^L (R + s) Y ds = 0: a 5 x 5 determinant whose roots (bracketed
     on a grid, refined by Brent's method to 1e-14) are the frequencies.
+
+    Parameters
+    ----------
+    hub_inertia_kg_m2 : float
+        J, the hub's inertia about Z [kg m^2].
+    root_radius_m : float
+        R, the clamp radius [m].
+    length_m : float
+        L, each beam's length [m].
+    mass_per_length_kg_m : float
+        rho A [kg/m].
+    bending_stiffness_n_m2 : float
+        EI of the in-plane bending [N m^2].
+    count : int
+        How many frequencies.
+    max_hz : float
+        Upper end of the search [Hz].
 
     Returns
     -------

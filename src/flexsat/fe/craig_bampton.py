@@ -48,7 +48,8 @@ def craig_bampton(
     Parameters
     ----------
     M, K : ndarray or scipy.sparse matrix, shape (n, n)
-        Mass and stiffness matrices of the free-free structure (SI, frame M).
+        Mass and stiffness matrices of the free-free structure (SI, frame M)
+        [kg, kg m, kg m^2; N/m, N/rad, N m/rad by DOF kind].
     interface_dofs : sequence of int
         The boundary DOFs b (indices into the matrices).
     n_modes : int
@@ -61,7 +62,8 @@ def craig_bampton(
         The structure's rigid motions per unit interface motion, when the caller knows
         them (from the node positions): used as the constraint modes instead of
         solving K_ii Psi_i = -K_ib T_b, whose round-off grows with the condition number
-        of K_ii (1e-7 for a thin solid plate). Their boundary rows must be T_b.
+        of K_ii (1e-7 for a thin solid plate). Their boundary rows must be T_b
+        [m/m, m/rad, rad/rad by DOF kind].
     damping_ratio : float or sequence of float
         Modal damping ratio zeta_k, one for all or one per mode [-].
     outputs : mapping, optional
@@ -179,7 +181,7 @@ def rigid_interface_map(points_m: np.ndarray, components: np.ndarray) -> np.ndar
     points_m : ndarray, shape (n_b, 3)
         Each boundary DOF's node position from the interface point, frame M [m].
     components : ndarray, shape (n_b,), int
-        Each DOF's translation component (0, 1, 2 for x, y, z).
+        Each DOF's translation component (0, 1, 2 for x, y, z) [-].
 
     Returns
     -------

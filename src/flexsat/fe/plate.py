@@ -23,10 +23,25 @@ __all__ = ["SolidPlateModel", "solid_plate"]
 
 @dataclass(frozen=True)
 class SolidPlateModel:
-    """FE matrices of a free-free plate and its interface; arguments of
-    :func:`flexsat.fe.craig_bampton` (``rigid_modes``: every DOF's rigid motion about
-    the interface point, (n, 6); ``tip_dofs``: translations x, y, z of the DOF
-    nearest the middle of the free edge, at ``tip_position_m`` from the interface)."""
+    """FE matrices of a free-free plate and its interface.
+
+    Attributes
+    ----------
+    M, K : scipy.sparse.csr_matrix, shape (n, n)
+        Mass and stiffness matrices, the arguments of :func:`flexsat.fe.craig_bampton`
+        [kg; N/m].
+    interface_dofs : ndarray, shape (n_b,)
+        The boundary DOFs rigidly linked to the interface point (indices) [-].
+    interface_map : ndarray, shape (n_b, 6)
+        T_b, boundary displacement per unit interface motion [m/m, m/rad].
+    rigid_modes : ndarray, shape (n, 6)
+        Every DOF's rigid motion about the interface point [m/m, m/rad].
+    tip_dofs : ndarray, shape (3,)
+        Translations x, y, z of the DOF nearest the middle of the free edge
+        (indices) [-].
+    tip_position_m : tuple of float
+        That DOF's place from the interface, frame M [m].
+    """
 
     M: sp.csr_matrix
     K: sp.csr_matrix

@@ -120,7 +120,7 @@ def run_openloop(
         default only a run whose records do not fit in memory is streamed, to a
         temporary file.
     record_budget_bytes : float, optional
-        Memory the records may use before they are streamed; default: half the
+        Memory the records may use before they are streamed [bytes]; default: half the
         machine's memory (:func:`flexsat.simulate.common.check_run_size`).
 
     Returns
