@@ -1,7 +1,7 @@
 """What a slew costs and what it leaves: control energy and residual elastic energy.
 
 The law-comparison figures of merit (``docs/control.md``, "Comparing the laws over
-the campaigns"): the control energy int |tau . omega| dt that the hub actuators
+the campaigns"): the control energy int ‖tau . omega‖ dt that the hub actuators
 spend (absolute power: a wheel spends energy braking too), and the residual
 elastic energy, the largest elastic energy U over the last
 :data:`RESIDUAL_WINDOW_S` of the run (U oscillates between 0 and its envelope at
@@ -32,7 +32,7 @@ def effort_metrics(ds: xr.Dataset) -> dict[str, float]:
     Returns
     -------
     dict
-        ``control_energy_j``: int_0^T |tau_applied . omega| dt (trapezoid over the
+        ``control_energy_j``: int_0^T ‖tau_applied . omega‖ dt (trapezoid over the
         records); ``residual_elastic_energy_j``: max U over the last
         :data:`RESIDUAL_WINDOW_S` [J].
     """

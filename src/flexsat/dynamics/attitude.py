@@ -56,8 +56,8 @@ __all__ = [
 ]
 
 SWITCH_PITCH = pi / 3.0
-"""Re-base the attitude when |pitch| > 60 deg [rad]: far enough from the singularity
-that |cos(pitch)| >= 0.5 (S(Theta)^-1 stays well conditioned), far enough from the
+"""Re-base the attitude when ‖pitch‖ > 60 deg [rad]: far enough from the singularity
+that ‖cos(pitch)‖ >= 0.5 (S(Theta)^-1 stays well conditioned), far enough from the
 thesis's slews (pitch up to 45 deg) that they never switch. A test on the coordinate
 itself, not on cos(pitch): the pitch coordinate grows continuously from 0 after each
 re-base, so an adaptive solver's event on it cannot be stepped over."""
@@ -94,7 +94,7 @@ def _store_m33(a, R):
 
 @njit(cache=True, error_model="numpy")
 def rebase(x, n_dof, frame, threshold=SWITCH_PITCH):
-    """Move the reference frame onto the hub's body frame if |pitch| > ``threshold``.
+    """Move the reference frame onto the hub's body frame if ‖pitch‖ > ``threshold``.
 
     Parameters
     ----------
@@ -105,7 +105,7 @@ def rebase(x, n_dof, frame, threshold=SWITCH_PITCH):
         R_NF, row-major; updated in place.
     threshold : float
         ``SWITCH_PITCH`` [rad]; an adaptive solver that located the switch as an event
-        (where |pitch| = ``SWITCH_PITCH`` up to round-off) passes 0.0.
+        (where ‖pitch‖ = ``SWITCH_PITCH`` up to round-off) passes 0.0.
 
     Returns
     -------
@@ -135,7 +135,7 @@ def inertial_view(x, n_dof, frame, view):
     What a loop stage reads when the run has switched: hub position and velocity in N,
     ZYX Euler angles of R_NB = R_NF R_FB and their rates S(Theta_N)^-1 omega_B. Within
     about 1e-6 rad of pitch +-90 deg in N those rates, and a body rate formed back from
-    them, lose eps / |cos(pitch)| of their relative accuracy (docs/model.md, 'Attitude
+    them, lose eps / ‖cos(pitch)‖ of their relative accuracy (docs/model.md, 'Attitude
     parametrization'); the integration itself does not.
     """
     view[:] = x

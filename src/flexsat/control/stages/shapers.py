@@ -86,7 +86,7 @@ def residual_vibration(
 ) -> float:
     """Residual vibration of a damped mode after the impulses, relative to one impulse.
 
-    V = exp(-zeta w t_N) |sum A_i exp(zeta w t_i) exp(j w_d t_i)| (Singer and Seering
+    V = exp(-zeta w t_N) ‖sum A_i exp(zeta w t_i) exp(j w_d t_i)‖ (Singer and Seering
     1990), 0 for a perfect shaper, 1 for no shaping.
     """
     w = 2.0 * pi * frequency_hz

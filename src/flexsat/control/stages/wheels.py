@@ -14,10 +14,10 @@ H_B = J_rest omega + sum a_i h_i (+ the appendages'), and (``docs/control.md``,
 so the wheels exert on the hub the wrench -sum a_i (u_i - f_i) - omega x sum a_i h_i,
 evaluated inside every RK4 stage (it depends on omega within the step). u_i is the
 motor torque, a first-order response u_i_dot = (u_cmd,i - u_i) / tau_m to the
-command; it is cut to zero while it would drive |h_i| beyond I_s Omega_max
+command; it is cut to zero while it would drive ‖h_i‖ beyond I_s Omega_max
 (momentum saturation: the speed limit on the wheel's axial spin rate h_i / I_s,
 within a . omega ~ 1e-5 Omega_max of its rate relative to the hub at slew rates).
-A wheel is reported saturated at records where |h_i| >= 0.999 I_s Omega_max (the
+A wheel is reported saturated at records where ‖h_i‖ >= 0.999 I_s Omega_max (the
 drive holds it there, friction pulling it just below).
 f_i = c_v Omega_i + c_c tanh(Omega_i / omega_c): viscous and Coulomb friction (the
 Coulomb sign smoothed over omega_c). The motor work sum u_i Omega_i and the

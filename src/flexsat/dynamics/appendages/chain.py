@@ -3,7 +3,8 @@
 The thesis's own recommendation for higher modes (section 6.2): discretize each
 appendage into "a kinematic chain of N rigid segments connected in series". Each
 joint frees any subset of the six relative DOFs; the thesis plate is the chain of one
-segment on a full 6-DOF joint and gives the same results as :mod:`.plate`.
+segment on a full 6-DOF joint and gives the same results as
+:mod:`flexsat.dynamics.appendages.plate`.
 
 Coordinates: per joint, root first, its free DOFs in the order ``x, y, z, rx, ry,
 rz`` (:data:`~flexsat.dynamics.appendages.chain_config.DOF_NAMES`), named
