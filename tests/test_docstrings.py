@@ -1,7 +1,9 @@
 """Every public function and class has a numpydoc docstring that matches its signature.
 
-The public API is everything a package's ``__all__`` names (``flexsat``,
-``flexsat.simulate``, ``flexsat.control.laws``...). Like python-control's docstring
+The public API is everything a package's or a module's ``__all__`` names
+(``flexsat``, ``flexsat.simulate``, ``flexsat.control.laws``,
+``flexsat.dynamics.kernels``...); a module without ``__all__`` exports every function
+and class it defines without a leading underscore. Like python-control's docstring
 meta-test, this parses each docstring (``numpydoc.validate``) and checks that it has a
 summary, that its Parameters section lists exactly the signature's parameters, in
 order, each with a type and a description, and that every quantity carries its unit:
@@ -44,23 +46,47 @@ NUMERIC = re.compile(r"\b(float|ndarray|array_like|array|complex|Quantity)\b")
 UNIT = re.compile(r"\[[^\]]+\]")
 
 
-def _packages() -> list[str]:
+def _modules() -> list[str]:
+    """Every importable module of flexsat, packages first (their names are the shorter)."""
     names = ["flexsat"]
     for info in pkgutil.walk_packages(flexsat.__path__, "flexsat."):
-        if info.ispkg and not any(p.startswith("_") for p in info.name.split(".")[1:]):
+        if not any(p.startswith("_") for p in info.name.split(".")[1:]):
             names.append(info.name)
-    return names
+    packages = [n for n in names if hasattr(importlib.import_module(n), "__path__")]
+    return packages + [n for n in names if n not in packages]
+
+
+def _is_public_kind(obj: object) -> bool:
+    return inspect.isclass(obj) or inspect.isfunction(obj) or hasattr(obj, "py_func")
+
+
+def _public_names(module) -> list[str]:
+    """A module's ``__all__``, or else every non-underscore function or class it defines."""
+    if hasattr(module, "__all__"):
+        return list(module.__all__)
+    return [
+        name
+        for name, obj in vars(module).items()
+        if not name.startswith("_")
+        and _is_public_kind(obj)
+        and getattr(getattr(obj, "py_func", obj), "__module__", None) == module.__name__
+    ]
 
 
 def _public_objects() -> dict[str, object]:
-    """``package.name`` of each public function, class or compiled function, once."""
+    """``module.name`` of each public function, class or compiled function, once.
+
+    Public: what a package's or a module's ``__all__`` names; a module without
+    ``__all__`` exports every function and class it defines without a leading
+    underscore. An object is listed under the first (package-level) name found.
+    """
     found: dict[int, tuple[str, object]] = {}
-    for package in _packages():
-        module = importlib.import_module(package)
-        for name in module.__all__:
-            obj = getattr(module, name)
-            if inspect.isclass(obj) or inspect.isfunction(obj) or hasattr(obj, "py_func"):
-                found.setdefault(id(obj), (f"{package}.{name}", obj))
+    for name in _modules():
+        module = importlib.import_module(name)
+        for attr in _public_names(module):
+            obj = getattr(module, attr)
+            if _is_public_kind(obj):
+                found.setdefault(id(obj), (f"{name}.{attr}", obj))
     return dict(found.values())
 
 
@@ -81,7 +107,7 @@ def _unitless(items) -> list[str]:
 
 
 def test_the_public_api_is_found():
-    assert len(PUBLIC) > 100
+    assert len(PUBLIC) > 250
     assert "flexsat.simulate.run_slew" in PUBLIC and "flexsat.Plant" in PUBLIC
 
 

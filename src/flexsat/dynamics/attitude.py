@@ -70,16 +70,37 @@ def identity_frame() -> np.ndarray:
 
 @njit(cache=True, error_model="numpy")
 def is_identity(frame):
-    """True if ``frame`` (9,) is exactly the identity (the run has not switched)."""
+    """True if ``frame`` is exactly the identity (the run has not switched).
+
+    Parameters
+    ----------
+    frame : ndarray, shape (9,)
+        R_NF, row-major [-].
+
+    Returns
+    -------
+    bool
+        Whether R_NF = I exactly.
+    """
     return frame[0] == 1.0 and frame[4] == 1.0 and frame[8] == 1.0
 
 
 @njit(cache=True, error_model="numpy")
 def euler_zyx(R):
-    """ZYX Euler angles (phi, theta, psi) [rad] of a rotation matrix (nested tuples).
+    """ZYX Euler angles of a rotation matrix.
 
     The inverse of :func:`flexsat.dynamics.linalg3.rot_zyx`, with theta in
     [-pi/2, pi/2]; at theta = +-pi/2 only phi - psi (or phi + psi) is defined.
+
+    Parameters
+    ----------
+    R : tuple of 3 rows of 3 float
+        The rotation matrix, child to parent components [-].
+
+    Returns
+    -------
+    phi, theta, psi : float
+        Roll, pitch and yaw [rad].
     """
     theta = atan2(-R[2][0], hypot(R[0][0], R[1][0]))
     return atan2(R[2][1], R[2][2]), theta, atan2(R[1][0], R[0][0])
@@ -101,8 +122,9 @@ def rebase(x, n_dof, frame, threshold=SWITCH_PITCH):
     x : ndarray, shape (2 n_dof + 2,)
         Augmented state [q, q_dot, W_in, W_diss] relative to F; re-based in place.
     n_dof : int
+        Number of generalized coordinates.
     frame : ndarray, shape (9,)
-        R_NF, row-major; updated in place.
+        R_NF, row-major [-]; updated in place.
     threshold : float
         ``SWITCH_PITCH`` [rad]; an adaptive solver that located the switch as an event
         (where ‖pitch‖ = ``SWITCH_PITCH`` up to round-off) passes 0.0.
@@ -137,6 +159,17 @@ def inertial_view(x, n_dof, frame, view):
     about 1e-6 rad of pitch +-90 deg in N those rates, and a body rate formed back from
     them, lose eps / ‖cos(pitch)‖ of their relative accuracy (docs/model.md, 'Attitude
     parametrization'); the integration itself does not.
+
+    Parameters
+    ----------
+    x : ndarray, shape (2 n_dof + 2,)
+        Augmented state [q, q_dot, W_in, W_diss] relative to F (SI: m, rad, J).
+    n_dof : int
+        Number of generalized coordinates.
+    frame : ndarray, shape (9,)
+        R_NF of x, row-major [-].
+    view : ndarray, shape (2 n_dof + 2,)
+        Output: x with its hub part relative to N [SI, as x].
     """
     view[:] = x
     R_NF = load_m33_at(frame, 0)
@@ -157,18 +190,19 @@ def inertial_records(
     Parameters
     ----------
     q, qd : ndarray, shape (m, n_dof)
-        Recorded coordinates and rates, hub part relative to F.
+        Recorded coordinates [m, rad] and rates [m/s, rad/s], hub part relative to F.
     omega_B : ndarray, shape (m, 3)
         Body rates of the records [rad/s] (frame-independent).
     frames : ndarray, shape (m, 9)
-        R_NF of each record, row-major.
+        R_NF of each record, row-major [-].
 
     Returns
     -------
     q_N, qd_N : ndarray, shape (m, n_dof)
         Copies with the hub position, velocity, ZYX Euler angles and their rates
-        relative to N. Rows whose frame is the identity are copied unchanged (bit-for-
-        bit). Exactly at pitch +-90 deg in N the Euler rates are infinite.
+        relative to N [m, rad, m/s, rad/s]. Rows whose frame is the identity are copied
+        unchanged (bit-for-bit). Exactly at pitch +-90 deg in N the Euler rates are
+        infinite.
     """
     q_N, qd_N = q.copy(), qd.copy()
     moved = _moved(frames)
@@ -194,7 +228,20 @@ def inertial_records(
 
 
 def vectors_to_inertial(v_F: np.ndarray, frames: np.ndarray) -> np.ndarray:
-    """v_N = R_NF v_F for each record, shapes (m, 3) and (m, 9); identity rows unchanged."""
+    """v_N = R_NF v_F for each record; identity rows unchanged.
+
+    Parameters
+    ----------
+    v_F : ndarray, shape (m, 3)
+        Vectors in each record's frame F [any].
+    frames : ndarray, shape (m, 9)
+        R_NF of each record, row-major [-].
+
+    Returns
+    -------
+    ndarray, shape (m, 3)
+        The vectors in N [unit of v_F].
+    """
     v_N = v_F.copy()
     moved = _moved(frames)
     v_N[moved] = np.einsum("kij,kj->ki", frames[moved].reshape(-1, 3, 3), v_F[moved])

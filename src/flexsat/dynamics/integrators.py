@@ -38,7 +38,24 @@ __all__ = [
 
 @njit(cache=True)
 def applied_torque(t, seg_start, seg_end, seg_torque, disturbance):
-    """Body torque at time t: active segments plus the disturbance, hub frame B [N m]."""
+    """Body torque at time t: active segments plus the disturbance, hub frame B.
+
+    Parameters
+    ----------
+    t : float
+        Time [s].
+    seg_start, seg_end : ndarray, shape (k,)
+        Start and end of each torque segment [s]; a segment is active on [start, end).
+    seg_torque : ndarray, shape (k, 3)
+        Each segment's torque, hub frame B [N m].
+    disturbance : ndarray, shape (3,)
+        Constant disturbance torque, hub frame B [N m].
+
+    Returns
+    -------
+    tuple of 3 float
+        The applied torque, hub frame B [N m].
+    """
     tx, ty, tz = disturbance[0], disturbance[1], disturbance[2]
     for k in range(seg_start.shape[0]):
         if seg_start[k] <= t < seg_end[k]:
@@ -52,12 +69,30 @@ def applied_torque(t, seg_start, seg_end, seg_torque, disturbance):
 def augmented_derivative(x, torque_B, n, Q, dx, packed):
     """dx/dt of the augmented state [q, q_dot, W_in, W_diss] under a body torque.
 
-    ``torque_B`` is a 3-tuple [N m], ``Q`` (n,) the generalized forces: on input
-    ``Q[6:]`` holds those applied to the appendage coordinates (joint actuators; zero
-    without), ``Q[:6]`` is overwritten with the hub's. ``dx`` the output, ``packed``
-    the :class:`~flexsat.dynamics.packed.PackedPlant`. Shared by the compiled RK4
-    loop and the adaptive scipy solver. Returns a status. W_in integrates the power
-    of every applied generalized force, hub torque and joint actuators.
+    Shared by the compiled RK4 loop and the adaptive scipy solver. W_in integrates the
+    power of every applied generalized force, hub torque and joint actuators.
+
+    Parameters
+    ----------
+    x : ndarray, shape (2 n + 2,)
+        Augmented state: q [m, rad], q_dot [m/s, rad/s], W_in [J], W_diss [J].
+    torque_B : tuple of 3 float
+        Body torque on the hub, hub frame B [N m].
+    n : int
+        Number of generalized coordinates n_dof.
+    Q : ndarray, shape (n,)
+        Generalized forces [N, N m per coordinate]: on input ``Q[6:]`` holds those
+        applied to the appendage coordinates (joint actuators; zero without),
+        ``Q[:6]`` is overwritten with the hub's.
+    dx : ndarray, shape (2 n + 2,)
+        Output: the derivative [unit of x per s].
+    packed : PackedPlant
+        The plant's packed arrays and kernels (:class:`~flexsat.dynamics.packed.PackedPlant`).
+
+    Returns
+    -------
+    int
+        ``STATUS_OK`` or a kernel status.
     """
     q = x[:n]
     qd = x[n : 2 * n]
@@ -77,10 +112,29 @@ def augmented_derivative(x, torque_B, n, Q, dx, packed):
 def rk4_step(x, dt, torque_B, n, Q, scratch, packed):
     """One RK4 step of the augmented state x, in place, under a held body torque.
 
-    ``scratch`` (5, len(x)) is a work array the caller allocates once; ``Q`` (n,) holds
-    the generalized forces held on the appendage coordinates in ``Q[6:]`` (zeros
-    without joint actuators; :func:`augmented_derivative`). On a non-zero status x is
-    left unchanged.
+    Parameters
+    ----------
+    x : ndarray, shape (2 n + 2,)
+        Augmented state [q, q_dot, W_in, W_diss] (SI: m, rad, m/s, rad/s, J); on a
+        non-zero status it is left unchanged.
+    dt : float
+        Step [s].
+    torque_B : tuple of 3 float
+        Held body torque, hub frame B [N m].
+    n : int
+        Number of generalized coordinates n_dof.
+    Q : ndarray, shape (n,)
+        Generalized forces held on the appendage coordinates in ``Q[6:]`` [N, N m per
+        coordinate] (zeros without joint actuators; :func:`augmented_derivative`).
+    scratch : ndarray, shape (5, len(x))
+        Work array the caller allocates once [-].
+    packed : PackedPlant
+        The plant's packed arrays and kernels.
+
+    Returns
+    -------
+    int
+        ``STATUS_OK``, a kernel status or ``STATUS_NOT_FINITE``.
     """
     size = x.shape[0]
     k1, k2, k3, k4, stage = scratch[0], scratch[1], scratch[2], scratch[3], scratch[4]
@@ -106,9 +160,29 @@ def rk4_step(x, dt, torque_B, n, Q, scratch, packed):
 
 @njit(cache=True)
 def rk4_hold(x, dt, n_steps, torque_B, packed, frame):
-    """``n_steps`` RK4 steps under one held body torque (3-tuple). Returns (status, done).
+    """``n_steps`` RK4 steps under one held body torque.
 
-    ``frame`` (9,) is the attitude reference R_NF, re-based before each step.
+    Parameters
+    ----------
+    x : ndarray, shape (2 n_dof + 2,)
+        Augmented state [q, q_dot, W_in, W_diss] (SI), advanced in place.
+    dt : float
+        Step [s].
+    n_steps : int
+        Number of steps.
+    torque_B : tuple of 3 float
+        Held body torque, hub frame B [N m].
+    packed : PackedPlant
+        The plant's packed arrays and kernels.
+    frame : ndarray, shape (9,)
+        The attitude reference R_NF (row-major) [-], re-based before each step.
+
+    Returns
+    -------
+    status : int
+        ``STATUS_OK`` or the failing step's status.
+    done : int
+        Steps completed without error.
     """
     n = packed.n_dof
     scratch = np.empty((5, x.shape[0]))
@@ -134,20 +208,28 @@ def rk4_open_loop(
         Augmented state [q, q_dot, W_in, W_diss], advanced in place.
     t0, dt : float
         Time of x and step [s]; step k starts at t0 + k dt.
-    n_steps, record_every : int
+    n_steps : int
+        Number of steps.
+    record_every : int
+        Steps between two records.
     seg_start, seg_end : ndarray, shape (k,)
+        Start and end of each torque segment [s].
     seg_torque : ndarray, shape (k, 3)
+        Each segment's torque, hub frame B [N m].
     disturbance : ndarray, shape (3,)
+        Constant disturbance torque, hub frame B [N m].
     packed : PackedPlant
         ``Plant.packed``.
     frame : ndarray, shape (9,)
-        Attitude reference R_NF of x (row-major), re-based before each step and
+        Attitude reference R_NF of x (row-major) [-], re-based before each step and
         updated in place (:mod:`flexsat.dynamics.attitude`).
     rec_t, rec_x, rec_tau, rec_frame : ndarray
-        Record buffers, shapes (m,), (m, 2 n_dof + 2), (m, 3), (m, 9); the state after
-        step k is written at row rec_start + (k + 1) / record_every - 1 when
-        (k + 1) is a multiple of ``record_every``, with the torque held during the
-        next step and the state's reference frame.
+        Record buffers, shapes (m,) [s], (m, 2 n_dof + 2) [SI, as x], (m, 3) [N m],
+        (m, 9) [-]; the state after step k is written at row rec_start + (k + 1) /
+        record_every - 1 when (k + 1) is a multiple of ``record_every``, with the torque
+        held during the next step and the state's reference frame.
+    rec_start : int
+        First row of the record buffers to write.
 
     Returns
     -------

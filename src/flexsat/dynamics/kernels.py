@@ -130,12 +130,15 @@ def accelerations(q, qd, Q, packed, qdd):
     Parameters
     ----------
     q, qd : ndarray, shape (n_dof,)
-        Generalized coordinates and their rates (SI, rad).
+        Generalized coordinates and their rates: hub position [m], ZYX Euler angles
+        [rad], appendage coordinates [m or rad]; rates [m/s, rad/s].
     Q : ndarray, shape (n_dof,)
-        External generalized forces (see :func:`flexsat.dynamics.plant.Plant.generalized_forces`).
+        External generalized forces [N, N m per coordinate] (see
+        :func:`flexsat.dynamics.plant.Plant.generalized_forces`).
     packed : PackedPlant
+        The plant's packed arrays and kernels (:class:`flexsat.dynamics.packed.PackedPlant`).
     qdd : ndarray, shape (n_dof,)
-        Output: generalized accelerations.
+        Output: generalized accelerations [m/s^2, rad/s^2].
 
     Returns
     -------
@@ -244,10 +247,19 @@ def _hold_locked(q, packed, qdd):
 
 @njit(cache=True, error_model="numpy")
 def mass_matrix(q, packed, M):
-    """Mass matrix M(q) (eq. 2.39), written into ``M``, shape (n_dof, n_dof).
+    """Mass matrix M(q) (eq. 2.39), written into ``M``.
 
     Assembled from the bodies' velocity Jacobians, M = sum_b m_b Jv_b^T Jv_b +
     Jw_b^T J_b Jw_b: the hub's here, each appendage's by its model.
+
+    Parameters
+    ----------
+    q : ndarray, shape (n_dof,)
+        Generalized coordinates [m, rad].
+    packed : PackedPlant
+        The plant's packed arrays and kernels.
+    M : ndarray, shape (n_dof, n_dof)
+        Output: the mass matrix [kg, kg m, kg m^2 per entry].
     """
     M[:, :] = 0.0
     S = euler_rate_matrix(q[3], q[4])
@@ -272,6 +284,15 @@ def bias_forces(q, qd, packed, h):
     M_dot q_dot - (dT/dq)^T for this holonomic system: h = sum_b Jv_b^T m_b a0_b +
     Jw_b^T (J_b alpha0_b + w_b x J_b w_b), with a0, alpha0 the accelerations
     at zero q_ddot.
+
+    Parameters
+    ----------
+    q, qd : ndarray, shape (n_dof,)
+        Generalized coordinates [m, rad] and their rates [m/s, rad/s].
+    packed : PackedPlant
+        The plant's packed arrays and kernels.
+    h : ndarray, shape (n_dof,)
+        Output: h [N, N m per coordinate].
     """
     phi, theta = q[3], q[4]
     S = euler_rate_matrix(phi, theta)
@@ -291,11 +312,26 @@ def bias_forces(q, qd, packed, h):
 
 @njit(cache=True, error_model="numpy")
 def hub_joint_wrench(q, qd, Q, packed, out):
-    """Wrench the appendages' joints exert on the hub, written into ``out``, shape (6,).
+    """Wrench the appendages' joints exert on the hub, written into ``out``.
 
-    ``out[0:3]`` is the force and ``out[3:6]`` the torque tau_flex about the hub
-    centre of mass, both in hub frame B [N], [N m] (elastic + damping, plus any
-    external generalized force on the joint coordinates). Returns a status.
+    Elastic + damping, plus any external generalized force on the joint coordinates.
+
+    Parameters
+    ----------
+    q, qd : ndarray, shape (n_dof,)
+        Generalized coordinates [m, rad] and their rates [m/s, rad/s].
+    Q : ndarray, shape (n_dof,)
+        External generalized forces [N, N m per coordinate].
+    packed : PackedPlant
+        The plant's packed arrays and kernels.
+    out : ndarray, shape (6,)
+        Output: ``out[0:3]`` the force [N] and ``out[3:6]`` the torque tau_flex about
+        the hub centre of mass [N m], both in hub frame B.
+
+    Returns
+    -------
+    int
+        ``STATUS_OK`` or an appendage's failure status.
     """
     out[:] = 0.0
     for g in range(len(packed.joint_wrench)):
@@ -307,14 +343,22 @@ def hub_joint_wrench(q, qd, Q, packed, out):
 
 @njit(cache=True, error_model="numpy")
 def observe(q, qd, packed, out):
-    """Energies, momentum and locked inertia at one state, into ``out`` (OBS_SIZE,).
+    """Energies, momentum and locked inertia at one state, into ``out``.
 
-    Slots (``OBS_*`` of the contract module): kinetic energy T (eqs. 2.32-2.34) [J];
-    total angular momentum about the inertial origin, frame N [N m s] (exactly
-    conserved without external torque); the locked inertia J(eta) of the satellite
-    frozen in its current shape, about the hub centre of mass, frame B [kg m^2]
-    (J(eta) omega_B is the rigid part of the angular momentum the thesis plots);
-    elastic energy U (eq. 2.35) [J]; damper power q_dot^T C q_dot (eq. 2.36) [W].
+    Parameters
+    ----------
+    q, qd : ndarray, shape (n_dof,)
+        Generalized coordinates [m, rad] and their rates [m/s, rad/s].
+    packed : PackedPlant
+        The plant's packed arrays and kernels.
+    out : ndarray, shape (OBS_SIZE,)
+        Output, slots ``OBS_*`` of the contract module: kinetic energy T (eqs.
+        2.32-2.34) [J]; total angular momentum about the inertial origin, frame N
+        [N m s] (exactly conserved without external torque); the locked inertia J(eta)
+        of the satellite frozen in its current shape, about the hub centre of mass,
+        frame B [kg m^2] (J(eta) omega_B is the rigid part of the angular momentum the
+        thesis plots); elastic energy U (eq. 2.35) [J]; damper power q_dot^T C q_dot
+        (eq. 2.36) [W].
     """
     R_NB = rot_zyx(q[3], q[4], q[5])
     r_hub = load_seg(q, 0)
@@ -336,9 +380,16 @@ def observe(q, qd, packed, out):
 
 @njit(cache=True, error_model="numpy")
 def tip_displacement(q, packed, out):
-    """Displacement of each appendage's tip from its undeformed place, mount frame [m].
+    """Displacement of each appendage's tip from its undeformed place, mount frame.
 
-    ``out`` (n, 3), one row per appendage in config order.
+    Parameters
+    ----------
+    q : ndarray, shape (n_dof,)
+        Generalized coordinates [m, rad].
+    packed : PackedPlant
+        The plant's packed arrays and kernels.
+    out : ndarray, shape (n_appendages, 3)
+        Output: one row per appendage in config order [m].
     """
     for g in range(len(packed.tips)):
         packed.tips[g](q, packed.members[g], packed.params[g], out)

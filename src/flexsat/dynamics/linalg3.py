@@ -45,26 +45,88 @@ __all__ = [
 
 @njit(cache=True, error_model="numpy")
 def add(a, b):
+    """a + b for 3-vectors.
+
+    Parameters
+    ----------
+    a, b : tuple of 3 float
+        The vectors, in one unit [any].
+
+    Returns
+    -------
+    tuple of 3 float
+        Their sum [unit of a].
+    """
     return (a[0] + b[0], a[1] + b[1], a[2] + b[2])
 
 
 @njit(cache=True, error_model="numpy")
 def sub(a, b):
+    """a - b for 3-vectors.
+
+    Parameters
+    ----------
+    a, b : tuple of 3 float
+        The vectors, in one unit [any].
+
+    Returns
+    -------
+    tuple of 3 float
+        Their difference [unit of a].
+    """
     return (a[0] - b[0], a[1] - b[1], a[2] - b[2])
 
 
 @njit(cache=True, error_model="numpy")
 def scale(s, a):
+    """s a for a 3-vector.
+
+    Parameters
+    ----------
+    s : float
+        The factor [any].
+    a : tuple of 3 float
+        The vector [any].
+
+    Returns
+    -------
+    tuple of 3 float
+        The scaled vector [unit of s times unit of a].
+    """
     return (s * a[0], s * a[1], s * a[2])
 
 
 @njit(cache=True, error_model="numpy")
 def dot(a, b):
+    """a . b for 3-vectors.
+
+    Parameters
+    ----------
+    a, b : tuple of 3 float
+        The vectors, components in one frame [any].
+
+    Returns
+    -------
+    float
+        Their scalar product [unit of a times unit of b].
+    """
     return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 
 
 @njit(cache=True, error_model="numpy")
 def cross(a, b):
+    """a x b for 3-vectors.
+
+    Parameters
+    ----------
+    a, b : tuple of 3 float
+        The vectors, components in one frame [any].
+
+    Returns
+    -------
+    tuple of 3 float
+        Their cross product, same frame [unit of a times unit of b].
+    """
     return (
         a[1] * b[2] - a[2] * b[1],
         a[2] * b[0] - a[0] * b[2],
@@ -74,13 +136,39 @@ def cross(a, b):
 
 @njit(cache=True, error_model="numpy")
 def mv(m, x):
-    """m @ x."""
+    """m @ x.
+
+    Parameters
+    ----------
+    m : tuple of 3 rows of 3 float
+        The 3x3 matrix [any].
+    x : tuple of 3 float
+        The vector [any].
+
+    Returns
+    -------
+    tuple of 3 float
+        The product [unit of m times unit of x].
+    """
     return (dot(m[0], x), dot(m[1], x), dot(m[2], x))
 
 
 @njit(cache=True, error_model="numpy")
 def mtv(m, x):
-    """m.T @ x."""
+    """m.T @ x.
+
+    Parameters
+    ----------
+    m : tuple of 3 rows of 3 float
+        The 3x3 matrix [any]; for a rotation matrix, m.T maps parent to body components.
+    x : tuple of 3 float
+        The vector [any].
+
+    Returns
+    -------
+    tuple of 3 float
+        The product [unit of m times unit of x].
+    """
     return (
         m[0][0] * x[0] + m[1][0] * x[1] + m[2][0] * x[2],
         m[0][1] * x[0] + m[1][1] * x[1] + m[2][1] * x[2],
@@ -90,6 +178,18 @@ def mtv(m, x):
 
 @njit(cache=True, error_model="numpy")
 def transpose(m):
+    """m.T for a 3x3 matrix.
+
+    Parameters
+    ----------
+    m : tuple of 3 rows of 3 float
+        The matrix [any].
+
+    Returns
+    -------
+    tuple of 3 rows of 3 float
+        Its transpose [unit of m].
+    """
     return (
         (m[0][0], m[1][0], m[2][0]),
         (m[0][1], m[1][1], m[2][1]),
@@ -99,7 +199,18 @@ def transpose(m):
 
 @njit(cache=True, error_model="numpy")
 def mm(a, b):
-    """a @ b."""
+    """a @ b for 3x3 matrices.
+
+    Parameters
+    ----------
+    a, b : tuple of 3 rows of 3 float
+        The matrices [any].
+
+    Returns
+    -------
+    tuple of 3 rows of 3 float
+        The product [unit of a times unit of b].
+    """
     bt = transpose(b)
     return (
         (dot(a[0], bt[0]), dot(a[0], bt[1]), dot(a[0], bt[2])),
@@ -110,19 +221,52 @@ def mm(a, b):
 
 @njit(cache=True, error_model="numpy")
 def mtm(a, b):
-    """a.T @ b."""
+    """a.T @ b for 3x3 matrices.
+
+    Parameters
+    ----------
+    a, b : tuple of 3 rows of 3 float
+        The matrices [any].
+
+    Returns
+    -------
+    tuple of 3 rows of 3 float
+        The product [unit of a times unit of b].
+    """
     return mm(transpose(a), b)
 
 
 @njit(cache=True, error_model="numpy")
 def skew(v):
-    """[v]x, the matrix with skew(v) @ x == cross(v, x)."""
+    """[v]x, the matrix with skew(v) @ x == cross(v, x).
+
+    Parameters
+    ----------
+    v : tuple of 3 float
+        The vector [any].
+
+    Returns
+    -------
+    tuple of 3 rows of 3 float
+        The skew-symmetric matrix [unit of v].
+    """
     return ((0.0, -v[2], v[1]), (v[2], 0.0, -v[0]), (-v[1], v[0], 0.0))
 
 
 @njit(cache=True, error_model="numpy")
 def rot_zyx(phi, theta, psi):
-    """Rz(psi) Ry(theta) Rx(phi): body (child) components to parent components (eq. 2.25)."""
+    """Rz(psi) Ry(theta) Rx(phi): body (child) components to parent components (eq. 2.25).
+
+    Parameters
+    ----------
+    phi, theta, psi : float
+        ZYX Euler angles: roll, pitch, yaw [rad].
+
+    Returns
+    -------
+    tuple of 3 rows of 3 float
+        The rotation matrix [-].
+    """
     c1, s1 = cos(phi), sin(phi)
     c2, s2 = cos(theta), sin(theta)
     c3, s3 = cos(psi), sin(psi)
@@ -135,7 +279,18 @@ def rot_zyx(phi, theta, psi):
 
 @njit(cache=True, error_model="numpy")
 def euler_rate_matrix(phi, theta):
-    """S(Theta) of eq. 2.28: body rate = S @ ZYX Euler-angle rates."""
+    """S(Theta) of eq. 2.28: body rate = S @ ZYX Euler-angle rates.
+
+    Parameters
+    ----------
+    phi, theta : float
+        Roll and pitch [rad] (S does not depend on yaw).
+
+    Returns
+    -------
+    tuple of 3 rows of 3 float
+        S [-].
+    """
     c1, s1 = cos(phi), sin(phi)
     c2, s2 = cos(theta), sin(theta)
     return ((1.0, 0.0, -s2), (0.0, c1, c2 * s1), (0.0, -s1, c2 * c1))
@@ -143,7 +298,18 @@ def euler_rate_matrix(phi, theta):
 
 @njit(cache=True, error_model="numpy")
 def euler_rate_matrix_inv(phi, theta):
-    """S(Theta)^-1; singular at theta = +-90 deg (the caller checks cos(theta))."""
+    """S(Theta)^-1; singular at theta = +-90 deg (the caller checks cos(theta)).
+
+    Parameters
+    ----------
+    phi, theta : float
+        Roll and pitch [rad].
+
+    Returns
+    -------
+    tuple of 3 rows of 3 float
+        S^-1: ZYX Euler-angle rates = S^-1 @ body rate [-].
+    """
     c1, s1 = cos(phi), sin(phi)
     c2, s2 = cos(theta), sin(theta)
     t2 = s2 / c2
@@ -152,7 +318,20 @@ def euler_rate_matrix_inv(phi, theta):
 
 @njit(cache=True, error_model="numpy")
 def euler_rate_bias(phi, theta, dphi, dtheta, dpsi):
-    """dS/dt @ Theta_dot: the part of the body angular acceleration not from Theta_ddot."""
+    """dS/dt @ Theta_dot: the part of the body angular acceleration not from Theta_ddot.
+
+    Parameters
+    ----------
+    phi, theta : float
+        Roll and pitch [rad].
+    dphi, dtheta, dpsi : float
+        ZYX Euler-angle rates [rad/s].
+
+    Returns
+    -------
+    tuple of 3 float
+        dS/dt @ Theta_dot, body frame B [rad/s^2].
+    """
     c1, s1 = cos(phi), sin(phi)
     c2, s2 = cos(theta), sin(theta)
     return (
@@ -164,13 +343,39 @@ def euler_rate_bias(phi, theta, dphi, dtheta, dpsi):
 
 @njit(cache=True, error_model="numpy")
 def load_v3(a, i):
-    """Row i of an (n, 3) array as a tuple."""
+    """Row i of an (n, 3) array as a tuple.
+
+    Parameters
+    ----------
+    a : ndarray, shape (n, 3)
+        The rows [any].
+    i : int
+        The row.
+
+    Returns
+    -------
+    tuple of 3 float
+        a[i] [unit of a].
+    """
     return (a[i, 0], a[i, 1], a[i, 2])
 
 
 @njit(cache=True, error_model="numpy")
 def load_m33(a, i):
-    """Matrix i of an (n, 3, 3) array as nested tuples."""
+    """Matrix i of an (n, 3, 3) array as nested tuples.
+
+    Parameters
+    ----------
+    a : ndarray, shape (n, 3, 3)
+        The matrices [any].
+    i : int
+        The matrix.
+
+    Returns
+    -------
+    tuple of 3 rows of 3 float
+        a[i] [unit of a].
+    """
     return (
         (a[i, 0, 0], a[i, 0, 1], a[i, 0, 2]),
         (a[i, 1, 0], a[i, 1, 1], a[i, 1, 2]),
@@ -180,7 +385,20 @@ def load_m33(a, i):
 
 @njit(cache=True, error_model="numpy")
 def load_m33_at(x, k):
-    """x[k:k+9] (a row-major 3x3 matrix) as nested tuples."""
+    """x[k:k+9] (a row-major 3x3 matrix) as nested tuples.
+
+    Parameters
+    ----------
+    x : ndarray, shape (n,)
+        A packed array [any].
+    k : int
+        Offset of the matrix's first entry.
+
+    Returns
+    -------
+    tuple of 3 rows of 3 float
+        The matrix [unit of x].
+    """
     return (
         (x[k], x[k + 1], x[k + 2]),
         (x[k + 3], x[k + 4], x[k + 5]),
@@ -190,7 +408,19 @@ def load_m33_at(x, k):
 
 @njit(cache=True, error_model="numpy")
 def add_block(M, r0, c0, A, s):
-    """M[r0:r0+3, c0:c0+3] += s A and, off the diagonal, the transposed block."""
+    """M[r0:r0+3, c0:c0+3] += s A and, off the diagonal, the transposed block.
+
+    Parameters
+    ----------
+    M : ndarray, shape (n, n)
+        The symmetric matrix accumulated into, in place [any].
+    r0, c0 : int
+        Row and column of the block's first entry.
+    A : tuple of 3 rows of 3 float
+        The block [unit of M over unit of s].
+    s : float
+        Its factor [any].
+    """
     for a in range(3):
         for b in range(3):
             M[r0 + a, c0 + b] += s * A[a][b]
@@ -200,11 +430,37 @@ def add_block(M, r0, c0, A, s):
 
 @njit(cache=True, error_model="numpy")
 def load_seg(x, k):
-    """x[k:k+3] as a tuple."""
+    """x[k:k+3] as a tuple.
+
+    Parameters
+    ----------
+    x : ndarray, shape (n,)
+        A packed array [any].
+    k : int
+        Offset of the vector's first entry.
+
+    Returns
+    -------
+    tuple of 3 float
+        The vector [unit of x].
+    """
     return (x[k], x[k + 1], x[k + 2])
 
 
 @njit(cache=True, error_model="numpy")
 def scale_m(s, m):
-    """s * m for a 3x3 matrix."""
+    """s * m for a 3x3 matrix.
+
+    Parameters
+    ----------
+    s : float
+        The factor [any].
+    m : tuple of 3 rows of 3 float
+        The matrix [any].
+
+    Returns
+    -------
+    tuple of 3 rows of 3 float
+        The scaled matrix [unit of s times unit of m].
+    """
     return (scale(s, m[0]), scale(s, m[1]), scale(s, m[2]))

@@ -38,29 +38,32 @@ class PackedPlant(NamedTuple):
         6 x 6 system; else the bare hub's Newton-Euler equations).
     hub : ndarray, shape (HUB_SIZE,)
         Exchange array between the engine and the kernels (scratch, overwritten by
-        every evaluation; slots in the contract module).
+        every evaluation; slots in the contract module) [SI per slot].
     solve : ndarray, shape (6, 7)
-        Scratch of the 6 x 6 hub solve.
+        Scratch of the 6 x 6 hub solve [SI].
     locked : bool
         True if some appendage coordinates are locked (held at their initial value):
         q_ddot is then projected on the free coordinates (:mod:`flexsat.dynamics.kernels`).
     free : ndarray, shape (n_free,), int64
-        Indices of the free coordinates (all of them when nothing is locked).
+        Indices of the free coordinates (all of them when nothing is locked) [-].
     mass : ndarray, shape (n_dof, n_dof)
-        Scratch of M(q) for the projection (1 x 1 when nothing is locked).
+        Scratch of M(q) for the projection (1 x 1 when nothing is locked) [kg, kg m,
+        kg m^2].
     reduced : ndarray, shape (n_free, n_free + 1)
-        Scratch of the free-coordinate solve (1 x 2 when nothing is locked).
+        Scratch of the free-coordinate solve (1 x 2 when nothing is locked) [SI].
     is_free : ndarray, shape (n_dof,), bool
-        Per coordinate: free (True) or locked.
+        Per coordinate: free (True) or locked [-].
     reaction : ndarray, shape (2, n_dof)
         Scratch: the unconstrained q_ddot, then the generalized constraint forces of
-        the locked coordinates left by the last evaluation (2 x 1 when none).
+        the locked coordinates left by the last evaluation (2 x 1 when none)
+        [m/s^2, rad/s^2; N, N m].
     members : tuple of ndarray, shape (k_g, 2), int64
-        Per group: appendage index and offset of its first coordinate in q.
+        Per group: appendage index and offset of its first coordinate in q [-].
     params : tuple of ndarray, shape (k_g, p_g)
-        Per group: each member's packed parameter row.
+        Per group: each member's packed parameter row [SI, per the model's layout].
     work : tuple of ndarray, shape (k_g, w_g)
-        Per group: scratch rows pass 1 leaves for pass 2 (``work_size`` of the model).
+        Per group: scratch rows pass 1 leaves for pass 2 (``work_size`` of the model)
+        [SI].
     pass1, pass2, mass_matrix, bias_forces, observe, joint_wrench, tips : tuple
         Per group: the model's compiled kernels.
     """
@@ -123,6 +126,18 @@ def only(packed: PackedPlant, *kernels: str) -> PackedPlant:
 
     A call from Python unboxes every first-class function it is given (a few
     microseconds each); a single-kernel evaluation such as M(q) passes only its own.
+
+    Parameters
+    ----------
+    packed : PackedPlant
+        The full packed plant.
+    *kernels : str
+        Names of the kernel tuples to keep (``"mass_matrix"``, ``"observe"``...).
+
+    Returns
+    -------
+    PackedPlant
+        A copy sharing every array, the other kernel tuples empty.
     """
     return packed._replace(**{name: () for name in _KERNEL_FIELDS if name not in kernels})
 
@@ -149,6 +164,13 @@ class FirstClassKernel:
     numba would type a dispatcher in a tuple the same way, but it looks the machine
     code address up again on every call from Python (about 0.1 ms per function);
     this object resolves it once (numba's wrapper-address protocol).
+
+    Parameters
+    ----------
+    dispatcher : numba dispatcher
+        The kernel, compiled with ``signature``.
+    signature : numba signature
+        Its contract signature.
     """
 
     def __init__(self, dispatcher, signature) -> None:
@@ -172,7 +194,20 @@ _KERNELS: dict[tuple[int, str], FirstClassKernel] = {}
 
 
 def first_class(dispatcher, signature) -> FirstClassKernel:
-    """The :class:`FirstClassKernel` of a dispatcher compiled with ``signature`` (cached)."""
+    """The :class:`FirstClassKernel` of a dispatcher compiled with ``signature`` (cached).
+
+    Parameters
+    ----------
+    dispatcher : numba dispatcher
+        The kernel; it must have been compiled with ``signature`` (else TypeError).
+    signature : numba signature
+        Its contract signature.
+
+    Returns
+    -------
+    FirstClassKernel
+        The same object for the same dispatcher and signature.
+    """
     key = (id(dispatcher), str(signature))
     if key not in _KERNELS:
         if signature.args not in dispatcher.signatures:

@@ -45,6 +45,7 @@ def derive_records(
     Parameters
     ----------
     q, qd : ndarray, shape (m, n_dof)
+        Recorded generalized coordinates [m, rad] and rates [m/s, rad/s].
     tau_B : ndarray, shape (m, 3)
         Applied body torque at each record [N m].
     packed : PackedPlant

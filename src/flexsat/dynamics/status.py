@@ -34,5 +34,16 @@ STATUS_MESSAGES = {
 
 
 def status_message(status: int) -> str:
-    """The message of a non-zero status code."""
+    """The message of a non-zero status code.
+
+    Parameters
+    ----------
+    status : int
+        A status a kernel or the loop returned.
+
+    Returns
+    -------
+    str
+        Its sentence, or "unknown failure (status n)".
+    """
     return STATUS_MESSAGES.get(status, f"unknown failure (status {status})")
