@@ -14,7 +14,7 @@ import pytest
 from numba import njit
 from pydantic import Field
 
-from flexsat.control import Channel, StageConfig, StageSpec, register_actuator, register_sensor
+from flexsat.control import Channel, StageConfig, StageSpec, register_stage
 from flexsat.control.quaternion import euler_zyx_to_quaternion, target_quaternion
 from flexsat.control.stages import (
     ACTUATOR_SIGNATURE,
@@ -78,8 +78,8 @@ SCALING = StageSpec(
 
 @pytest.fixture(scope="module")
 def stages():
-    register_sensor(BIASED)  # the one line a user writes, per stage
-    register_actuator(SCALING)
+    register_stage(BIASED)  # the one line a user writes, per stage
+    register_stage(SCALING)
     yield
     SENSORS.unregister(BIASED.name)
     ACTUATORS.unregister(SCALING.name)

@@ -8,7 +8,7 @@ from flexsat.control.config import DisturbanceConfig
 from flexsat.control.laws import LawConfig, LawSpec, get_law, law_names, register_law
 from flexsat.control.quaternion import target_quaternion
 from flexsat.control.registry import Channel
-from flexsat.control.stages import StageConfig, StageSpec, register_actuator, register_sensor
+from flexsat.control.stages import StageConfig, StageSpec, register_stage
 from flexsat.control.stages.static_actuator import ActuatorConfig
 
 __all__ = [
@@ -21,8 +21,7 @@ __all__ = [
     "StageSpec",
     "get_law",
     "law_names",
-    "register_actuator",
     "register_law",
-    "register_sensor",
+    "register_stage",
     "target_quaternion",
 ]

@@ -6,6 +6,7 @@ this boundary are in degrees (fields ending in ``_deg``), everything else SI.
 
 from __future__ import annotations
 
+from functools import partial
 from pathlib import Path
 from typing import Annotated, ClassVar, Literal
 
@@ -15,6 +16,7 @@ from pydantic import (
     Field,
     SerializeAsAny,
     Strict,
+    ValidationInfo,
     field_validator,
     model_validator,
 )
@@ -33,12 +35,7 @@ from flexsat.control.stages import (
     JointActuatorConfig,
     PlantStageConfig,
     StageConfig,
-    validate_actuator_config,
-    validate_actuator_stage,
-    validate_joint_actuator_config,
-    validate_reference_config,
-    validate_sensor_config,
-    validate_sensor_stage,
+    validate_stage,
 )
 
 __all__ = [
@@ -115,7 +112,21 @@ def pulse(
 
 
 class AppendageInitialState(_Frozen):
-    """Initial deformation of one appendage's root joint (mount frame)."""
+    """Initial deformation of one appendage's root joint (mount frame).
+
+    Parameters
+    ----------
+    name : str
+        The appendage's name in the satellite config.
+    eta_m : tuple of 3 float
+        Root translation (x, y, z), mount frame [m].
+    rho_deg : tuple of 3 float
+        ZYX root rotation (x, y, z) [deg].
+    eta_rate_m_s : tuple of 3 float
+        Rate of the root translation [m/s].
+    rho_rate_deg_s : tuple of 3 float
+        Rates of the root rotation [deg/s].
+    """
 
     name: str
     eta_m: Vector3 = _ZERO3
@@ -133,7 +144,17 @@ class AppendageInitialState(_Frozen):
 
 
 class InitialState(_Frozen):
-    """Hub attitude and rate, and appendage deformations, at t = 0."""
+    """Hub attitude and rate, and appendage deformations, at t = 0.
+
+    Parameters
+    ----------
+    attitude_deg : tuple of 3 float
+        ZYX Euler angles (roll, pitch, yaw) relative to N [deg].
+    rate_deg_s : tuple of 3 float
+        Body rate, hub frame B [deg/s].
+    appendages : list of AppendageInitialState
+        One per deformed appendage, by name (others start undeformed).
+    """
 
     attitude_deg: Vector3 = Field(_ZERO3, description="ZYX Euler angles (roll, pitch, yaw) [deg]")
     rate_deg_s: Vector3 = Field(_ZERO3, description="body rate, hub frame B [deg/s]")
@@ -258,10 +279,18 @@ class SlewScenario(_TimedRun):
         description="the actuator stage, by its kind",
     )
     sensor_stages: tuple[
-        Annotated[SerializeAsAny[StageConfig], BeforeValidator(validate_sensor_stage)], ...
+        Annotated[
+            SerializeAsAny[StageConfig],
+            BeforeValidator(partial(validate_stage, "sensor", chained=True)),
+        ],
+        ...,
     ] = Field((), description="sensing stages run after [sensor], in order ([[sensor_stages]])")
     actuator_stages: tuple[
-        Annotated[SerializeAsAny[StageConfig], BeforeValidator(validate_actuator_stage)], ...
+        Annotated[
+            SerializeAsAny[StageConfig],
+            BeforeValidator(partial(validate_stage, "actuator", chained=True)),
+        ],
+        ...,
     ] = Field((), description="actuation stages run before [actuator], in order "
               "([[actuator_stages]])")  # fmt: skip
     disturbances: DisturbanceConfig = Field(
@@ -292,25 +321,10 @@ class SlewScenario(_TimedRun):
     def _registered_law(cls, value: object) -> LawConfig:
         return validate_law_config(value)  # at validation time: laws registered later count
 
-    @field_validator("sensor", mode="before")
+    @field_validator("sensor", "actuator", "reference", "joint_actuator", mode="before")
     @classmethod
-    def _registered_sensor(cls, value: object) -> StageConfig:
-        return validate_sensor_config(value)
-
-    @field_validator("actuator", mode="before")
-    @classmethod
-    def _registered_actuator(cls, value: object) -> ActuatorStageConfig:
-        return validate_actuator_config(value)
-
-    @field_validator("reference", mode="before")
-    @classmethod
-    def _registered_reference(cls, value: object) -> PlantStageConfig:
-        return validate_reference_config(value)
-
-    @field_validator("joint_actuator", mode="before")
-    @classmethod
-    def _registered_joint_actuator(cls, value: object) -> JointActuatorConfig:
-        return validate_joint_actuator_config(value)
+    def _registered_stage(cls, value: object, info: ValidationInfo) -> StageConfig:
+        return validate_stage(info.field_name, value)  # each field is named by its role
 
     @field_validator("design_inertia_kg_m2")
     @classmethod

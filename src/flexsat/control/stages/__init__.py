@@ -28,18 +28,11 @@ from flexsat.control.stages.registry import (
     ActuatorStageConfig,
     JointActuatorConfig,
     PlantStageConfig,
+    Role,
     StageConfig,
     StageSpec,
-    register_actuator,
-    register_joint_actuator,
-    register_reference,
-    register_sensor,
-    validate_actuator_config,
-    validate_actuator_stage,
-    validate_joint_actuator_config,
-    validate_reference_config,
-    validate_sensor_config,
-    validate_sensor_stage,
+    register_stage,
+    validate_stage,
 )
 from flexsat.control.stages.star_tracker import STAR_TRACKER
 from flexsat.control.stages.static_actuator import STATIC_ACTUATOR
@@ -59,29 +52,22 @@ __all__ = [
     "ActuatorStageConfig",
     "JointActuatorConfig",
     "PlantStageConfig",
+    "Role",
     "StageConfig",
     "StageSpec",
-    "register_actuator",
-    "register_joint_actuator",
-    "register_reference",
-    "register_sensor",
-    "validate_actuator_config",
-    "validate_actuator_stage",
-    "validate_joint_actuator_config",
-    "validate_reference_config",
-    "validate_sensor_config",
-    "validate_sensor_stage",
+    "register_stage",
+    "validate_stage",
 ]
 
-register_sensor(IDEAL_SENSOR, default=True)
-register_sensor(GYRO)
-register_sensor(STAR_TRACKER)
-register_sensor(MEKF)
-register_actuator(STATIC_ACTUATOR, default=True)
-register_reference(STEP_REFERENCE, default=True)
-register_reference(EIGENAXIS_REFERENCE)
-register_joint_actuator(NO_JOINT_ACTUATOR, default=True)
-register_joint_actuator(JOINT_RATE_FEEDBACK)
-register_actuator(WHEELS)
-register_actuator(DELAY)
-register_actuator(NOTCH)
+register_stage(IDEAL_SENSOR, default=True)
+register_stage(GYRO)
+register_stage(STAR_TRACKER)
+register_stage(MEKF)
+register_stage(STATIC_ACTUATOR, default=True)
+register_stage(STEP_REFERENCE, default=True)
+register_stage(EIGENAXIS_REFERENCE)
+register_stage(NO_JOINT_ACTUATOR, default=True)
+register_stage(JOINT_RATE_FEEDBACK)
+register_stage(WHEELS)
+register_stage(DELAY)
+register_stage(NOTCH)

@@ -99,19 +99,12 @@ __all__ = [
     "ActuatorStageConfig",
     "JointActuatorConfig",
     "PlantStageConfig",
+    "Role",
     "StageConfig",
     "StageSpec",
     "no_derivative",
-    "register_actuator",
-    "register_joint_actuator",
-    "register_reference",
-    "register_sensor",
-    "validate_actuator_config",
-    "validate_actuator_stage",
-    "validate_joint_actuator_config",
-    "validate_reference_config",
-    "validate_sensor_config",
-    "validate_sensor_stage",
+    "register_stage",
+    "validate_stage",
 ]
 
 _vec = types.float64[::1]
@@ -176,6 +169,10 @@ class JointActuatorConfig(PlantStageConfig):
     """Base of every joint actuator's model."""
 
 
+Role = Literal["sensor", "actuator", "reference", "joint_actuator"]
+"""Where a stage sits in the loop; each role has its registry and its table."""
+
+
 @dataclass(frozen=True)
 class StageSpec:
     """A loop stage as the loop and every consumer see it.
@@ -201,7 +198,7 @@ class StageSpec:
         ``state`` are integrated with the plant inside each RK4 step.
     """
 
-    role: Literal["sensor", "actuator", "reference", "joint_actuator"]
+    role: Role
     name: str
     config: type[StageConfig]
     step: Any
@@ -219,187 +216,80 @@ SENSORS: Registry[StageSpec] = Registry("sensor", "flexsat.sensors")
 ACTUATORS: Registry[StageSpec] = Registry("actuator", "flexsat.actuators")
 REFERENCES: Registry[StageSpec] = Registry("reference", "flexsat.references")
 JOINT_ACTUATORS: Registry[StageSpec] = Registry("joint actuator", "flexsat.joint_actuators")
-_BY_ROLE = {"sensor": SENSORS, "actuator": ACTUATORS, "reference": REFERENCES,
-            "joint_actuator": JOINT_ACTUATORS}  # fmt: skip
 
 
-def _register(role: str, spec: StageSpec, default: bool) -> StageSpec:
-    if spec.role != role:
-        raise ValueError(f"stage {spec.name!r} is a {spec.role}, not a {role}")
+@dataclass(frozen=True)
+class _RoleRules:
+    """What a role asks of its stages' parameter models."""
+
+    registry: Registry[StageSpec]
+    base: type[StageConfig]  # every stage of the role derives it
+    final: type[StageConfig]  # the one a role's own table ([actuator]...) selects derives it
+
+
+_ROLES: dict[str, _RoleRules] = {
+    "sensor": _RoleRules(SENSORS, StageConfig, StageConfig),
+    "actuator": _RoleRules(ACTUATORS, StageConfig, ActuatorStageConfig),  # limits: R3
+    "reference": _RoleRules(REFERENCES, PlantStageConfig, PlantStageConfig),
+    "joint_actuator": _RoleRules(JOINT_ACTUATORS, JointActuatorConfig, JointActuatorConfig),
+}
+
+
+def register_stage(spec: StageSpec, default: bool = False) -> StageSpec:
+    """Register a loop stage in its role's registry under ``spec.name`` (replacing one
+    of that name).
+
+    The role is ``spec.role``. Its config's ``kind`` must default to ``spec.name``; a
+    joint actuator's config derives :class:`JointActuatorConfig`, a reference's
+    :class:`PlantStageConfig`. Only an actuator whose config derives
+    :class:`ActuatorStageConfig` (the limits) can be the final ``[actuator]`` (and so
+    the default); any actuator can be one of the ``actuator_stages``.
+
+    Parameters
+    ----------
+    spec : StageSpec
+        The stage: its role, name, config model, compiled step and records.
+    default : bool
+        Make it the stage its role's table (``[sensor]``, ``[actuator]``,
+        ``[reference]``, ``[joint_actuator]``) selects when it gives no ``kind``.
+
+    Returns
+    -------
+    StageSpec
+        ``spec``, so a module can keep it: ``X = register_stage(StageSpec(...))``.
+    """
+    rules = _ROLES[spec.role]
     if spec.config.model_fields["kind"].default != spec.name:
         raise ValueError(f"stage {spec.name!r}: its config's kind must default to {spec.name!r}")
-    return _BY_ROLE[role].register(spec.name, spec, default=default)
+    required = rules.final if default else rules.base
+    if not issubclass(spec.config, required):
+        raise ValueError(f"{spec.role} {spec.name!r}: its config must derive {required.__name__}")
+    return rules.registry.register(spec.name, spec, default=default)
 
 
-def register_sensor(spec: StageSpec, default: bool = False) -> StageSpec:
-    """Register a sensor stage under ``spec.name`` (replacing one of that name).
-
-    Parameters
-    ----------
-    spec : StageSpec
-        The stage, with ``role = "sensor"``.
-    default : bool
-        Make it the stage a ``[sensor]`` table without ``kind`` selects.
-
-    Returns
-    -------
-    StageSpec
-        ``spec``, so a module can keep it.
-    """
-    return _register("sensor", spec, default)
-
-
-def register_actuator(spec: StageSpec, default: bool = False) -> StageSpec:
-    """Register an actuator stage under ``spec.name`` (replacing one of that name).
-
-    Only a stage whose config derives :class:`ActuatorStageConfig` (the limits) can
-    be the final ``[actuator]``; any can be one of the ``actuator_stages``.
+def validate_stage(role: Role, value: Any, chained: bool = False) -> StageConfig:
+    """A stage's table validated by the model of the stage its ``kind`` names.
 
     Parameters
     ----------
-    spec : StageSpec
-        The stage, with ``role = "actuator"``.
-    default : bool
-        Make it the stage an ``[actuator]`` table without ``kind`` selects.
-
-    Returns
-    -------
-    StageSpec
-        ``spec``, so a module can keep it: ``X = register_actuator(StageSpec(...))``.
-    """
-    if default and not issubclass(spec.config, ActuatorStageConfig):
-        raise ValueError(f"actuator {spec.name!r}: its config must derive ActuatorStageConfig")
-    return _register("actuator", spec, default)
-
-
-def register_reference(spec: StageSpec, default: bool = False) -> StageSpec:
-    """Register a reference generator under ``spec.name`` (replacing one of that name).
-
-    Parameters
-    ----------
-    spec : StageSpec
-        The stage: its name, config model, compiled step and records.
-    default : bool
-        Whether it is used when a table gives no ``kind``.
-
-    Returns
-    -------
-    StageSpec
-        ``spec``, so that registration can decorate an assignment.
-    """
-    return _register("reference", spec, default)
-
-
-def register_joint_actuator(spec: StageSpec, default: bool = False) -> StageSpec:
-    """Register a joint actuator under ``spec.name`` (replacing one of that name).
-
-    Parameters
-    ----------
-    spec : StageSpec
-        The stage: its name, config model, compiled step and records.
-    default : bool
-        Whether it is used when a table gives no ``kind``.
-
-    Returns
-    -------
-    StageSpec
-        ``spec``, so that registration can decorate an assignment.
-    """
-    if not issubclass(spec.config, JointActuatorConfig):
-        raise ValueError(f"joint actuator {spec.name!r}: its config must derive "
-                         "JointActuatorConfig")  # fmt: skip
-    return _register("joint_actuator", spec, default)
-
-
-def validate_sensor_config(value: Any) -> StageConfig:
-    """A ``[sensor]`` table validated by its stage's model (no ``kind``: the default).
-
-    Parameters
-    ----------
+    role : {"sensor", "actuator", "reference", "joint_actuator"}
+        The registry the ``kind`` is looked up in.
     value : dict or StageConfig
-        The table, or an already validated model.
+        The table (no ``kind``: the role's default stage), or an already validated model.
+    chained : bool
+        The table is one of the ``sensor_stages`` or ``actuator_stages`` (any stage of
+        the role), not the role's own table (whose stage must carry what the loop
+        reads of it, e.g. the final ``[actuator]``'s limits).
 
     Returns
     -------
     StageConfig
+        The validated model, of the stage's own config class.
     """
-    return SENSORS.validate_table(value, lambda spec: spec.config)
-
-
-def validate_actuator_config(value: Any) -> ActuatorStageConfig:
-    """An ``[actuator]`` table validated by its stage's model (no ``kind``: the default).
-
-    Parameters
-    ----------
-    value : dict or ActuatorStageConfig
-        The table, or an already validated model.
-
-    Returns
-    -------
-    ActuatorStageConfig
-    """
-    config = ACTUATORS.validate_table(value, lambda spec: spec.config)
-    if not isinstance(config, ActuatorStageConfig):
-        raise ValueError(f"kind {config.kind!r} carries no actuator limits: it can only be "
-                         "one of the actuator_stages, before the final [actuator]")
+    rules = _ROLES[role]
+    config = rules.registry.validate_table(value, lambda spec: spec.config)
+    if not chained and not isinstance(config, rules.final):
+        raise ValueError(f"kind {config.kind!r} cannot be the [{role}] (its config does not "
+                         f"derive {rules.final.__name__}): it can only be one of the "
+                         f"{role}_stages, before the final [{role}]")  # fmt: skip
     return config
-
-
-def validate_sensor_stage(value: Any) -> StageConfig:
-    """One table of ``sensor_stages``: any registered sensor stage, by its kind.
-
-    Parameters
-    ----------
-    value : dict or StageConfig
-        The table, or an already validated model.
-
-    Returns
-    -------
-    StageConfig
-    """
-    return SENSORS.validate_table(value, lambda spec: spec.config)
-
-
-def validate_actuator_stage(value: Any) -> StageConfig:
-    """One table of ``actuator_stages``: any registered actuator stage, by its kind.
-
-    Parameters
-    ----------
-    value : dict or StageConfig
-        The table, or an already validated model.
-
-    Returns
-    -------
-    StageConfig
-    """
-    return ACTUATORS.validate_table(value, lambda spec: spec.config)
-
-
-def validate_reference_config(value: Any) -> PlantStageConfig:
-    """A ``[reference]`` table validated by its generator's model (no ``kind``: ``step``).
-
-    Parameters
-    ----------
-    value : dict or PlantStageConfig
-        The table, or an already validated model.
-
-    Returns
-    -------
-    PlantStageConfig
-    """
-    return REFERENCES.validate_table(value, lambda spec: spec.config)
-
-
-def validate_joint_actuator_config(value: Any) -> JointActuatorConfig:
-    """A ``[joint_actuator]`` table validated by its model (no ``kind``: ``none``).
-
-    Parameters
-    ----------
-    value : dict or JointActuatorConfig
-        The table, or an already validated model.
-
-    Returns
-    -------
-    JointActuatorConfig
-    """
-    return JOINT_ACTUATORS.validate_table(value, lambda spec: spec.config)
