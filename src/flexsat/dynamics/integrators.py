@@ -165,7 +165,7 @@ def rk4_hold(x, dt, n_steps, torque_B, packed, frame):
     Parameters
     ----------
     x : ndarray, shape (2 n_dof + 2,)
-        Augmented state [q, q_dot, W_in, W_diss] (SI), advanced in place.
+        Augmented state [q, q_dot, W_in, W_diss] [SI], advanced in place.
     dt : float
         Step [s].
     n_steps : int

@@ -213,7 +213,20 @@ def run_slew(
 
 def loop_layout(plant: Plant, scenario: SlewScenario) -> LoopLayout:
     """Where a slew's states and records live: its law, its two stage chains, its
-    reference generator and its joint actuator."""
+    reference generator and its joint actuator.
+
+    Parameters
+    ----------
+    plant : Plant
+        The plant flown (its state layout).
+    scenario : SlewScenario
+        The slew (its law and stages, by kind).
+
+    Returns
+    -------
+    LoopLayout
+        The offsets of the plant state, control state and record row.
+    """
     chain = scenario.stage_chain()
     n_sensors = 1 + len(scenario.sensor_stages)
     sensors = tuple(SENSORS.get(c.kind) for _, c in chain[:n_sensors])

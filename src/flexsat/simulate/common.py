@@ -29,14 +29,48 @@ _CHUNK_STEPS = 10_000  # compiled steps between progress updates
 
 
 def chunk_steps(*multiples: int) -> int:
-    """Steps per compiled call: about 10 000, a multiple of every given period."""
+    """Steps per compiled call: about 10 000, a multiple of every given period.
+
+    Parameters
+    ----------
+    *multiples : int
+        Periods in steps (control, record).
+
+    Returns
+    -------
+    int
+        Their least common multiple times the largest factor keeping it near 10 000.
+    """
     period = math.lcm(*multiples)
     return max(period, (_CHUNK_STEPS // period) * period)
 
 
 def run_attributes(plant, scenario, kind: str, status: int, t_fail: float, wall: float,
                    steps: int) -> dict:  # fmt: skip
-    """Dataset attributes of a run: configs as JSON, version, status and timing."""
+    """Dataset attributes of a run: configs as JSON, version, status and timing.
+
+    Parameters
+    ----------
+    plant : Plant
+        The plant flown.
+    scenario : OpenLoopScenario or SlewScenario
+        The scenario flown.
+    kind : str
+        "open-loop" or "slew", for the title.
+    status : int
+        The run's status (0: completed).
+    t_fail : float
+        Time of the failure [s] (read only if ``status`` is non-zero).
+    wall : float
+        Wall time of the run [s].
+    steps : int
+        Steps taken.
+
+    Returns
+    -------
+    dict
+        The attributes (str, float and int values).
+    """
     message = ""
     if status:
         message = f"simulation stopped at t = {t_fail:.6g} s: {status_message(status)}"
@@ -54,7 +88,15 @@ def run_attributes(plant, scenario, kind: str, status: int, t_fail: float, wall:
 
 
 class progress_bar:
-    """Context manager yielding (progress, task) or (None, None) when hidden."""
+    """Context manager yielding (progress, task) or (None, None) when hidden.
+
+    Parameters
+    ----------
+    show : bool
+        Show a rich progress bar.
+    total_s : float
+        The simulated time the bar counts to [s].
+    """
 
     def __init__(self, show: bool, total_s: float) -> None:
         self.show, self.total = show, total_s
@@ -97,9 +139,22 @@ class LongRunWarning(UserWarning):
 class RunEstimate:
     """What a run will cost: steps, records, peak memory [bytes] and wall time [s].
 
-    ``fits_in_memory`` is False for a run whose records must be streamed to disk;
-    ``record_bytes`` is the size of one record [bytes] and ``available_bytes`` the
-    memory the records may use.
+    Attributes
+    ----------
+    steps : int
+        RK4 steps.
+    records : int
+        Recorded rows.
+    memory_bytes : float
+        Peak memory of the records, the dataset and its writer [bytes].
+    wall_time_s : float
+        Estimated wall time [s].
+    fits_in_memory : bool
+        False for a run whose records must be streamed to disk.
+    record_bytes : float
+        Size of one record [bytes].
+    available_bytes : float
+        Memory the records may use [bytes].
     """
 
     steps: int
@@ -120,8 +175,10 @@ def check_run_size(n_dof: int, scenario, available_bytes: float | None = None, *
     n_dof : int
         Generalized coordinates of the plant.
     scenario : OpenLoopScenario or SlewScenario
+        The run's scenario (duration, step, record interval).
     available_bytes : float, optional
-        Memory the records may use; default: half the machine's physical memory.
+        Memory the records may use [bytes]; default: half the machine's physical
+        memory.
     can_stream : bool
         The caller streams records that do not fit to disk
         (:mod:`flexsat.simulate.stream`): such a run is not refused, its estimate

@@ -27,11 +27,20 @@ __all__ = ["LoopFlow", "chain_wrench", "rk4_coupled_hold", "rk4_coupled_step"]
 class LoopFlow(NamedTuple):
     """Work arrays of the coupled step (float64, C order), allocated once per run.
 
-    ``state`` is the actuation chain's state block (a view into the control state),
-    ``state_views`` each stage's piece of it; ``eval``/``dot`` (same length) hold the
-    chain's state at an RK4 stage and its rate, ``eval_views``/``dot_views`` each
-    stage's piece of them; ``k`` (4, m) the four rates; ``wrench`` (3,) the stages'
-    torque on the hub [N m]; ``held`` (3,) the chain's held output [N m].
+    Attributes
+    ----------
+    state : ndarray, shape (m,)
+        The actuation chain's state block, a view into the control state [per stage].
+    eval, dot : ndarray, shape (m,)
+        The chain's state at an RK4 stage and its rate [per stage, per stage per s].
+    eval_views, dot_views : tuple of ndarray
+        Each stage's piece of ``eval`` and ``dot`` [per stage].
+    k : ndarray, shape (4, m)
+        The four RK4 rates of the chain's state [per stage per s].
+    wrench : ndarray, shape (3,)
+        The stages' torque on the hub, hub frame B [N m].
+    held : ndarray, shape (3,)
+        The chain's held output [N m].
     """
 
     state: np.ndarray
@@ -46,7 +55,28 @@ class LoopFlow(NamedTuple):
 
 @njit(cache=True)
 def chain_wrench(x, n, t, derivatives, params, flow):
-    """Evaluate every stage's derivative at (x, flow.eval): flow.dot and flow.wrench."""
+    """Evaluate every stage's derivative at (x, flow.eval): flow.dot and flow.wrench.
+
+    Parameters
+    ----------
+    x : ndarray, shape (2 n + 2,)
+        Plant state at the RK4 stage [q, q_dot, W_in, W_diss] [SI].
+    n : int
+        Number of generalized coordinates.
+    t : float
+        Time of the RK4 stage [s].
+    derivatives : tuple of first-class functions
+        One ``DERIVATIVE_SIGNATURE`` function per actuation stage.
+    params : tuple of ndarray
+        Each stage's packed parameters [per stage].
+    flow : LoopFlow
+        Its ``dot`` and ``wrench`` are overwritten.
+
+    Returns
+    -------
+    int
+        0, or the OR of the stages' non-zero statuses.
+    """
     flow.dot[:] = 0.0
     flow.wrench[:] = 0.0
     status = 0
@@ -70,9 +100,37 @@ def _rates(x, n, t, derivatives, params, flow, Q, k, kc, packed):
 def rk4_coupled_step(x, t, dt, n, Q, scratch, derivatives, params, flow, packed):
     """One RK4 step of the plant state ``x`` and the chain state ``flow.state``, in place.
 
-    The held torque is ``flow.held``; ``scratch`` (5, len(x)) and ``Q`` (n,) as for
-    :func:`~flexsat.dynamics.integrators.rk4_step`. On a non-zero status both states
-    are left unchanged.
+    The held torque is ``flow.held``. On a non-zero status both states are left
+    unchanged.
+
+    Parameters
+    ----------
+    x : ndarray, shape (2 n + 2,)
+        Plant state [q, q_dot, W_in, W_diss] (SI: m, rad, m/s, rad/s, J).
+    t : float
+        Time of x [s].
+    dt : float
+        Step [s].
+    n : int
+        Number of generalized coordinates.
+    Q : ndarray, shape (n,)
+        Generalized forces, as for :func:`~flexsat.dynamics.integrators.rk4_step`
+        [N, N m per coordinate].
+    scratch : ndarray, shape (5, len(x))
+        Work array [-].
+    derivatives : tuple of first-class functions
+        One ``DERIVATIVE_SIGNATURE`` function per actuation stage.
+    params : tuple of ndarray
+        Each stage's packed parameters [per stage].
+    flow : LoopFlow
+        The chain's state and work arrays.
+    packed : PackedPlant
+        ``Plant.packed``.
+
+    Returns
+    -------
+    int
+        ``STATUS_OK``, a kernel or stage status, or ``STATUS_NOT_FINITE``.
     """
     size, m = x.shape[0], flow.state.shape[0]
     c, ce, kc = flow.state, flow.eval, flow.k
@@ -111,7 +169,34 @@ def rk4_coupled_step(x, t, dt, n, Q, scratch, derivatives, params, flow, packed)
 
 @njit(cache=True)
 def rk4_coupled_hold(x, t0, dt, n_steps, derivatives, params, flow, packed):
-    """``n_steps`` coupled RK4 steps under the held ``flow.held``. Returns (status, done)."""
+    """``n_steps`` coupled RK4 steps under the held ``flow.held``.
+
+    Parameters
+    ----------
+    x : ndarray, shape (2 n_dof + 2,)
+        Plant state [SI], advanced in place.
+    t0 : float
+        Time of x [s].
+    dt : float
+        Step [s].
+    n_steps : int
+        Number of steps.
+    derivatives : tuple of first-class functions
+        One ``DERIVATIVE_SIGNATURE`` function per actuation stage.
+    params : tuple of ndarray
+        Each stage's packed parameters [per stage].
+    flow : LoopFlow
+        The chain's state, advanced in place, and work arrays.
+    packed : PackedPlant
+        ``Plant.packed``.
+
+    Returns
+    -------
+    status : int
+        ``STATUS_OK`` or the failing step's status.
+    done : int
+        Steps completed without error.
+    """
     n = packed.n_dof
     scratch = np.empty((5, x.shape[0]))
     Q = np.empty(n)

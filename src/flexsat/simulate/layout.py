@@ -37,8 +37,19 @@ class LoopLayout:
     ``[law_diag]``, the sensing chain's and the actuation chain's records, then the
     reference's and the joint actuator's.
 
-    ``sensors`` and ``actuators`` are the chains in order (a single
-    :class:`~flexsat.control.stages.StageSpec` is a chain of one).
+    Parameters
+    ----------
+    plant : StateLayout
+        The plant's state layout.
+    law : LawSpec
+        The control law.
+    sensors, actuators : tuple of StageSpec
+        The sensing and actuation chains in order (a single
+        :class:`~flexsat.control.stages.StageSpec` is a chain of one).
+    reference : StageSpec
+        The reference generator.
+    joint_actuator : StageSpec
+        The joint actuator.
     """
 
     plant: StateLayout

@@ -40,7 +40,25 @@ __all__ = [
 
 
 class LoopClock(NamedTuple):
-    """Timing of one compiled call."""
+    """Timing of one compiled call.
+
+    Attributes
+    ----------
+    t0 : float
+        Time of the first step [s].
+    dt : float
+        RK4 step [s].
+    n_steps : int
+        Steps to take.
+    final : bool
+        Also control and record at t0 + n_steps dt (the run's last record).
+    control_every : int
+        Plant steps per control period.
+    record_every : int
+        Plant steps per record.
+    continuous : bool
+        An actuation stage integrates states in the RK4 steps.
+    """
 
     t0: float  # time of the first step [s]
     dt: float  # RK4 step [s]
@@ -52,7 +70,23 @@ class LoopClock(NamedTuple):
 
 
 class LoopStages(NamedTuple):
-    """The compiled steps, tuples of first-class functions (chains in order)."""
+    """The compiled steps, tuples of first-class functions (chains in order).
+
+    Attributes
+    ----------
+    sensor : tuple
+        ``SENSOR_SIGNATURE`` functions: the sensing chain.
+    law : tuple
+        One ``LAW_SIGNATURE`` function.
+    actuator : tuple
+        ``ACTUATOR_SIGNATURE`` functions: the actuation chain.
+    derivative : tuple
+        ``DERIVATIVE_SIGNATURE`` functions, one per actuation stage.
+    reference : tuple
+        One ``REFERENCE_SIGNATURE`` function.
+    joint_actuator : tuple
+        One ``JOINT_ACTUATOR_SIGNATURE`` function.
+    """
 
     sensor: tuple  # (SENSOR_SIGNATURE, ...): the sensing chain
     law: tuple  # (LAW_SIGNATURE,)
@@ -69,6 +103,47 @@ class LoopData(NamedTuple):
     :class:`~flexsat.simulate.layout.LoopLayout`; the states are views into one
     control-state vector. Stage parameters, states and records are tuples with one
     array per stage of the chain.
+
+    Attributes
+    ----------
+    J_design : ndarray, shape (3, 3)
+        The law's design inertia, hub frame B [kg m^2].
+    q_d : ndarray, shape (4,)
+        Reference quaternion, scalar first [-].
+    omega_d, omega_dot_d : ndarray, shape (3,)
+        Reference rate [rad/s] and acceleration [rad/s^2], frame D.
+    law_gains, law_state : ndarray
+        The law's packed gains and state [per law].
+    sensor_params, sensor_state : tuple of ndarray
+        Each sensing stage's packed parameters and state [per stage].
+    actuator_params, actuator_state : tuple of ndarray
+        Each actuation stage's packed parameters and state [per stage].
+    q_meas : ndarray, shape (4,)
+        Measured attitude quaternion, scalar first [-].
+    omega_meas : ndarray, shape (3,)
+        Measured body rate [rad/s].
+    held : ndarray, shape (record_size,)
+        The control record row held between instants [per channel].
+    tau_cmd, tau_applied : ndarray, shape (3,)
+        Views into ``held``: commanded and applied torque [N m].
+    law_diag : ndarray
+        View into ``held``: the law's diagnostics [per channel].
+    sensor_record, actuator_record : tuple of ndarray
+        Views into ``held``: each stage's records [per channel].
+    tau_between : ndarray, shape (3,)
+        A stage's input inside the actuation chain [N m].
+    flow : LoopFlow
+        Work arrays of the coupled RK4 step.
+    reference_params, reference_state : ndarray
+        The reference's packed parameters and state [per stage].
+    reference_record : ndarray
+        View into ``held``: its records [per channel].
+    joint_params, joint_state : ndarray
+        The joint actuator's packed parameters and state [per stage].
+    joint_record : ndarray
+        View into ``held``: its records [per channel].
+    Q : ndarray, shape (n_dof,)
+        Generalized forces on the appendage coordinates, ``Q[6:]``, held [N or N m].
     """
 
     J_design: np.ndarray  # (3, 3) [kg m^2]
@@ -101,7 +176,21 @@ class LoopData(NamedTuple):
 
 
 class LoopRecords(NamedTuple):
-    """Record buffers and the first row this call writes."""
+    """Record buffers and the first row this call writes.
+
+    Attributes
+    ----------
+    t : ndarray, shape (m,)
+        Record times [s].
+    x : ndarray, shape (m, x_size)
+        Recorded plant states [SI].
+    ctrl : ndarray, shape (m, record_size)
+        Recorded control rows [per channel].
+    start : int
+        First row this call writes.
+    frame : ndarray, shape (m, 9)
+        Attitude reference R_NF of each recorded state, row-major [-].
+    """
 
     t: np.ndarray  # (m,) [s]
     x: np.ndarray  # (m, x_size)
@@ -112,7 +201,26 @@ class LoopRecords(NamedTuple):
 
 @njit(cache=True)
 def run_sensors(x, n, t, stages, d):
-    """The sensing chain at one control instant: each stage refines q_meas, omega_meas."""
+    """The sensing chain at one control instant: each stage refines q_meas, omega_meas.
+
+    Parameters
+    ----------
+    x : ndarray, shape (2 n + 2,)
+        Plant state relative to N [SI].
+    n : int
+        Number of generalized coordinates.
+    t : float
+        Time [s].
+    stages : LoopStages
+        The compiled steps.
+    d : LoopData
+        Its ``q_meas``, ``omega_meas``, stage states and records are written.
+
+    Returns
+    -------
+    int
+        0, or the OR of the stages' non-zero statuses.
+    """
     status = 0
     for i in range(len(stages.sensor)):
         status |= stages.sensor[i](x, n, t, d.sensor_params[i], d.sensor_state[i], d.q_meas,
@@ -127,6 +235,28 @@ def run_actuators(x, n, t, control_dt, continuous, stages, d):
     Each stage after the first reads the previous one's output. With continuous
     stages the chain's output is held for the RK4 steps and ``tau_applied`` records
     the total torque on the hub at this instant (held output plus the stages' wrench).
+
+    Parameters
+    ----------
+    x : ndarray, shape (2 n + 2,)
+        Plant state [SI].
+    n : int
+        Number of generalized coordinates.
+    t : float
+        Time [s].
+    control_dt : float
+        Control period [s].
+    continuous : bool
+        Some stage integrates states (``derivative``).
+    stages : LoopStages
+        The compiled steps.
+    d : LoopData
+        Its ``tau_applied``, stage states and records are written.
+
+    Returns
+    -------
+    int
+        0, or the OR of the stages' non-zero statuses.
     """
     status = stages.actuator[0](
         d.tau_cmd, t, control_dt, d.actuator_params[0], d.actuator_state[0], d.tau_applied,
@@ -158,12 +288,32 @@ def rk4_closed_loop(x, clock, stages, d, records, plant, frame):
     k is a record instant, then take one RK4 step under the held torque and joint
     forces ``d.Q`` (coupled with the chain's continuous states if any). Chunk
     boundaries must be multiples of ``control_every`` and ``record_every``.
-    ``plant`` is the plant's named structure (``Plant.packed``), passed to ``rk4_step``;
-    ``frame`` (9,) the attitude reference R_NF of ``x``, updated in place.
+
+    Parameters
+    ----------
+    x : ndarray, shape (2 n_dof + 2,)
+        Plant state [q, q_dot, W_in, W_diss] [SI], advanced in place.
+    clock : LoopClock
+        Timing of this call.
+    stages : LoopStages
+        The compiled steps.
+    d : LoopData
+        Parameters, states and the held record row.
+    records : LoopRecords
+        Record buffers.
+    plant : PackedPlant
+        The plant's named structure (``Plant.packed``), passed to ``rk4_step``.
+    frame : ndarray, shape (9,)
+        The attitude reference R_NF of ``x`` [-], updated in place.
 
     Returns
     -------
-    status, steps_done, records_written
+    status : int
+        0, ``STATUS_CONTROL_FAILED`` or a plant status.
+    steps_done : int
+        Steps completed.
+    records_written : int
+        Rows written.
     """
     n = plant.n_dof
     scratch = np.empty((5, x.shape[0]))

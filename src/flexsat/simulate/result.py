@@ -248,9 +248,12 @@ def build_dataset(
 
     Parameters
     ----------
+    plant : Plant
+        The plant that flew the run.
     t : ndarray, shape (m,)
         Record times [s].
     q, qd : ndarray, shape (m, n_dof)
+        Recorded generalized coordinates [m, rad] and rates [m/s, rad/s].
     work_in, dissipated : ndarray, shape (m,)
         Cumulative work of the applied torque and damper dissipation [J].
     tau_cmd, tau_applied : ndarray, shape (m, 3)
@@ -261,7 +264,8 @@ def build_dataset(
         E(0) of the run [J], for a block of records that does not start at t = 0
         (a streamed run); default: the first record's total energy.
     frames : ndarray, shape (m, 9), optional
-        The attitude reference R_NF of each record (:mod:`flexsat.dynamics.attitude`);
+        The attitude reference R_NF of each record, row-major [-]
+        (:mod:`flexsat.dynamics.attitude`);
         the hub part of ``q`` and ``qd`` is relative to it. Default: the identity.
         The dataset holds every attitude, position and momentum relative to N.
     """

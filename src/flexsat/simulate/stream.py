@@ -29,6 +29,13 @@ _CHUNK_RECORDS = 4096  # records per HDF5 chunk (about 1-150 kB per variable)
 def check_disk_space(folder: Path, needed_bytes: float) -> None:
     """Refuse a streamed run whose records would not fit on the disk of ``folder``.
 
+    Parameters
+    ----------
+    folder : Path
+        Where the records are written.
+    needed_bytes : float
+        The records' estimated size [bytes].
+
     Raises
     ------
     ConfigError

@@ -57,7 +57,7 @@ G = ASMCGains(*range(len(ASMCGains._fields)))  # index of each gain in the packe
 class ASMCConfig(LawConfig):
     """Adaptive sliding-mode control with torque-budget allocation (thesis ch. 4, sec. 5.1)."""
 
-    kind: Literal["asmc"] = "asmc"
+    kind: Literal["asmc"] = Field("asmc", description="the law's registered name")
     jk_min_nm: Positive = Field(0.8925, description="JK_min = D_max + eta [N m] (eq. 4.21)")
     lambda_min: Positive = Field(0.2, description="slope far from the target [rad/s]")
     lambda_max: Positive = Field(5.0, description="slope near the target [rad/s]")

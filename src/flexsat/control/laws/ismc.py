@@ -49,7 +49,7 @@ G = ISMCGains(*range(len(ISMCGains._fields)))  # index of each gain in the packe
 class ISMCConfig(LawConfig):
     """Integral sliding mode: s = omega_e + lambda q_v,e + k_i int q_v,e - s(0)."""
 
-    kind: Literal["ismc"] = "ismc"
+    kind: Literal["ismc"] = Field("ismc", description="the law's registered name")
     jk_nm: Positive = Field(0.8925, description="robust torque JK = D_max + eta [N m]")
     lambda_: Positive = Field(0.6, alias="lambda", description="surface slope [rad/s]")
     k_i: Positive = Field(0.045, description="integral gain of the surface [1/s^2]")

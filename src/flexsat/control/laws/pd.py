@@ -35,7 +35,7 @@ G = PDGains(*range(len(PDGains._fields)))  # index of each gain in the packed ar
 class PDConfig(LawConfig):
     """Quaternion PD with gyroscopic compensation: tau = w x Jw - J (kp q_v,e + kd w)."""
 
-    kind: Literal["pd"] = "pd"
+    kind: Literal["pd"] = Field("pd", description="the law's registered name")
     natural_frequency_rad_s: Positive = Field(0.3, description="omega_n [rad/s]")
     damping_ratio: Annotated[float, Field(gt=0.0, le=5.0)] = 0.9
 

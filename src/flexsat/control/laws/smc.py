@@ -44,7 +44,7 @@ G = SMCGains(*range(len(SMCGains._fields)))  # index of each gain in the packed 
 class SMCConfig(LawConfig):
     """Classical sliding-mode control: constant slope and robust gain, same surface."""
 
-    kind: Literal["smc"] = "smc"
+    kind: Literal["smc"] = Field("smc", description="the law's registered name")
     jk_nm: Positive = Field(0.8925, description="robust torque JK [N m]")
     lambda_: Positive = Field(1.0, alias="lambda", description="surface slope [rad/s]")
     phi: Positive = Field(0.01, description="boundary-layer width [rad/s]")

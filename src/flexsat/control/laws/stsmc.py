@@ -73,7 +73,7 @@ def moreno_osorio_c2_min(c1: float) -> float:
 class STSMCConfig(LawConfig):
     """Super-twisting sliding mode on s = omega_e + lambda q_v,e ([Nad+19])."""
 
-    kind: Literal["stsmc"] = "stsmc"
+    kind: Literal["stsmc"] = Field("stsmc", description="the law's registered name")
     lambda_: Positive = Field(0.5, alias="lambda", description="surface slope [rad/s]")
     d_max_nm: Positive = Field(0.85, description="disturbance bound D_max [N m] (eq. 5.6)")
     disturbance_hz: Positive = Field(

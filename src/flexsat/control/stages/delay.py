@@ -25,7 +25,7 @@ MAX_DELAY_PERIODS = 1000
 class DelayConfig(StageConfig):
     """A delay of ``periods`` whole control periods between the law and the actuator."""
 
-    kind: Literal["delay"] = "delay"
+    kind: Literal["delay"] = Field("delay", description="the stage's registered name")
     periods: Annotated[int, Field(ge=0, le=MAX_DELAY_PERIODS)] = Field(
         1, description="D, the delay in control periods"
     )

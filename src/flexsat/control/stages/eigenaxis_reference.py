@@ -98,7 +98,7 @@ def coupled_modes(plant, max_frequency_hz: float) -> tuple[np.ndarray, np.ndarra
 class EigenaxisReferenceConfig(PlantStageConfig):
     """Rest-to-rest eigenaxis slew (module docstring): ``[reference] kind = "eigenaxis"``."""
 
-    kind: Literal["eigenaxis"] = "eigenaxis"
+    kind: Literal["eigenaxis"] = Field("eigenaxis", description="the stage's registered name")
     profile: Literal["trapezoid", "polynomial"] = Field(
         "trapezoid", description="rate/acceleration-limited trapezoid or 7th-order polynomial"
     )

@@ -51,7 +51,7 @@ _COUNT, _DRAWN, _HELD, _BGM, _BRW, _SUM = 0, 1, 2, 5, 8, 11
 class GyroConfig(StageConfig):
     """A three-axis rate gyro (module docstring); replaces the measured body rate."""
 
-    kind: Literal["gyro"] = "gyro"
+    kind: Literal["gyro"] = Field("gyro", description="the stage's registered name")
     sample_dt_s: Positive = Field(0.01, description="Delta, sample period [s]")
     arw_deg_rt_h: NonNegative = Field(0.01, description="angle random walk N [deg/sqrt(h)]")
     bias_instability_deg_h: NonNegative = Field(0.05, description="B [deg/h]")

@@ -18,7 +18,13 @@ __all__ = ["IDEAL_SENSOR", "IdealSensorConfig"]
 
 
 class IdealSensorConfig(StageConfig):
-    """The ideal sensor has no parameters."""
+    """The ideal sensor has no parameters.
+
+    Parameters
+    ----------
+    kind : str
+        The stage's registered name, ``"ideal"``.
+    """
 
     kind: Literal["ideal"] = "ideal"
 

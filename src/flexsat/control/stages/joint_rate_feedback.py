@@ -44,7 +44,9 @@ _GAIN, _LIMIT, _BANDWIDTH, _ENGAGE, _N, _INDICES = 0, 1, 2, 3, 4, 5
 class JointRateFeedbackConfig(JointActuatorConfig):
     """Root actuators closed by joint-rate (strain-rate) feedback (module docstring)."""
 
-    kind: Literal["rate_feedback"] = "rate_feedback"
+    kind: Literal["rate_feedback"] = Field(
+        "rate_feedback", description="the stage's registered name"
+    )
     coordinates: list[str] = Field(
         min_length=1,
         description="actuated coordinates: '<appendage>.<coordinate>', or '<coordinate>' "

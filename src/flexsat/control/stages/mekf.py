@@ -55,7 +55,7 @@ class MEKFConfig(StageConfig):
     """The MEKF (module docstring). Noise densities not given are those the sensing
     chain's gyro and star tracker declare (``estimator_noise``)."""
 
-    kind: Literal["mekf"] = "mekf"
+    kind: Literal["mekf"] = Field("mekf", description="the stage's registered name")
     gyro_arw_rad_rt_s: NonNegative | None = Field(None, description="sv [rad/sqrt(s)]")
     gyro_rrw_rad_s_rt_s: NonNegative | None = Field(None, description="su [rad/s/sqrt(s)]")
     star_tracker_noise_rad: tuple[NonNegative, NonNegative, NonNegative] | None = Field(

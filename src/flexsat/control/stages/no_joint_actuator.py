@@ -16,7 +16,13 @@ __all__ = ["NO_JOINT_ACTUATOR", "NoJointActuatorConfig"]
 
 
 class NoJointActuatorConfig(JointActuatorConfig):
-    """Hub-only control: no parameters."""
+    """Hub-only control: no parameters.
+
+    Parameters
+    ----------
+    kind : str
+        The stage's registered name, ``"none"``.
+    """
 
     kind: Literal["none"] = "none"
 

@@ -44,7 +44,7 @@ class Notch(_Frozen):
 class NotchConfig(StageConfig):
     """Notches and an optional roll-off on each axis of the commanded torque."""
 
-    kind: Literal["notch"] = "notch"
+    kind: Literal["notch"] = Field("notch", description="the stage's registered name")
     notches: tuple[Notch, ...] = Field((), description="the notch sections")
     rolloff_hz: Positive | None = Field(None, description="2nd-order low-pass corner [Hz]")
 

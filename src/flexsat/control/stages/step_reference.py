@@ -18,7 +18,13 @@ __all__ = ["STEP_REFERENCE", "StepReferenceConfig"]
 
 
 class StepReferenceConfig(PlantStageConfig):
-    """The step reference has no parameters: the scenario's target, at rest."""
+    """The step reference has no parameters: the scenario's target, at rest.
+
+    Parameters
+    ----------
+    kind : str
+        The stage's registered name, ``"step"``.
+    """
 
     kind: Literal["step"] = "step"
 

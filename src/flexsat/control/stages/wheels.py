@@ -86,7 +86,7 @@ class WheelsConfig(ActuatorStageConfig):
     """A reaction-wheel cluster (module docstring); ``t_max_nm`` is the body-torque
     limit the law clips its command to."""
 
-    kind: Literal["wheels"] = "wheels"
+    kind: Literal["wheels"] = Field("wheels", description="the stage's registered name")
     preset: Literal["orthogonal3", "pyramid4"] = Field(
         "pyramid4", description="spin-axis layout when ``axes`` is not given"
     )
