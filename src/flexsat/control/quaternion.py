@@ -21,7 +21,18 @@ __all__ = [
 
 @njit(cache=True)
 def euler_zyx_to_quaternion(phi, theta, psi):
-    """Scalar-first quaternion of R_NB = Rz(psi) Ry(theta) Rx(phi) (the sensor interface)."""
+    """Scalar-first quaternion of R_NB = Rz(psi) Ry(theta) Rx(phi) (the sensor interface).
+
+    Parameters
+    ----------
+    phi, theta, psi : float
+        ZYX Euler angles: roll, pitch, yaw [rad].
+
+    Returns
+    -------
+    tuple of 4 float
+        Unit quaternion, scalar first [-].
+    """
     c1, s1 = cos(0.5 * phi), sin(0.5 * phi)
     c2, s2 = cos(0.5 * theta), sin(0.5 * theta)
     c3, s3 = cos(0.5 * psi), sin(0.5 * psi)
@@ -35,7 +46,18 @@ def euler_zyx_to_quaternion(phi, theta, psi):
 
 @njit(cache=True)
 def quaternion_error(q_d, q):
-    """q_e = q_d^-1 (x) q (eq. 4.1), sign chosen so that q_e0 >= 0 (the shorter rotation)."""
+    """q_e = q_d^-1 (x) q (eq. 4.1), sign chosen so that q_e0 >= 0 (the shorter rotation).
+
+    Parameters
+    ----------
+    q_d, q : ndarray or tuple, shape (4,)
+        Reference and actual attitude quaternions, scalar first [-].
+
+    Returns
+    -------
+    tuple of 4 float
+        The error quaternion, scalar first [-].
+    """
     e0 = q_d[0] * q[0] + q_d[1] * q[1] + q_d[2] * q[2] + q_d[3] * q[3]
     e1 = -q_d[1] * q[0] + q_d[0] * q[1] + q_d[3] * q[2] - q_d[2] * q[3]
     e2 = -q_d[2] * q[0] - q_d[3] * q[1] + q_d[0] * q[2] + q_d[1] * q[3]
@@ -47,7 +69,18 @@ def quaternion_error(q_d, q):
 
 @njit(cache=True)
 def quaternion_product(a, b):
-    """a (x) b, scalar first (Hamilton product: R(a (x) b) = R(a) R(b))."""
+    """a (x) b, scalar first (Hamilton product: R(a (x) b) = R(a) R(b)).
+
+    Parameters
+    ----------
+    a, b : ndarray or tuple, shape (4,)
+        Quaternions, scalar first [-].
+
+    Returns
+    -------
+    tuple of 4 float
+        Their product, scalar first [-].
+    """
     return (
         a[0] * b[0] - a[1] * b[1] - a[2] * b[2] - a[3] * b[3],
         a[0] * b[1] + a[1] * b[0] + a[2] * b[3] - a[3] * b[2],
@@ -79,14 +112,38 @@ def target_quaternion(euler_deg: tuple[float, float, float]) -> np.ndarray:
 
 @njit(cache=True)
 def pointing_error(q_d, q):
-    """Absolute pointing error 2 asin ‖q_v,e‖ [rad] of attitude ``q`` from ``q_d``."""
+    """Absolute pointing error 2 asin ‖q_v,e‖ of attitude ``q`` from ``q_d``.
+
+    Parameters
+    ----------
+    q_d, q : ndarray or tuple, shape (4,)
+        Reference and actual attitude quaternions, scalar first [-].
+
+    Returns
+    -------
+    float
+        The error angle [rad].
+    """
     e = quaternion_error(q_d, q)
     return 2.0 * asin(min(1.0, sqrt(e[1] ** 2 + e[2] ** 2 + e[3] ** 2)))
 
 
 @njit(cache=True)
 def pointing_errors(q_d, euler):
-    """Pointing error [rad] of each ZYX Euler attitude (rows of ``euler``, (m, 3)) from q_d."""
+    """Pointing error of each ZYX Euler attitude from ``q_d``.
+
+    Parameters
+    ----------
+    q_d : ndarray, shape (4,)
+        Reference quaternion, scalar first [-].
+    euler : ndarray, shape (m, 3)
+        Roll, pitch, yaw of each attitude [rad].
+
+    Returns
+    -------
+    ndarray, shape (m,)
+        The error angles [rad].
+    """
     out = np.empty(euler.shape[0])
     for k in range(euler.shape[0]):
         out[k] = pointing_error(q_d, euler_zyx_to_quaternion(euler[k, 0], euler[k, 1], euler[k, 2]))

@@ -50,7 +50,18 @@ class Channel:
 
 
 def channel_columns(channels: tuple[Channel, ...]) -> dict[str, slice]:
-    """Columns of each channel in a record row holding ``channels`` in order."""
+    """Columns of each channel in a record row holding ``channels`` in order.
+
+    Parameters
+    ----------
+    channels : tuple of Channel
+        The channels, in record order.
+
+    Returns
+    -------
+    dict of str to slice
+        Each channel's columns, by name.
+    """
     columns, start = {}, 0
     for c in channels:
         columns[c.name] = slice(start, start + c.size)

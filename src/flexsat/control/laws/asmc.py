@@ -37,18 +37,42 @@ __all__ = ["ASMC", "ASMCConfig", "ASMCGains"]
 
 
 class ASMCGains(NamedTuple):
-    """The packed gains, in order (SI)."""
+    """The packed gains, in order (SI).
 
-    t_max: float  # T_max per axis [N m]
-    reduction_factor: float  # RF [-]
-    jk_min: float  # JK_min [N m]
-    lambda_min: float  # [rad/s]
-    lambda_max: float  # [rad/s]
-    phi: float  # boundary-layer width Phi [rad/s]
-    theta_threshold: float  # theta_th [rad]
-    include_lambda_dot: float  # 1.0: add -J Lambda_dot q_v,e
-    smooth: float  # 1.0: smoothstep target, filtered (module docstring)
-    lambda_time_constant: float  # tau_Lambda of the filter [s]
+    Attributes
+    ----------
+    t_max : float
+        T_max per axis [N m].
+    reduction_factor : float
+        RF [-].
+    jk_min : float
+        JK_min [N m].
+    lambda_min : float
+        Lower bound Lambda_min of the surface slope [rad/s].
+    lambda_max : float
+        Upper bound Lambda_max of the surface slope [rad/s].
+    phi : float
+        Boundary-layer width Phi [rad/s].
+    theta_threshold : float
+        theta_th, the error angle where the slope starts to adapt [rad].
+    include_lambda_dot : float
+        1.0: add -J Lambda_dot q_v,e; 0.0: leave it out [-].
+    smooth : float
+        1.0: smoothstep target, filtered (module docstring); 0.0: the thesis's slope [-].
+    lambda_time_constant : float
+        tau_Lambda of the filter [s].
+    """
+
+    t_max: float
+    reduction_factor: float
+    jk_min: float
+    lambda_min: float
+    lambda_max: float
+    phi: float
+    theta_threshold: float
+    include_lambda_dot: float
+    smooth: float
+    lambda_time_constant: float
 
 
 G = ASMCGains(*range(len(ASMCGains._fields)))  # index of each gain in the packed array

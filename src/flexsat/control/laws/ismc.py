@@ -33,14 +33,30 @@ __all__ = ["ISMC", "ISMCConfig", "ISMCGains"]
 
 
 class ISMCGains(NamedTuple):
-    """The packed gains, in order (SI)."""
+    """The packed gains, in order (SI).
 
-    t_max: float  # T_max per axis [N m]
-    reduction_factor: float  # RF [-]
-    jk: float  # robust torque JK [N m]
-    lambda_: float  # surface slope [rad/s]
-    k_i: float  # integral gain of the surface [1/s^2]
-    phi: float  # boundary-layer width [rad/s]
+    Attributes
+    ----------
+    t_max : float
+        T_max per axis [N m].
+    reduction_factor : float
+        RF [-].
+    jk : float
+        Robust torque JK [N m].
+    lambda_ : float
+        Surface slope [rad/s].
+    k_i : float
+        Integral gain of the surface [1/s^2].
+    phi : float
+        Boundary-layer width [rad/s].
+    """
+
+    t_max: float
+    reduction_factor: float
+    jk: float
+    lambda_: float
+    k_i: float
+    phi: float
 
 
 G = ISMCGains(*range(len(ISMCGains._fields)))  # index of each gain in the packed array

@@ -21,12 +21,24 @@ __all__ = ["PD", "PDConfig", "PDGains"]
 
 
 class PDGains(NamedTuple):
-    """The packed gains, in order (SI)."""
+    """The packed gains, in order (SI).
 
-    t_max: float  # T_max per axis [N m]
-    reduction_factor: float  # RF [-]
-    kp: float  # [1/s^2]
-    kd: float  # [1/s]
+    Attributes
+    ----------
+    t_max : float
+        T_max per axis [N m].
+    reduction_factor : float
+        RF [-].
+    kp : float
+        Proportional gain kp [1/s^2].
+    kd : float
+        Rate gain kd [1/s].
+    """
+
+    t_max: float
+    reduction_factor: float
+    kp: float
+    kd: float
 
 
 G = PDGains(*range(len(PDGains._fields)))  # index of each gain in the packed array
@@ -37,7 +49,7 @@ class PDConfig(LawConfig):
 
     kind: Literal["pd"] = Field("pd", description="the law's registered name")
     natural_frequency_rad_s: Positive = Field(0.3, description="omega_n [rad/s]")
-    damping_ratio: Annotated[float, Field(gt=0.0, le=5.0)] = 0.9
+    damping_ratio: Annotated[float, Field(gt=0.0, le=5.0, description="zeta [-]")] = 0.9
 
     def gains(self, actuator) -> np.ndarray:
         wn = self.natural_frequency_rad_s

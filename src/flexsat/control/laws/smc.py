@@ -29,13 +29,27 @@ __all__ = ["SMC", "SMCConfig", "SMCGains"]
 
 
 class SMCGains(NamedTuple):
-    """The packed gains, in order (SI)."""
+    """The packed gains, in order (SI).
 
-    t_max: float  # T_max per axis [N m]
-    reduction_factor: float  # RF [-]
-    jk: float  # robust torque JK [N m]
-    lambda_: float  # surface slope [rad/s]
-    phi: float  # boundary-layer width [rad/s]
+    Attributes
+    ----------
+    t_max : float
+        T_max per axis [N m].
+    reduction_factor : float
+        RF [-].
+    jk : float
+        Robust torque JK [N m].
+    lambda_ : float
+        Surface slope [rad/s].
+    phi : float
+        Boundary-layer width [rad/s].
+    """
+
+    t_max: float
+    reduction_factor: float
+    jk: float
+    lambda_: float
+    phi: float
 
 
 G = SMCGains(*range(len(SMCGains._fields)))  # index of each gain in the packed array

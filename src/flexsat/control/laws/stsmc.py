@@ -51,22 +51,51 @@ __all__ = [
 
 
 class STSMCGains(NamedTuple):
-    """The packed gains, in order (SI)."""
+    """The packed gains, in order (SI).
 
-    t_max: float  # T_max per axis [N m]
-    reduction_factor: float  # RF [-]
-    lambda_: float  # surface slope [rad/s]
-    d_max: float  # disturbance bound D_max [N m]
-    d_rate: float  # disturbance rate bound L = 2 pi f_d D_max [N m/s]
-    c1: float  # k1 = c1 sqrt(L_i) [-]
-    c2: float  # k2 = c2 L_i [-]
+    Attributes
+    ----------
+    t_max : float
+        T_max per axis [N m].
+    reduction_factor : float
+        RF [-].
+    lambda_ : float
+        Surface slope [rad/s].
+    d_max : float
+        Disturbance bound D_max [N m].
+    d_rate : float
+        Disturbance rate bound L = 2 pi f_d D_max [N m/s].
+    c1 : float
+        K1 = c1 sqrt(L_i) [-].
+    c2 : float
+        K2 = c2 L_i [-].
+    """
+
+    t_max: float
+    reduction_factor: float
+    lambda_: float
+    d_max: float
+    d_rate: float
+    c1: float
+    c2: float
 
 
 G = STSMCGains(*range(len(STSMCGains._fields)))  # index of each gain in the packed array
 
 
 def moreno_osorio_c2_min(c1: float) -> float:
-    """Smallest c2 of the Lyapunov condition k2 > L + 2 L^2 / k1^2 with k1 = c1 sqrt(L)."""
+    """Smallest c2 of the Lyapunov condition k2 > L + 2 L^2 / k1^2 with k1 = c1 sqrt(L).
+
+    Parameters
+    ----------
+    c1 : float
+        k1 = c1 sqrt(L) [-].
+
+    Returns
+    -------
+    float
+        1 + 2 / c1^2 [-].
+    """
     return 1.0 + 2.0 / c1**2
 
 
@@ -120,7 +149,21 @@ def _inverse_row_sums(J):
 
 
 def axis_gains(gains: np.ndarray, J: np.ndarray) -> dict[str, np.ndarray]:
-    """Per-axis L_i [rad/s^3], k1_i [rad^(1/2)/s^(3/2)], k2_i [rad/s^3], v_max,i [rad/s^2]."""
+    """Per-axis gains of the super-twisting law.
+
+    Parameters
+    ----------
+    gains : ndarray, shape (7,)
+        The packed :class:`STSMCGains` [SI, per gain].
+    J : ndarray, shape (3, 3)
+        Design inertia, hub frame B [kg m^2].
+
+    Returns
+    -------
+    dict of str to ndarray, shape (3,)
+        ``L`` [rad/s^3], ``k1`` [rad^(1/2)/s^(3/2)], ``k2`` [rad/s^3] and ``v_max``
+        [rad/s^2] per axis.
+    """
     rows = np.abs(np.linalg.inv(J)).sum(axis=1)
     rate = gains[G.d_rate] * rows
     return {"L": rate, "k1": gains[G.c1] * np.sqrt(rate), "k2": gains[G.c2] * rate,
@@ -128,7 +171,22 @@ def axis_gains(gains: np.ndarray, J: np.ndarray) -> dict[str, np.ndarray]:
 
 
 def lyapunov_matrices(k1: float, k2: float, rho: float) -> tuple[np.ndarray, np.ndarray]:
-    """P and Q(rho) of V = zeta^T P zeta, ‖s‖^(1/2) V_dot = -zeta^T Q zeta, rho = a_dot sgn(s)."""
+    """P and Q(rho) of V = zeta^T P zeta, ‖s‖^(1/2) V_dot = -zeta^T Q zeta, rho = a_dot sgn(s).
+
+    Parameters
+    ----------
+    k1 : float
+        Gain of the square-root term [rad^(1/2)/s^(3/2)].
+    k2 : float
+        Gain of the integral term [rad/s^3].
+    rho : float
+        a_dot sgn(s), the disturbance rate seen by the surface [rad/s^3].
+
+    Returns
+    -------
+    P, Q : ndarray, shape (2, 2)
+        The Lyapunov matrices [SI].
+    """
     P = np.array([[2.0 * k2 + 0.5 * k1**2, -0.5 * k1], [-0.5 * k1, 1.0]])
     Q = np.array([[k1 * k2 + 0.5 * k1**3 + rho * k1, -(0.5 * k1**2 + rho)],
                   [-(0.5 * k1**2 + rho), 0.5 * k1]])  # fmt: skip

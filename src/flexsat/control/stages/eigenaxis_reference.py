@@ -77,11 +77,25 @@ class ShaperConfig(_Frozen):
 
 
 def coupled_modes(plant, max_frequency_hz: float) -> tuple[np.ndarray, np.ndarray]:
-    """Frequencies [Hz] and modal damping ratios of the flexible modes coupled to the hub.
+    """Frequencies and modal damping ratios of the flexible modes coupled to the hub.
 
     A mode is coupled if the modal analysis names a hub DOF it moves
     (``Mode.hub_dof``); its damping ratio is phi^T C phi / (2 omega) of the
     mass-normalized shape (the joints' damping, eq. 2.15).
+
+    Parameters
+    ----------
+    plant : Plant
+        The design plant.
+    max_frequency_hz : float
+        Modes above this frequency are left out [Hz].
+
+    Returns
+    -------
+    frequencies : ndarray, shape (k,)
+        Natural frequencies, ascending [Hz].
+    ratios : ndarray, shape (k,)
+        Modal damping ratios [-].
     """
     modal = modal_analysis(plant)
     C = plant.damping_matrix()

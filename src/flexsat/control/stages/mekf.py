@@ -62,7 +62,7 @@ class MEKFConfig(StageConfig):
         None, description="sigma_st per axis [rad]"
     )
     initial_attitude_std_deg: Annotated[float, Field(gt=0.0, le=180.0)] | None = Field(
-        None, description="P0 of the attitude; default sigma_st (q_hat starts at a sample)"
+        None, description="P0 of the attitude [deg]; default sigma_st (q_hat starts at a sample)"
     )
     initial_bias_std_deg_h: Annotated[float, Field(gt=0.0)] = Field(
         0.1, description="P0 of the gyro bias [deg/h]"

@@ -32,16 +32,42 @@ def _mix(z):
 
 @njit(cache=True)
 def uniform(seed, counter):
-    """A uniform deviate in (0, 1) from integers ``seed`` and ``counter`` (floats
-    holding integers below 2**53)."""
+    """A uniform deviate in (0, 1) from integers ``seed`` and ``counter``.
+
+    Parameters
+    ----------
+    seed : float
+        The stream, a float holding an integer below 2**53 [-].
+    counter : float
+        The draw, a float holding an integer below 2**53 [-].
+
+    Returns
+    -------
+    float
+        The deviate [-].
+    """
     z = _mix(_mix(np.uint64(seed)) * _STREAM ^ _mix(np.uint64(counter)))
     return (float(z >> np.uint64(11)) + 0.5) * 2.0**-53
 
 
 @njit(cache=True)
 def normal(seed, counter):
-    """A standard normal deviate, draw ``counter`` of stream ``seed`` (uses the uniform
-    draws 2 counter and 2 counter + 1)."""
+    """A standard normal deviate, draw ``counter`` of stream ``seed``.
+
+    Box-Muller on the uniform draws 2 counter and 2 counter + 1.
+
+    Parameters
+    ----------
+    seed : float
+        The stream, a float holding an integer below 2**53 [-].
+    counter : float
+        The draw, a float holding an integer below 2**52 [-].
+
+    Returns
+    -------
+    float
+        The deviate, zero mean and unit variance [-].
+    """
     u1 = uniform(seed, 2.0 * counter)
     u2 = uniform(seed, 2.0 * counter + 1.0)
     return sqrt(-2.0 * log(u1)) * cos(2.0 * pi * u2)

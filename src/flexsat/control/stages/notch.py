@@ -32,13 +32,21 @@ MAX_SECTIONS = 4
 
 
 class Notch(_Frozen):
-    """One notch: centre, depth and width (the poles' damping ratio)."""
+    """One notch: centre, depth and width (the poles' damping ratio).
+
+    Parameters
+    ----------
+    frequency_hz : float
+        Centre frequency [Hz].
+    depth_db : float
+        Attenuation at the centre, 0 < depth <= 80 [dB].
+    damping : float
+        zeta_p, the poles' damping ratio: the notch's width [-].
+    """
 
     frequency_hz: Positive
     depth_db: Annotated[float, Field(gt=0.0, le=80.0)] = 20.0
-    damping: Annotated[float, Field(gt=0.0, le=1.0)] = Field(
-        0.3, description="zeta_p: the notch's width"
-    )
+    damping: Annotated[float, Field(gt=0.0, le=1.0)] = 0.3
 
 
 class NotchConfig(StageConfig):
@@ -110,9 +118,14 @@ def notch_for_modes(plant, modes: int = 1, depth_db: float = 20.0, damping: floa
     modes : int
         How many modes to notch, lowest first (at most :data:`MAX_SECTIONS`).
     depth_db, damping : float
-        Of every notch.
+        Depth [dB] and poles' damping ratio [-] of every notch.
     rolloff_hz : float, optional
-        A roll-off corner above them.
+        A roll-off corner above them [Hz].
+
+    Returns
+    -------
+    NotchConfig
+        The filter stage's parameters.
     """
     from flexsat.analysis.modal import modal_analysis
 

@@ -124,7 +124,28 @@ DERIVATIVE_SIGNATURE = types.int64(_vec, types.int64, types.float64, _vec, _vec,
 
 @njit(DERIVATIVE_SIGNATURE, cache=True)
 def no_derivative(x, n_dof, t, params, state, state_dot, wrench):
-    """The derivative of a stage without continuous states: nothing integrated."""
+    """The derivative of a stage without continuous states: nothing integrated.
+
+    Parameters
+    ----------
+    x : ndarray, shape (2 n_dof + 2,)
+        Plant state [SI].
+    n_dof : int
+        Number of generalized coordinates.
+    t : float
+        Time [s].
+    params, state : ndarray
+        The stage's packed parameters and state [per stage].
+    state_dot : ndarray
+        Left at zero [per stage per s].
+    wrench : ndarray, shape (3,)
+        Left as it is [N m].
+
+    Returns
+    -------
+    int
+        0.
+    """
     return 0
 
 

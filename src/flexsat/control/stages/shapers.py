@@ -48,10 +48,18 @@ def shaper(kind: str, frequency_hz: float, damping_ratio: float) -> tuple[np.nda
     Parameters
     ----------
     kind : {"zv", "zvd", "ei"}
+        The shaper (:data:`SHAPERS`).
     frequency_hz : float
         Natural frequency f of the mode [Hz], > 0.
     damping_ratio : float
-        zeta of the mode, 0 <= zeta < 1.
+        zeta of the mode, 0 <= zeta < 1 [-].
+
+    Returns
+    -------
+    amplitudes : ndarray, shape (k,)
+        Impulse amplitudes, sum 1 [-].
+    times : ndarray, shape (k,)
+        Impulse times, the first at 0 [s].
     """
     zeta = float(damping_ratio)
     wd = 2.0 * pi * frequency_hz * sqrt(1.0 - zeta * zeta)  # damped frequency [rad/s]
@@ -64,7 +72,20 @@ def shaper(kind: str, frequency_hz: float, damping_ratio: float) -> tuple[np.nda
 def convolve(
     first: tuple[np.ndarray, np.ndarray], second: tuple[np.ndarray, np.ndarray]
 ) -> tuple[np.ndarray, np.ndarray]:
-    """The shaper whose impulses are every pair's product at the sum of their times."""
+    """The shaper whose impulses are every pair's product at the sum of their times.
+
+    Parameters
+    ----------
+    first, second : tuple of ndarray
+        Each shaper's (amplitudes [-], times [s]).
+
+    Returns
+    -------
+    amplitudes : ndarray
+        The products, in time order [-].
+    times : ndarray
+        The sums of the times, sorted [s].
+    """
     A = np.multiply.outer(first[0], second[0]).ravel()
     t = np.add.outer(first[1], second[1]).ravel()
     order = np.argsort(t, kind="stable")
@@ -74,7 +95,24 @@ def convolve(
 def shaper_for_modes(
     kind: str, frequencies_hz: Sequence[float], damping_ratios: Sequence[float]
 ) -> tuple[np.ndarray, np.ndarray]:
-    """One shaper per mode, convolved (multi-mode shaping): amplitudes, times [s]."""
+    """One shaper per mode, convolved (multi-mode shaping).
+
+    Parameters
+    ----------
+    kind : {"zv", "zvd", "ei"}
+        The shaper of every mode.
+    frequencies_hz : sequence of float
+        The modes' natural frequencies [Hz].
+    damping_ratios : sequence of float
+        Their damping ratios [-].
+
+    Returns
+    -------
+    amplitudes : ndarray
+        Impulse amplitudes, sum 1 [-].
+    times : ndarray
+        Impulse times [s].
+    """
     out = (np.ones(1), np.zeros(1))
     for f, zeta in zip(frequencies_hz, damping_ratios, strict=True):
         out = convolve(out, shaper(kind, f, zeta))
@@ -88,6 +126,22 @@ def residual_vibration(
 
     V = exp(-zeta w t_N) ‖sum A_i exp(zeta w t_i) exp(j w_d t_i)‖ (Singer and Seering
     1990), 0 for a perfect shaper, 1 for no shaping.
+
+    Parameters
+    ----------
+    amplitudes : ndarray, shape (k,)
+        Impulse amplitudes [-].
+    times : ndarray, shape (k,)
+        Impulse times, ascending [s].
+    frequency_hz : float
+        The mode's natural frequency [Hz].
+    damping_ratio : float
+        Its damping ratio [-].
+
+    Returns
+    -------
+    float
+        V [-].
     """
     w = 2.0 * pi * frequency_hz
     zeta = damping_ratio

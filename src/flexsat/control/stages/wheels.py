@@ -68,11 +68,21 @@ NonNegative = Annotated[float, Field(ge=0.0, allow_inf_nan=False)]
 
 
 def wheel_axes(preset: str, pyramid_half_angle_deg: float = 54.7356) -> np.ndarray:
-    """Spin axes of a preset cluster, hub frame B, shape (N, 3).
+    """Spin axes of a preset cluster, hub frame B.
 
-    ``"orthogonal3"``: the body axes. ``"pyramid4"``: four axes at the half-angle
-    from +Z_B, spread 90 deg apart in azimuth from 45 deg (54.7356 deg: equal
-    torque capability on the three axes).
+    Parameters
+    ----------
+    preset : {"orthogonal3", "pyramid4"}
+        ``"orthogonal3"``: the body axes. ``"pyramid4"``: four axes at the half-angle
+        from +Z_B, spread 90 deg apart in azimuth from 45 deg.
+    pyramid_half_angle_deg : float
+        The pyramid's half-angle [deg] (54.7356 deg: equal torque capability on the
+        three axes).
+
+    Returns
+    -------
+    ndarray, shape (N, 3)
+        Unit spin axes, hub frame B [-].
     """
     if preset == "orthogonal3":
         return np.eye(3)
@@ -90,11 +100,15 @@ class WheelsConfig(ActuatorStageConfig):
     preset: Literal["orthogonal3", "pyramid4"] = Field(
         "pyramid4", description="spin-axis layout when ``axes`` is not given"
     )
-    pyramid_half_angle_deg: Annotated[float, Field(gt=0.0, lt=90.0)] = 54.7356
-    axes: tuple[tuple[Real, Real, Real], ...] | None = Field(
-        None, description="spin axes a_i, hub frame B (normalized); overrides the preset"
+    pyramid_half_angle_deg: Annotated[float, Field(gt=0.0, lt=90.0)] = Field(
+        54.7356, description="half-angle of the pyramid4 preset from +Z_B [deg]"
     )
-    spin_inertia_kg_m2: Positive = Field(0.1, description="I_s, axial inertia of each wheel")
+    axes: tuple[tuple[Real, Real, Real], ...] | None = Field(
+        None, description="spin axes a_i, hub frame B (normalized) [-]; overrides the preset"
+    )
+    spin_inertia_kg_m2: Positive = Field(
+        0.1, description="I_s, axial inertia of each wheel [kg m^2]"
+    )
     max_torque_nm: Positive = Field(2.0, description="motor torque limit per wheel [N m]")
     max_speed_rpm: Positive = Field(6000.0, description="speed limit |Omega_i| [rpm]")
     viscous_nm_s_rad: NonNegative = Field(1e-5, description="c_v [N m s/rad]")
