@@ -57,7 +57,9 @@ class GyroConfig(StageConfig):
     bias_instability_deg_h: NonNegative = Field(0.05, description="B [deg/h]")
     bias_correlation_s: Positive = Field(100.0, description="T_c of the bias instability [s]")
     rrw_deg_h_rt_h: NonNegative = Field(0.0, description="rate random walk K [deg/h/sqrt(h)]")
-    scale_factor_ppm: Annotated[float, Field(ge=-1e5, le=1e5)] = Field(0.0, description="scale-factor error s [ppm]")
+    scale_factor_ppm: Annotated[float, Field(ge=-1e5, le=1e5)] = Field(
+        0.0, description="scale-factor error s [ppm]"
+    )
     bias_deg_h: Vector3 = Field((0.0, 0.0, 0.0), description="turn-on bias b_0 [deg/h]")
     seed: Annotated[int, Field(ge=0, lt=2**53)] = Field(1, description="noise stream")
 
