@@ -89,7 +89,17 @@ class RandomCases(_Frozen):
 
 
 class Dispersed(_Frozen):
-    """One parameter of a Sobol or worst-case campaign: a path and its range."""
+    """One parameter of a Sobol or worst-case campaign: a path and its range.
+
+    Parameters
+    ----------
+    path : str
+        Config path of the value (``hub.mass_kg``, ``appendages[*].thickness_m``...).
+    op : {"set", "scale"}
+        Set the value, or scale it by a factor.
+    bounds : tuple of 2 float
+        [low, high] of the value [its unit] or of the factor [-].
+    """
 
     path: Annotated[str, Field(min_length=1)]
     op: Literal["set", "scale"] = "set"
@@ -107,7 +117,20 @@ class Dispersed(_Frozen):
 
 def dispersed_modifiers(parameters: list[Dispersed], values) -> tuple[list, list]:
     """(plant, scenario) modifiers setting each parameter to its value: paths under
-    ``hub`` and ``appendages`` are the plant's, the others the scenario's."""
+    ``hub`` and ``appendages`` are the plant's, the others the scenario's.
+
+    Parameters
+    ----------
+    parameters : list of Dispersed
+        The campaign's parameters.
+    values : sequence of float
+        One value (or factor) per parameter [the parameter's unit, or - for a factor].
+
+    Returns
+    -------
+    plant, scenario : list of Modifier
+        The modifiers of each config.
+    """
     plant, scenario = [], []
     for parameter, value in zip(parameters, values, strict=True):
         root = parameter.path.split(".")[0].split("[")[0]
@@ -117,7 +140,17 @@ def dispersed_modifiers(parameters: list[Dispersed], values) -> tuple[list, list
 
 class SobolCases(_Frozen):
     """Saltelli's sampling of the parameters for first and total Sobol indices (SALib):
-    ``n`` (D + 2) cases for D parameters."""
+    ``n`` (D + 2) cases for D parameters.
+
+    Parameters
+    ----------
+    n : int
+        Base sample size N, a power of 2.
+    seed : int
+        Seed of the scrambled Sobol' sequence.
+    parameters : list of Dispersed
+        The dispersed parameters (1 to 64).
+    """
 
     n: Annotated[int, Field(ge=2, le=65536)] = Field(
         64, description="base sample size N, a power of 2"
@@ -133,7 +166,17 @@ class SobolCases(_Frozen):
 
 
 class WorstCaseSearch(_Frozen):
-    """Differential evolution over the parameters' box, maximizing ``metric``."""
+    """Differential evolution over the parameters' box, maximizing ``metric``.
+
+    Parameters
+    ----------
+    metric : str
+        A numeric slew metric (``final_pointing_error_deg``...).
+    parameters : list of Dispersed
+        The parameters searched (1 to 32).
+    seed : int
+        Seed of the search.
+    """
 
     metric: str = Field("final_pointing_error_deg", description="a numeric slew metric")
     parameters: Annotated[list[Dispersed], Field(min_length=1, max_length=32)]
@@ -260,6 +303,17 @@ class CaseStream:
     Iterating resolves the cases in order; a later case whose draws are refused is
     yielded with its ``error`` set (stored as a failed row), not raised, unless
     ``strict``.
+
+    Parameters
+    ----------
+    definition : CampaignDefinition
+        The campaign.
+    satellite : SatelliteConfig
+        Its base satellite.
+    n_random : int, optional
+        Random cases to draw; default the definition's ``[random] n``.
+    strict : bool
+        Raise on a refused case instead of yielding it with its ``error``.
 
     Raises
     ------
@@ -390,7 +444,18 @@ class CaseStream:
 
 
 def sobol_problem(sobol: SobolCases) -> dict:
-    """SALib's problem dictionary of a Sobol campaign (names are the paths)."""
+    """SALib's problem dictionary of a Sobol campaign (names are the paths).
+
+    Parameters
+    ----------
+    sobol : SobolCases
+        The campaign's ``[sobol]`` table.
+
+    Returns
+    -------
+    dict
+        ``num_vars``, ``names`` and ``bounds``.
+    """
     return {
         "num_vars": len(sobol.parameters),
         "names": [p.path for p in sobol.parameters],
@@ -399,8 +464,19 @@ def sobol_problem(sobol: SobolCases) -> dict:
 
 
 def sobol_samples(sobol: SobolCases) -> np.ndarray:
-    """Saltelli's sample (SALib, scrambled Sobol' sequence, seeded), shape
-    (n (D + 2), D): first and total indices, no second order."""
+    """Saltelli's sample (SALib, scrambled Sobol' sequence, seeded): first and total
+    indices, no second order.
+
+    Parameters
+    ----------
+    sobol : SobolCases
+        The campaign's ``[sobol]`` table.
+
+    Returns
+    -------
+    ndarray, shape (n (D + 2), D)
+        One row of parameter values per case [each parameter's unit].
+    """
     try:
         from SALib.sample import sobol as sampler
     except ImportError:
@@ -443,6 +519,15 @@ def campaign_fingerprint(
     cases: CaseStream | list[ResolvedCase],
 ) -> dict:
     """What a store's results depend on, part by part, to refuse a mixed resume.
+
+    Parameters
+    ----------
+    definition : CampaignDefinition
+        The campaign.
+    satellite : SatelliteConfig
+        Its base satellite.
+    cases : CaseStream or list of ResolvedCase
+        Its cases (a stream's checked head).
 
     Returns
     -------

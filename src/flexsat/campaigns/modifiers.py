@@ -29,7 +29,25 @@ _TOKEN = re.compile(r"([A-Za-z_][A-Za-z0-9_]*)|\[(\*|\d+)\]")
 
 
 class Modifier(_Frozen):
-    """Set or scale one config value, by a constant or a random draw."""
+    """Set or scale one config value, by a constant or a random draw.
+
+    Give exactly one of ``value``, ``uniform``, ``normal``, ``truncnormal``.
+
+    Parameters
+    ----------
+    path : str
+        Config path; ``[*]`` targets every element of a list (each draws its own).
+    op : {"set", "scale"}
+        Set the value, or scale it by a factor.
+    value : any
+        A constant [the target's unit, or - for a factor].
+    uniform : tuple of 2 float, optional
+        (low, high) of a uniform draw [the target's unit, or -].
+    normal : tuple of 2 float, optional
+        (mean, std) of a normal draw [the target's unit, or -].
+    truncnormal : tuple of 4 float, optional
+        (mean, std, low, high) of a truncated normal draw [the target's unit, or -].
+    """
 
     path: Annotated[str, Field(min_length=1)]
     op: Literal["set", "scale"] = "set"
@@ -81,6 +99,22 @@ def apply_modifiers(
     Random values are drawn from ``rng`` once per targeted element, in order, so a
     case is reproducible from its seed; every applied value is recorded in
     ``realised`` under its concrete path.
+
+    Parameters
+    ----------
+    data : dict
+        A config as plain data (``model_dump``).
+    modifiers : list of Modifier
+        Applied in order.
+    rng : numpy.random.Generator
+        The case's generator.
+    realised : dict
+        Receives every applied value under its concrete path.
+
+    Returns
+    -------
+    dict
+        The modified copy.
 
     Raises
     ------

@@ -43,6 +43,8 @@ _PR_SET_PDEATHSIG = 1  # prctl(2) option: signal sent to this process when its p
 class LocalPool:
     """Run ``function`` on items in ``n_workers`` processes, one item per worker at a time.
 
+    Use it as a context manager; leaving the block stops every worker.
+
     Parameters
     ----------
     function : callable
@@ -52,8 +54,6 @@ class LocalPool:
     on_lost : callable
         ``on_lost(item, exitcode)`` gives the result of an item whose worker died
         ``_ATTEMPTS`` times running it.
-
-    Use it as a context manager; leaving the block stops every worker.
     """
 
     def __init__(self, function: Callable, n_workers: int, on_lost: Callable) -> None:

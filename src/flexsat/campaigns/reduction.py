@@ -94,10 +94,14 @@ def compare_reduction(
     ----------
     definitions : list of CampaignDefinition
         Flown as given (the full model) and with ``reduced`` set.
+    satellite : SatelliteConfig
+        The base satellite of every campaign.
     out : path
         Stores go to ``out/full/<name>`` and ``out/reduced/<name>`` (resumed if there).
     reduced : Reduced, optional
         Default: the root translations locked, 10 ms step and control period.
+    workers : int or None
+        Worker processes of each campaign (None: one per core).
 
     Returns
     -------

@@ -164,6 +164,18 @@ def case_history(ds, dt: float = HISTORY_DT_S) -> dict:
     ``tip_displacement_max`` the largest tip-displacement magnitude over the
     appendages [m]. Variables a dataset lacks are left out. A partial (failed) run
     gives the history up to where it stopped.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        The slew's dataset (:class:`~flexsat.simulate.result.Result`'s).
+    dt : float
+        Sampling interval [s].
+
+    Returns
+    -------
+    dict
+        Lists by variable name, plus ``channels``.
     """
     import numpy as np
 
@@ -516,7 +528,18 @@ DASK_BATCH = 8
 
 
 def run_batch(cases: list[ResolvedCase]) -> list[dict]:
-    """Rows of :func:`run_case` for each case, in one task (never raises)."""
+    """Rows of :func:`run_case` for each case, in one task (never raises).
+
+    Parameters
+    ----------
+    cases : list of ResolvedCase
+        The batch.
+
+    Returns
+    -------
+    list of dict
+        One row per case, in order.
+    """
     return [run_case(case) for case in cases]
 
 

@@ -29,7 +29,7 @@ def analyze_sobol(sobol: SobolCases, outputs: np.ndarray, seed: int = 0) -> pd.D
     sobol : SobolCases
         The sample's definition (parameters and their bounds).
     outputs : ndarray, shape (n (D + 2),)
-        The output at each row of :func:`sobol_samples`, in order.
+        The output at each row of :func:`sobol_samples`, in order [its unit].
     seed : int
         Seed of SALib's bootstrap (confidence intervals).
 
@@ -49,6 +49,13 @@ def analyze_sobol(sobol: SobolCases, outputs: np.ndarray, seed: int = 0) -> pd.D
 
 def sobol_indices(store: str | Path, sobol: SobolCases) -> pd.DataFrame:
     """Sobol indices of every numeric metric of a stored Sobol campaign.
+
+    Parameters
+    ----------
+    store : path
+        The campaign's store folder.
+    sobol : SobolCases
+        The campaign's ``[sobol]`` table (the sample's order).
 
     Returns
     -------

@@ -61,7 +61,7 @@ def pass_rate_interval(passes: int, cases: int, confidence: float = 0.95) -> tup
     passes, cases : int
         Cases that met the requirement, out of ``cases`` (>= 1).
     confidence : float
-        Two-sided confidence level, in (0, 1).
+        Two-sided confidence level, in (0, 1) [-].
 
     Returns
     -------
@@ -84,6 +84,20 @@ def cases_needed(probability: float, confidence: float = 0.95, failures: int = 0
     The smallest n whose one-sided Clopper–Pearson lower bound with ``failures``
     failing cases reaches ``probability``: with no failure, the smallest n with
     probability^n <= 1 - confidence (n = 1108 for 99.73 % at 95 %).
+
+    Parameters
+    ----------
+    probability : float
+        The pass probability to demonstrate, in (0, 1) [-].
+    confidence : float
+        One-sided confidence level, in (0, 1) [-].
+    failures : int
+        Failing cases allowed.
+
+    Returns
+    -------
+    int
+        The number of cases.
     """
     if not (0.0 < probability < 1.0 and 0.0 < confidence < 1.0) or failures < 0:
         raise ValueError("need 0 < probability < 1, 0 < confidence < 1, failures >= 0")
@@ -97,6 +111,13 @@ def requirement_statistics(table: pd.DataFrame, confidence: float = 0.95) -> pd.
     """Pass rate, its exact interval and the failing cases of each requirement.
 
     A case that failed to run counts as failing every requirement.
+
+    Parameters
+    ----------
+    table : DataFrame
+        A store's table (:meth:`~flexsat.campaigns.store.CampaignStore.table`).
+    confidence : float
+        Two-sided confidence level of the intervals [-].
 
     Returns
     -------
@@ -122,7 +143,18 @@ def requirement_statistics(table: pd.DataFrame, confidence: float = 0.95) -> pd.
 def metric_statistics(table: pd.DataFrame) -> pd.DataFrame:
     """Minimum, 5/50/95 % percentiles, maximum, mean and std of every numeric metric.
 
-    Over the cases that ran (status ``ok``); one row per metric column.
+    Over the cases that ran (status ``ok``).
+
+    Parameters
+    ----------
+    table : DataFrame
+        A store's table.
+
+    Returns
+    -------
+    DataFrame
+        One row per metric column: ``metric``, ``cases``, ``min``, ``p5``, ``p50``,
+        ``p95``, ``max``, ``mean``, ``std``, in the metric's unit.
     """
     ok = table[table["status"] == "ok"]
     rows = []
@@ -139,7 +171,18 @@ def metric_statistics(table: pd.DataFrame) -> pd.DataFrame:
 
 
 def metric_columns(table: pd.DataFrame) -> list[str]:
-    """The numeric (non-verdict) metric columns of a store's table."""
+    """The numeric (non-verdict) metric columns of a store's table.
+
+    Parameters
+    ----------
+    table : DataFrame
+        A store's table.
+
+    Returns
+    -------
+    list of str
+        Column names, ``metrics.<name>``.
+    """
     skip = {f"metrics.{k}" for k in REQUIREMENTS}
     return [c for c in table.columns if c.startswith("metrics.") and c not in skip
             and pd.api.types.is_numeric_dtype(table[c]) and not pd.api.types.is_bool_dtype(
@@ -152,11 +195,14 @@ def percentile_envelope(values: np.ndarray, percentiles=PERCENTILES) -> np.ndarr
     Parameters
     ----------
     values : ndarray, shape (cases, samples)
+        One history per case [any unit].
     percentiles : sequence of float
+        The percentiles, in [0, 100] [%].
 
     Returns
     -------
     ndarray, shape (len(percentiles), samples)
+        The envelopes [unit of values].
     """
     return np.nanpercentile(np.asarray(values, dtype=float), percentiles, axis=0)
 

@@ -49,6 +49,9 @@ def run_worst_case(
     definition : CampaignDefinition
         The base slew (``base``, ``reduced``); its own cases are not run.
     search : WorstCaseSearch
+        The ``[worst_case]`` table: metric, parameters, seed.
+    satellite : SatelliteConfig
+        The base satellite.
     out : path
         The store (one case per evaluation).
     workers : int, optional
