@@ -88,7 +88,20 @@ def load_config(path: str | Path | None = None) -> SatelliteConfig:
 
 
 def read_toml(path: str | Path, what: str = "config") -> dict[str, Any]:
-    """Parse a TOML file, turning a missing, unreadable or malformed file into a ConfigError."""
+    """Parse a TOML file, turning a missing, unreadable or malformed file into a ConfigError.
+
+    Parameters
+    ----------
+    path : path
+        The file.
+    what : str
+        What the file holds, for the message (``"config"``, ``"scenario"``...).
+
+    Returns
+    -------
+    dict
+        The parsed tables.
+    """
     path = Path(path)
     try:
         return tomllib.loads(path.read_text(encoding="utf-8"))

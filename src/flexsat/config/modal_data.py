@@ -49,7 +49,7 @@ class _Frozen(BaseModel):
 class OutputPoint(_Frozen):
     """A point of the structure whose motion is reported (e.g. the tip)."""
 
-    name: Annotated[str, Field(min_length=1, max_length=64)]
+    name: Annotated[str, Field(min_length=1, max_length=64, description="the point's name")]
     position_m: Vector3 = Field(description="undeformed position from the interface, frame M [m]")
     mode_shapes: list[Vector3] = Field(
         description="per mode, the point's translation per unit modal coordinate, frame M "
@@ -67,7 +67,9 @@ class ModalData(_Frozen):
     """
 
     format_version: Literal[1] = Field(description="version of this format")
-    mass_kg: Annotated[float, Strict(), AllowInfNan(False), Field(gt=0.0, le=1e7)]
+    mass_kg: Annotated[
+        float, Strict(), AllowInfNan(False), Field(gt=0.0, le=1e7, description="mass [kg]")
+    ]
     center_of_mass_m: Vector3 = Field(description="interface -> centre of mass, frame M [m]")
     inertia_interface_kg_m2: Matrix3 = Field(
         description="inertia about the interface point, frame M [kg m^2]"
@@ -85,7 +87,9 @@ class ModalData(_Frozen):
         description="optional: J'_k = dJ_I/d eta_k per mode, about the interface, frame M "
         "[sqrt(kg) m]; none: the inertia does not change with the modes",
     )
-    output_points: list[OutputPoint] = Field(default_factory=list)
+    output_points: list[OutputPoint] = Field(
+        default_factory=list, description="points whose motion is reported (e.g. the tip)"
+    )
 
     @model_validator(mode="after")
     def _consistent(self) -> ModalData:
@@ -222,7 +226,20 @@ def _from_arrays(arrays: dict[str, np.ndarray]) -> dict[str, Any]:
 
 
 def modal_data_from_dict(data: dict[str, Any], source: str = "modal data") -> ModalData:
-    """Validate a plain dict of the format; one :class:`ConfigError` naming the field."""
+    """Validate a plain dict of the format; one :class:`ConfigError` naming the field.
+
+    Parameters
+    ----------
+    data : dict
+        The format's keys and values.
+    source : str
+        Where the data came from, for the message.
+
+    Returns
+    -------
+    ModalData
+        The validated data.
+    """
     from flexsat.config.load import validate_config
 
     return validate_config(data, source=source, model=ModalData)
@@ -230,6 +247,16 @@ def modal_data_from_dict(data: dict[str, Any], source: str = "modal data") -> Mo
 
 def load_modal_data(path: str | Path) -> ModalData:
     """Read and validate a modal data file (``.toml`` or ``.npz``).
+
+    Parameters
+    ----------
+    path : path
+        The file.
+
+    Returns
+    -------
+    ModalData
+        The validated data.
 
     Raises
     ------
@@ -261,7 +288,20 @@ def load_modal_data(path: str | Path) -> ModalData:
 
 def save_modal_data(data: ModalData, path: str | Path) -> Path:
     """Write ``data`` as ``.toml`` (every float with 17 significant digits: exact) or
-    ``.npz``; returns the path."""
+    ``.npz``.
+
+    Parameters
+    ----------
+    data : ModalData
+        The appendage's modal data.
+    path : path
+        The file; its suffix picks the format.
+
+    Returns
+    -------
+    Path
+        ``path``.
+    """
     path = Path(path)
     suffix = path.suffix.lower()
     if suffix == ".npz":

@@ -255,7 +255,15 @@ def load_appendage_plugins() -> None:
 
 
 def register_appendage_config(model: str, config_class: type[BaseModel]) -> None:
-    """Accept ``model = "<model>"`` appendage tables, validated as ``config_class``."""
+    """Accept ``model = "<model>"`` appendage tables, validated as ``config_class``.
+
+    Parameters
+    ----------
+    model : str
+        The ``model`` key's value.
+    config_class : type of BaseModel
+        The table's model; it needs the fields ``name`` and ``model``.
+    """
     fields = config_class.model_fields
     if "name" not in fields or "model" not in fields:
         raise TypeError(f"{config_class.__name__} needs the fields 'name' and 'model'")

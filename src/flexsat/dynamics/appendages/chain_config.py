@@ -169,7 +169,7 @@ class SegmentConfig(_Frozen):
     )
     com_m: Point3 = Field(description="joint -> segment centre of mass, segment frame [m]")
     next_joint_m: Point3 = Field(description="joint -> next joint (or the tip), segment frame [m]")
-    joint: JointConfig
+    joint: JointConfig = Field(description="the joint at the segment's origin")
 
     @model_validator(mode="after")
     def _one_inertia(self) -> SegmentConfig:
@@ -195,7 +195,23 @@ def _box_inertia(mass: float, edges: np.ndarray) -> np.ndarray:
 
 
 class Segment:
-    """One resolved segment: SI numbers only (what the packing reads)."""
+    """One resolved segment: SI numbers only (what the packing reads).
+
+    Parameters
+    ----------
+    mass : float
+        Segment mass [kg].
+    inertia : array_like, shape (3, 3)
+        Inertia about its centre of mass, segment frame [kg m^2].
+    com : array_like, shape (3,)
+        Joint -> centre of mass, segment frame [m].
+    next_joint : array_like, shape (3,)
+        Joint -> next joint (or the tip), segment frame [m].
+    joint : JointConfig
+        Its joint (coordinates, initial state, damping).
+    stiffness : dict, optional
+        Stiffness per joint coordinate [N/m or N m/rad], overriding the joint's.
+    """
 
     __slots__ = ("com", "damping", "damping_ratio", "dofs", "frequencies", "inertia", "mass",
                  "next_joint", "q0", "qd0", "stiffness")  # fmt: skip
@@ -237,13 +253,13 @@ class ChainConfig(_Frozen):
     point mass at the last segment's ``next_joint_m`` (the free end).
     """
 
-    name: Name
+    name: Name = Field(description="unique name of the appendage")
     model: Literal["chain"] = Field(description="appendage model (registry key)")
     mount_point_m: Point3 = Field(description="root joint position from hub centre of mass, B [m]")
     mount_zyx_deg: tuple[Angle, Angle, Angle] = Field(
         (0.0, 0.0, 0.0), description="mount orientation, R_BM = Rz(a) Ry(b) Rx(c) [deg]"
     )
-    mount_matrix: Matrix3 | None = Field(None, description="R_BM (mount -> hub), instead")
+    mount_matrix: Matrix3 | None = Field(None, description="R_BM (mount -> hub) [-], instead")
     span_direction: _SPAN = Field("+y", description="span axis of the segment frames")
     segments: Annotated[int, Strict(), Field(ge=1, le=512)] | None = Field(
         None, description="segment count N of a uniform chain"

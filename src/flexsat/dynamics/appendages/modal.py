@@ -127,13 +127,13 @@ class ModalAppendageConfig(BaseModel):
 
     model_config = ConfigDict(frozen=True, extra="forbid", validate_default=True)
 
-    name: Name
+    name: Name = Field(description="unique name of the appendage")
     model: Literal["modal"] = Field("modal", description="appendage model (registry key)")
     mount_point_m: Point3 = Field(description="interface point from hub centre of mass, B [m]")
     mount_yaw_deg: Angle = Field(0.0, description="mount frame rotation about Z_B [deg]")
     sadm_angle_deg: Angle = Field(0.0, description="SADM angle about Y_M [deg]")
     mount_matrix: Matrix3 | None = Field(
-        None, description="R_BM (mount -> hub), instead of the two angles"
+        None, description="R_BM (mount -> hub) [-], instead of the two angles"
     )
     file: str | None = Field(None, description="modal data file (.toml or .npz)")
     data: ModalData | None = Field(None, description="modal data (the file's content)")
