@@ -354,7 +354,31 @@ def _invert_spd(w, k, n):
 
 @njit(PASS1_SIGNATURE, cache=True, error_model="numpy")
 def pass1(q, qd, Q, members, params, work, hub, qdd):
-    """Velocities outward, articulated inertias inward; the root's share to the hub."""
+    """Velocities outward, articulated inertias inward; the root's share to the hub.
+
+    Parameters
+    ----------
+    q, qd : ndarray, shape (n_dof,)
+        Generalized coordinates [m, rad] and rates [m/s, rad/s] of the whole plant.
+    Q : ndarray, shape (n_dof,)
+        External generalized forces [N, N m per coordinate].
+    members : ndarray, shape (k, 2), int64
+        Per chain: appendage index and offset of its first coordinate in q [-].
+    params : ndarray, shape (k, p)
+        Per chain: its packed row (``HEADER`` then the segments' ``G_*`` slots) [SI].
+    work : ndarray, shape (k, w)
+        Per chain: scratch pass 1 leaves for pass 2 [SI].
+    hub : ndarray, shape (HUB_SIZE,)
+        The hub exchange array (slots ``HUB_*`` of the contract module) [SI per
+        slot]; the wrench and articulated inertia are added to it.
+    qdd : ndarray, shape (n_dof,)
+        Not written in pass 1 [m/s^2, rad/s^2].
+
+    Returns
+    -------
+    int
+        ``STATUS_OK`` or a joint gimbal-lock status.
+    """
     omega_B = load_seg(hub, HUB_OMEGA)
     for j in range(members.shape[0]):
         o = members[j, 1]
@@ -446,7 +470,29 @@ def pass1(q, qd, Q, members, params, work, hub, qdd):
 
 @njit(PASS2_SIGNATURE, cache=True, error_model="numpy")
 def pass2(q, qd, members, params, work, hub, qdd):
-    """Joint accelerations outward from the hub's: q_ddot_k = D^-1 (u - U^T a'_k)."""
+    """Joint accelerations outward from the hub's: q_ddot_k = D^-1 (u - U^T a'_k).
+
+    Parameters
+    ----------
+    q, qd : ndarray, shape (n_dof,)
+        Generalized coordinates [m, rad] and rates [m/s, rad/s] of the whole plant.
+    members : ndarray, shape (k, 2), int64
+        Per chain: appendage index and offset of its first coordinate in q [-].
+    params : ndarray, shape (k, p)
+        Per chain: its packed row (``HEADER`` then the segments' ``G_*`` slots) [SI].
+    work : ndarray, shape (k, w)
+        Per chain: scratch pass 1 leaves for pass 2 [SI].
+    hub : ndarray, shape (HUB_SIZE,)
+        The hub exchange array (slots ``HUB_*`` of the contract module) [SI per
+        slot]; the hub's accelerations are read from it.
+    qdd : ndarray, shape (n_dof,)
+        Output: the chains' coordinate accelerations [m/s^2, rad/s^2].
+
+    Returns
+    -------
+    int
+        ``STATUS_OK``.
+    """
     for j in range(members.shape[0]):
         o = members[j, 1]
         p = params[j]
@@ -488,7 +534,19 @@ def _subspace_pass(q, o, p, w):
 
 @njit(MASS_SIGNATURE, cache=True, error_model="numpy")
 def mass_matrix(q, members, params, M):
-    """The chains' share of M(q) (eq. 2.39): composite-rigid-body algorithm."""
+    """The chains' share of M(q) (eq. 2.39): composite-rigid-body algorithm.
+
+    Parameters
+    ----------
+    q : ndarray, shape (n_dof,)
+        Generalized coordinates of the whole plant [m, rad].
+    members : ndarray, shape (k, 2), int64
+        Per chain: appendage index and offset of its first coordinate in q [-].
+    params : ndarray, shape (k, p)
+        Per chain: its packed row (``HEADER`` then the segments' ``G_*`` slots) [SI].
+    M : ndarray, shape (n_dof, n_dof)
+        The mass matrix, the chains' blocks added [kg, kg m, kg m^2 per entry].
+    """
     R_NB = rot_zyx(q[3], q[4], q[5])
     S = euler_rate_matrix(q[3], q[4])
     ic_hub = np.zeros(36)
@@ -552,7 +610,22 @@ def mass_matrix(q, members, params, M):
 
 @njit(BIAS_SIGNATURE, cache=True, error_model="numpy")
 def bias_forces(q, qd, members, params, hub, h):
-    """The chains' share of h(q, q_dot) (eq. 2.43): recursive Newton-Euler at q_ddot = 0."""
+    """The chains' share of h(q, q_dot) (eq. 2.43): recursive Newton-Euler at q_ddot = 0.
+
+    Parameters
+    ----------
+    q, qd : ndarray, shape (n_dof,)
+        Generalized coordinates [m, rad] and rates [m/s, rad/s] of the whole plant.
+    members : ndarray, shape (k, 2), int64
+        Per chain: appendage index and offset of its first coordinate in q [-].
+    params : ndarray, shape (k, p)
+        Per chain: its packed row (``HEADER`` then the segments' ``G_*`` slots) [SI].
+    hub : ndarray, shape (HUB_SIZE,)
+        The hub exchange array (slots ``HUB_*`` of the contract module) [SI per
+        slot]; the chains' force and torque on the hub are added to it.
+    h : ndarray, shape (n_dof,)
+        The bias vector, the chains' coordinates written [N, N m per coordinate].
+    """
     R_NB = rot_zyx(q[3], q[4], q[5])
     omega_B = load_seg(hub, HUB_OMEGA)
     s_bias = load_seg(hub, HUB_SBIAS)
@@ -601,7 +674,19 @@ def bias_forces(q, qd, members, params, hub, h):
 
 @njit(OBSERVE_SIGNATURE, cache=True, error_model="numpy")
 def observe(q, qd, members, params, out):
-    """Add the chains' kinetic energy, momentum, locked inertia, elastic energy, damper power."""
+    """Add the chains' kinetic energy, momentum, locked inertia, elastic energy, damper power.
+
+    Parameters
+    ----------
+    q, qd : ndarray, shape (n_dof,)
+        Generalized coordinates [m, rad] and rates [m/s, rad/s] of the whole plant.
+    members : ndarray, shape (k, 2), int64
+        Per chain: appendage index and offset of its first coordinate in q [-].
+    params : ndarray, shape (k, p)
+        Per chain: its packed row (``HEADER`` then the segments' ``G_*`` slots) [SI].
+    out : ndarray, shape (OBS_SIZE,)
+        The observation slots (``OBS_*``: [J], [N m s], [kg m^2], [J], [W]), added to.
+    """
     R_NB = rot_zyx(q[3], q[4], q[5])
     r_hub = load_seg(q, 0)
     omega_B = mv(euler_rate_matrix(q[3], q[4]), load_seg(qd, 3))
@@ -668,6 +753,25 @@ def joint_wrench(q, qd, Q, members, params, out):
     [n; f] on segment 0 with S^T [n; f] = tau and no component the joint does not
     free: f = sum_i tau_i R_JP^T e_i, n = S_r (S_r^T S_r)^-1 tau_r over the free
     rotations (= S(rho)^-T tau_r on a full joint, the plate's N_P).
+
+    Parameters
+    ----------
+    q, qd : ndarray, shape (n_dof,)
+        Generalized coordinates [m, rad] and rates [m/s, rad/s] of the whole plant.
+    Q : ndarray, shape (n_dof,)
+        External generalized forces [N, N m per coordinate].
+    members : ndarray, shape (k, 2), int64
+        Per chain: appendage index and offset of its first coordinate in q [-].
+    params : ndarray, shape (k, p)
+        Per chain: its packed row (``HEADER`` then the segments' ``G_*`` slots) [SI].
+    out : ndarray, shape (6,)
+        The hub wrench, added to: force [N] and torque about the hub centre of mass
+        [N m], hub frame B.
+
+    Returns
+    -------
+    int
+        ``STATUS_OK``.
     """
     for j in range(members.shape[0]):
         o = members[j, 1]
@@ -716,7 +820,19 @@ def joint_wrench(q, qd, Q, members, params, out):
 
 @njit(TIPS_SIGNATURE, cache=True, error_model="numpy")
 def tips(q, members, params, out):
-    """Displacement of each chain's free end from its undeformed place, mount frame [m]."""
+    """Displacement of each chain's free end from its undeformed place, mount frame [m].
+
+    Parameters
+    ----------
+    q : ndarray, shape (n_dof,)
+        Generalized coordinates of the whole plant [m, rad].
+    members : ndarray, shape (k, 2), int64
+        Per chain: appendage index and offset of its first coordinate in q [-].
+    params : ndarray, shape (k, p)
+        Per chain: its packed row (``HEADER`` then the segments' ``G_*`` slots) [SI].
+    out : ndarray, shape (n_appendages, 3)
+        Output: one row per appendage, the chains' rows written [m].
+    """
     for j in range(members.shape[0]):
         o = members[j, 1]
         p = params[j]
