@@ -17,6 +17,18 @@ def shorten(text: str, limit: int = 80) -> str:
 
     Error messages echo what the user wrote; a 50 MB name must not give a 50 MB
     message.
+
+    Parameters
+    ----------
+    text : str
+        The text.
+    limit : int
+        About the longest result [characters].
+
+    Returns
+    -------
+    str
+        ``text``, or its two ends around ``...[n characters]...``.
     """
     if len(text) <= limit:
         return text

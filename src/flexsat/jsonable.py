@@ -16,10 +16,13 @@ def jsonable(value):
     Parameters
     ----------
     value : float, int, bool, str, None, dict, list or tuple
+        A JSON-like structure [any units].
 
     Returns
     -------
-    The same structure (tuples as lists), safe for ``json.dumps(allow_nan=False)``.
+    object
+        The same structure (tuples as lists), safe for
+        ``json.dumps(allow_nan=False)``.
     """
     if isinstance(value, float) and not math.isfinite(value):
         return None

@@ -164,6 +164,16 @@ def effective_mass_table(plant: Plant) -> dict:
     [kg m^2]), with the cumulative fraction of the satellite's total in that direction
     (diag of M(0) at the hub: total mass, locked inertia; modes plus residual), see
     :func:`flexsat.linear.frequency.effective_masses`.
+
+    Parameters
+    ----------
+    plant : Plant
+        The satellite.
+
+    Returns
+    -------
+    dict
+        Plain lists and numbers, ready for ``json.dumps``.
     """
     from flexsat.linear.frequency import effective_masses
 

@@ -75,6 +75,16 @@ def finite_part(ds: xr.Dataset) -> xr.Dataset:
     blew up); metrics are computed on what came before. The first record is always
     kept. A column that is not finite from the first record on (a quantity the model
     does not have, such as the root rotation of a modal appendage) is not a divergence.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A run's dataset.
+
+    Returns
+    -------
+    xarray.Dataset
+        Its finite leading records.
     """
     bad = np.zeros(ds.sizes["time"], dtype=bool)
     for var in ds.data_vars.values():

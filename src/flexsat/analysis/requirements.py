@@ -204,6 +204,16 @@ def actuator_saturation_times(ds: xr.Dataset) -> dict[str, float]:
     Read from the ``actuator_saturated`` record an actuator stage may declare (bit
     i set: unit i + 1 could not deliver, e.g. a reaction wheel at its momentum
     limit; ``docs/control.md``, 'Reaction wheels'); empty without it or if none did.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A slew's dataset.
+
+    Returns
+    -------
+    dict of str to float
+        First saturation time of each unit that saturated [s].
     """
     if "actuator_saturated" not in ds:
         return {}

@@ -36,7 +36,20 @@ _TIP_STEP = 1e-6  # [sqrt(kg) m] central-difference step of the tip map (exact f
 
 def mount_rotation(model, params: np.ndarray) -> np.ndarray:
     """R_BM of a packed row from the model's ``mount_rotation(params)`` (the plate, chain
-    and modal models have one); identity for a model without (its data is then in B)."""
+    and modal models have one); identity for a model without (its data is then in B).
+
+    Parameters
+    ----------
+    model : AppendageModel
+        The appendage's model.
+    params : ndarray, shape (p,)
+        Its packed parameter row [SI].
+
+    Returns
+    -------
+    ndarray, shape (3, 3)
+        R_BM, mount frame M to hub frame B [-].
+    """
     rotation = getattr(model, "mount_rotation", None)
     return np.eye(3) if rotation is None else np.asarray(rotation(params), dtype=float)
 
@@ -51,6 +64,7 @@ def modal_data(plant: Plant, appendage: str, n_modes: int | None = None) -> Moda
     Parameters
     ----------
     plant : Plant
+        The satellite.
     appendage : str
         Its name.
     n_modes : int, optional
@@ -118,6 +132,18 @@ def modal_satellite(plant: Plant, n_modes: int | None = None) -> SatelliteConfig
     """``plant``'s satellite with every appendage replaced by its modal export.
 
     Each modal appendage keeps the original's name, root point and mount frame.
+
+    Parameters
+    ----------
+    plant : Plant
+        The satellite.
+    n_modes : int, optional
+        Modes kept per appendage, the lowest first (default: all).
+
+    Returns
+    -------
+    SatelliteConfig
+        The validated configuration.
     """
     from flexsat.config.load import validate_config
 

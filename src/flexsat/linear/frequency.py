@@ -105,6 +105,11 @@ def effective_masses(plant: Plant) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     As :func:`effective_inertia`, for every hub direction: translations x, y, z
     (L_k,a^2 [kg]) and rotations about the hub centre of mass x, y, z ([kg m^2]).
 
+    Parameters
+    ----------
+    plant : Plant
+        The satellite.
+
     Returns
     -------
     frequencies_hz : ndarray, shape (n_flex,)

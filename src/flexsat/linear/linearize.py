@@ -151,9 +151,11 @@ def body_frame_derivative(
     Parameters
     ----------
     plant : Plant
+        The satellite.
     x : ndarray, shape (2 n_dof,)
-        Body-frame state (module docstring); its attitude is relative to a reference
-        spinning at the constant body rate ``spin``, taken at the identity.
+        Body-frame state (module docstring) [m, rad, m/s, rad/s]; its attitude is
+        relative to a reference spinning at the constant body rate ``spin``, taken at
+        the identity.
     torque_B : ndarray, shape (3 + len(actuated),)
         Torque on the hub, hub frame B [N m], then the generalized forces on the
         actuated coordinates [N or N m].
@@ -165,6 +167,7 @@ def body_frame_derivative(
     Returns
     -------
     ndarray, shape (2 n_dof,)
+        dx/dt [unit of x per s].
     """
     r_B, dTheta, _, v_B, omega, eta_dot = _split(plant, x)
     q, qd, R_IB = _plant_state(plant, x)
@@ -203,8 +206,20 @@ def output_map(
 ) -> Callable[[np.ndarray, np.ndarray], np.ndarray]:
     """y(x, u) of the named output groups (see :data:`OUTPUT_GROUPS`), concatenated.
 
-    ``u = [tau_B, Q_a]`` as in :func:`body_frame_derivative` (``actuated``: the
-    indices in q of the actuated coordinates).
+    Parameters
+    ----------
+    plant : Plant
+        The satellite.
+    groups : sequence of str
+        Names of :data:`OUTPUT_GROUPS`, in output order.
+    actuated : sequence of int
+        Indices in q of the actuated coordinates: ``u = [tau_B, Q_a]`` as in
+        :func:`body_frame_derivative`.
+
+    Returns
+    -------
+    callable
+        ``y(x, u)``, an ndarray of the groups' outputs [each group's units].
 
     Raises
     ------
