@@ -35,6 +35,7 @@ numpydoc_validate = pytest.importorskip("numpydoc.validate")
 CHECKS = {
     "GL08",  # no docstring
     "SS01",  # no summary
+    "GL07",  # sections in the wrong order (Parameters before Returns...)
     "PR01",  # a parameter of the signature not documented
     "PR02",  # a documented parameter not in the signature
     "PR03",  # parameters documented out of order

@@ -111,6 +111,22 @@ def campaign_envelope(
     Each case is interpolated linearly onto ``t`` (a no-op for cases sharing its
     times); a case contributes nothing outside its own time span. Times no case
     covers come back NaN.
+
+    Parameters
+    ----------
+    histories : dict of str to xarray.Dataset
+        Each case's stored history, by case id.
+    name : str
+        The history variable.
+    t : ndarray, shape (n,)
+        The common times [s].
+    axis : int, optional
+        The component of a per-axis variable.
+
+    Returns
+    -------
+    low, high : ndarray, shape (n,)
+        The envelope [the variable's unit].
     """
     stack = _stack(histories, name, t, axis)
     if stack is None:
@@ -128,7 +144,26 @@ def campaign_percentiles(
     percentiles: tuple[float, ...] = PERCENTILES,
 ) -> np.ndarray:  # fmt: skip
     """Percentiles over the cases (5/50/95 % by default) on the times ``t``,
-    shape (len(percentiles), len(t)); interpolated as :func:`campaign_envelope`."""
+    shape (len(percentiles), len(t)); interpolated as :func:`campaign_envelope`.
+
+    Parameters
+    ----------
+    histories : dict of str to xarray.Dataset
+        Each case's stored history, by case id.
+    name : str
+        The history variable.
+    t : ndarray, shape (n,)
+        The common times [s].
+    axis : int, optional
+        The component of a per-axis variable.
+    percentiles : tuple of float
+        The percentiles, in [0, 100] [%].
+
+    Returns
+    -------
+    ndarray, shape (len(percentiles), n)
+        The percentile curves [the variable's unit].
+    """
     stack = _stack(histories, name, t, axis)
     if stack is None:
         return np.full((len(percentiles), t.size), np.nan)
@@ -210,7 +245,18 @@ def _log_panel(
 
 
 def plot_envelope_pointing(store_dir: str | Path) -> Figure:
-    """Pointing error [deg] of every case (log) with the R1 band."""
+    """Pointing error [deg] of every case (log) with the R1 band.
+
+    Parameters
+    ----------
+    store_dir : str or Path
+        The campaign's store folder.
+
+    Returns
+    -------
+    Figure
+        The figure.
+    """
     c = _load(store_dir)
     return _log_panel(
         c,
@@ -225,7 +271,18 @@ def plot_envelope_pointing(store_dir: str | Path) -> Figure:
 
 
 def plot_envelope_rate(store_dir: str | Path) -> Figure:
-    """Residual rate ‖ω − ω_d‖ [deg/s] of every case (log) with the R2 band."""
+    """Residual rate ‖ω − ω_d‖ [deg/s] of every case (log) with the R2 band.
+
+    Parameters
+    ----------
+    store_dir : str or Path
+        The campaign's store folder.
+
+    Returns
+    -------
+    Figure
+        The figure.
+    """
     c = _load(store_dir)
     return _log_panel(
         c,
@@ -240,7 +297,18 @@ def plot_envelope_rate(store_dir: str | Path) -> Figure:
 
 
 def plot_envelope_torque(store_dir: str | Path) -> Figure:
-    """Commanded torque per axis [N m] of every case with the limits ±RF·T_max."""
+    """Commanded torque per axis [N m] of every case with the limits ±RF·T_max.
+
+    Parameters
+    ----------
+    store_dir : str or Path
+        The campaign's store folder.
+
+    Returns
+    -------
+    Figure
+        The figure.
+    """
     c = _load(store_dir)
     fig, axes = style.figure(3, 1, size=(11.0, 8.5))
     for k in range(3):
@@ -273,7 +341,18 @@ def _single(c: _Campaign, name: str, scale: float, ylabel: str, what: str, colou
 
 
 def plot_envelope_tip(store_dir: str | Path) -> Figure:
-    """Largest panel tip displacement magnitude [mm] of every case."""
+    """Largest panel tip displacement magnitude [mm] of every case.
+
+    Parameters
+    ----------
+    store_dir : str or Path
+        The campaign's store folder.
+
+    Returns
+    -------
+    Figure
+        The figure.
+    """
     return _single(
         _load(store_dir),
         "tip_displacement_max",
@@ -285,7 +364,18 @@ def plot_envelope_tip(store_dir: str | Path) -> Figure:
 
 
 def plot_envelope_energy(store_dir: str | Path) -> Figure:
-    """Total energy T + U [J] of every case."""
+    """Total energy T + U [J] of every case.
+
+    Parameters
+    ----------
+    store_dir : str or Path
+        The campaign's store folder.
+
+    Returns
+    -------
+    Figure
+        The figure.
+    """
     return _single(
         _load(store_dir),
         "total_energy",
@@ -297,7 +387,18 @@ def plot_envelope_energy(store_dir: str | Path) -> Figure:
 
 
 def plot_envelope_gains(store_dir: str | Path) -> Figure:
-    """Adaptive gains of every case: Λ_act [rad/s] and JK per axis [N m]."""
+    """Adaptive gains of every case: Λ_act [rad/s] and JK per axis [N m].
+
+    Parameters
+    ----------
+    store_dir : str or Path
+        The campaign's store folder.
+
+    Returns
+    -------
+    Figure
+        The figure.
+    """
     c = _load(store_dir)
     fig, axes = style.figure(4, 1, size=(11.0, 10.0))
     _band_and_line(axes[0, 0], c, "lambda_act", colour="black")
@@ -323,7 +424,18 @@ _ENVELOPES = {
 
 
 def plot_envelopes(store_dir: str | Path) -> list[Figure]:
-    """Every envelope figure of a stored campaign, in the order of :data:`CAMPAIGN_FIGURES`."""
+    """Every envelope figure of a stored campaign, in the order of :data:`CAMPAIGN_FIGURES`.
+
+    Parameters
+    ----------
+    store_dir : str or Path
+        The campaign's store folder.
+
+    Returns
+    -------
+    list of Figure
+        The figures.
+    """
     campaign = _load(store_dir)
     return [make(campaign) for make in _ENVELOPES.values()]
 
@@ -340,7 +452,18 @@ def _parameters(row: dict) -> str:
 
 
 def plot_summary_table(store_dir: str | Path) -> Figure:
-    """Pass rates R1/R2/R3 and the five worst cases (final pointing error) with parameters."""
+    """Pass rates R1/R2/R3 and the five worst cases (final pointing error) with parameters.
+
+    Parameters
+    ----------
+    store_dir : str or Path
+        The campaign's store folder.
+
+    Returns
+    -------
+    Figure
+        The figure.
+    """
     store = CampaignStore(store_dir)
     summary = summarize(store.root)
     rows = {row["case_id"]: row for row in store.rows()}
@@ -409,6 +532,15 @@ def write_campaign_figures(
     Files, in the order of :data:`CAMPAIGN_FIGURES`: ``envelope_pointing.png``,
     ``envelope_rate.png``, ``envelope_torque.png``, ``envelope_tip_displacement.png``,
     ``envelope_energy.png``, ``envelope_gains.png`` and ``summary_table.png``.
+
+    Parameters
+    ----------
+    store_dir : str or Path
+        The campaign's store folder.
+    out_dir : str or Path, optional
+        Where the files go; created if missing.
+    dpi : int
+        Resolution [dots per inch].
 
     Returns
     -------

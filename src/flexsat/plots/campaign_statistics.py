@@ -56,7 +56,18 @@ def _label(column: str) -> str:
 
 
 def plot_metric_histograms(store_dir: str | Path) -> Figure:
-    """A histogram of every numeric metric over the cases that ran, with its 5/50/95 %."""
+    """A histogram of every numeric metric over the cases that ran, with its 5/50/95 %.
+
+    Parameters
+    ----------
+    store_dir : str or Path
+        The campaign's store folder.
+
+    Returns
+    -------
+    Figure
+        The figure.
+    """
     metrics = _metrics(CampaignStore(store_dir))
     fig, axes = _grid(len(metrics.columns))
     for ax, column in zip(axes, metrics.columns, strict=True):
@@ -72,7 +83,18 @@ def plot_metric_histograms(store_dir: str | Path) -> Figure:
 
 
 def plot_metric_cdfs(store_dir: str | Path) -> Figure:
-    """The empirical CDF of every numeric metric over the cases that ran."""
+    """The empirical CDF of every numeric metric over the cases that ran.
+
+    Parameters
+    ----------
+    store_dir : str or Path
+        The campaign's store folder.
+
+    Returns
+    -------
+    Figure
+        The figure.
+    """
     metrics = _metrics(CampaignStore(store_dir))
     fig, axes = _grid(len(metrics.columns))
     for ax, column in zip(axes, metrics.columns, strict=True):
@@ -94,7 +116,20 @@ def _parameters(store: CampaignStore) -> pd.DataFrame:
 
 
 def plot_parameter_scatter(store_dir: str | Path, metric: str = DEFAULT_METRIC) -> Figure:
-    """``metric`` against every dispersed parameter (physical values where known)."""
+    """``metric`` against every dispersed parameter (physical values where known).
+
+    Parameters
+    ----------
+    store_dir : str or Path
+        The campaign's store folder.
+    metric : str
+        The case metric (a column of the store's table without ``metrics.``).
+
+    Returns
+    -------
+    Figure
+        The figure.
+    """
     store = CampaignStore(store_dir)
     parameters, metrics = _parameters(store), _metrics(store)
     column = f"metrics.{metric}"
@@ -116,7 +151,20 @@ def plot_parameter_scatter(store_dir: str | Path, metric: str = DEFAULT_METRIC) 
 
 def plot_tornado(store_dir: str | Path, metric: str = DEFAULT_METRIC) -> Figure:
     """Tornado chart: Spearman rank correlation of ``metric`` with each parameter,
-    sorted by magnitude."""
+    sorted by magnitude.
+
+    Parameters
+    ----------
+    store_dir : str or Path
+        The campaign's store folder.
+    metric : str
+        The case metric (a column of the store's table without ``metrics.``).
+
+    Returns
+    -------
+    Figure
+        The figure.
+    """
     store = CampaignStore(store_dir)
     column = f"metrics.{metric}"
     metrics = _metrics(store)
@@ -146,7 +194,24 @@ def write_statistics_figures(
     store_dir: str | Path, out_dir: str | Path | None = None, *, metric: str = DEFAULT_METRIC,
     dpi: int = 120,
 ) -> list[Path]:  # fmt: skip
-    """Write the statistics figures as PNG (default folder ``<store_dir>/figures``)."""
+    """Write the statistics figures as PNG (default folder ``<store_dir>/figures``).
+
+    Parameters
+    ----------
+    store_dir : str or Path
+        The campaign's store folder.
+    out_dir : str or Path, optional
+        Where the files go; created if missing.
+    metric : str
+        The case metric (a column of the store's table without ``metrics.``).
+    dpi : int
+        Resolution [dots per inch].
+
+    Returns
+    -------
+    list of Path
+        The files written.
+    """
     out = Path(out_dir) if out_dir is not None else Path(store_dir) / "figures"
     makers = {
         "metric_histograms": lambda: plot_metric_histograms(store_dir),

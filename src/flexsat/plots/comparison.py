@@ -90,7 +90,22 @@ def plot_controller_comparison(datasets: dict[str, xr.Dataset]) -> Figure:
 def write_comparison_figure(
     datasets: dict[str, xr.Dataset], path: str | Path, *, dpi: int = 120
 ) -> Path:
-    """Write :func:`plot_controller_comparison` to ``path`` (PNG); returns the path."""
+    """Write :func:`plot_controller_comparison` to ``path`` (PNG); returns the path.
+
+    Parameters
+    ----------
+    datasets : dict of str to xarray.Dataset
+        Each law's slew, by label.
+    path : str or Path
+        The PNG file.
+    dpi : int
+        Resolution [dots per inch].
+
+    Returns
+    -------
+    Path
+        ``path``.
+    """
     return style.save_figure(plot_controller_comparison(datasets), path, dpi=dpi)
 
 

@@ -170,6 +170,16 @@ def meaningful_components(values: np.ndarray) -> list[int]:
     """Columns of ``values`` (shape (m, n)) worth a panel: peak above a fraction of the top.
 
     The column with the largest peak is always kept, so a flat record still shows.
+
+    Parameters
+    ----------
+    values : ndarray, shape (m, n)
+        One record per row [any unit].
+
+    Returns
+    -------
+    list of int
+        The columns kept.
     """
     peaks = np.nan_to_num(np.nanmax(np.abs(values), axis=0), nan=0.0)
     top = float(peaks.max())

@@ -28,12 +28,34 @@ _NEEDS_MODES = ("angular_acceleration", "spectrogram")  # open-loop figures with
 
 
 def result_kind(ds: xr.Dataset) -> str:
-    """``"slew"`` for a closed-loop run, ``"openloop"`` for an open-loop one."""
+    """``"slew"`` for a closed-loop run, ``"openloop"`` for an open-loop one.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A run's dataset.
+
+    Returns
+    -------
+    str
+        ``"slew"`` or ``"openloop"``.
+    """
     return "slew" if "pointing_error_deg" in ds else "openloop"
 
 
 def figure_names(ds: xr.Dataset) -> tuple[str, ...]:
-    """Names of the figures this run can draw, in the order they are written."""
+    """Names of the figures this run can draw, in the order they are written.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A run's dataset.
+
+    Returns
+    -------
+    tuple of str
+        The figure names.
+    """
     if result_kind(ds) == "slew":
         return slew.slew_figure_names(ds)
     return openloop.OPENLOOP_FIGURES
@@ -87,6 +109,7 @@ def write_result_figures(
     Parameters
     ----------
     ds : xarray.Dataset
+        The run's dataset.
     out_dir : str or Path
         Created if missing.
     kinds : tuple of str, optional

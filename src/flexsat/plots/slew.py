@@ -171,6 +171,16 @@ def plot_slew_root_deformation(ds: xr.Dataset) -> Figure:
 
     :func:`flexsat.plots.openloop.plot_root_deformation` without the torque shading
     (torque is commanded throughout a slew).
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A slew's dataset.
+
+    Returns
+    -------
+    Figure
+        The figure.
     """
     return plot_root_deformation(ds)
 
@@ -179,6 +189,16 @@ def plot_slew_tip_displacement(ds: xr.Dataset) -> Figure:
     """Panel tip displacement of each appendage [mm] during the slew.
 
     :func:`flexsat.plots.openloop.plot_tip_displacement` without the torque shading.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A slew's dataset.
+
+    Returns
+    -------
+    Figure
+        The figure.
     """
     return plot_tip_displacement(ds)
 
@@ -187,6 +207,16 @@ def plot_slew_energy(ds: xr.Dataset) -> Figure:
     """Energy balance of the slew [J], linear and logarithmic.
 
     :func:`flexsat.plots.openloop.plot_energy` without the torque shading.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A slew's dataset.
+
+    Returns
+    -------
+    Figure
+        The figure.
     """
     return plot_energy(ds)
 
@@ -908,13 +938,36 @@ def slew_figure_names(ds: xr.Dataset) -> tuple[str, ...]:
 
     A law without a sliding surface (PD, a plain-Python controller) records no
     sliding variable, slope or robust gain: its run has no figure of them.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A slew's dataset.
+
+    Returns
+    -------
+    tuple of str
+        The figure names.
     """
     has_surface = _surface(ds) is not None and "sliding_variable" in ds
     return tuple(n for n in SLEW_FIGURES if has_surface or n not in _SURFACE_FIGURES)
 
 
 def plot_slew(ds: xr.Dataset, name: str) -> Figure:
-    """The slew figure ``name`` (one of :data:`SLEW_FIGURES`) of a closed-loop run."""
+    """The slew figure ``name`` (one of :data:`SLEW_FIGURES`) of a closed-loop run.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A slew's dataset.
+    name : str
+        One of :data:`SLEW_FIGURES`.
+
+    Returns
+    -------
+    Figure
+        The figure.
+    """
     return _MAKERS[name](ds)
 
 

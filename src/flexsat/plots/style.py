@@ -65,6 +65,24 @@ def figure(nrows: int, ncols: int = 1, *, size=(11.0, 7.5), sharex=True, **grid)
     """A constrained-layout figure of ``size`` inches and its axes, shape (nrows, ncols).
 
     Extra keywords go to the grid (``height_ratios=...``).
+
+    Parameters
+    ----------
+    nrows, ncols : int
+        The grid of axes.
+    size : tuple of 2 float
+        Width and height [in].
+    sharex : bool
+        The axes share their x axis.
+    **grid
+        Keywords of the grid (``height_ratios=...``).
+
+    Returns
+    -------
+    fig : Figure
+        The figure.
+    axes : ndarray of Axes, shape (nrows, ncols)
+        Its axes.
     """
     fig = Figure(figsize=size, layout="constrained")
     axes = fig.subplots(nrows, ncols, sharex=sharex, squeeze=False, gridspec_kw=grid or None)
@@ -72,12 +90,33 @@ def figure(nrows: int, ncols: int = 1, *, size=(11.0, 7.5), sharex=True, **grid)
 
 
 def time_s(ds: xr.Dataset) -> np.ndarray:
-    """The time coordinate of a result dataset as float64 [s]."""
+    """The time coordinate of a result dataset as float64 [s].
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A run's dataset.
+
+    Returns
+    -------
+    ndarray, shape (m,)
+        The record times [s].
+    """
     return np.asarray(ds["time"].values, dtype=float)
 
 
 def suptitle(fig: Figure, ds: xr.Dataset, what: str) -> None:
-    """Title ``what``, the run's title below it, and the failure message of a failed run."""
+    """Title ``what``, the run's title below it, and the failure message of a failed run.
+
+    Parameters
+    ----------
+    fig : Figure
+        The figure.
+    ds : xarray.Dataset
+        The run drawn.
+    what : str
+        What the figure shows.
+    """
     scenario = ds.attrs.get("title", "flexsat open-loop run")
     text = f"{what}\n{scenario}"
     if ds.attrs.get("status", "ok") != "ok":
@@ -90,6 +129,20 @@ def envelope(t: np.ndarray, y: np.ndarray, max_points: int = MAX_LINE_POINTS) ->
 
     Unlike plain striding this keeps the peaks of an oscillation faster than the
     thinned sampling, so the drawn envelope is the true one.
+
+    Parameters
+    ----------
+    t : ndarray, shape (m,)
+        Times [s].
+    y : ndarray, shape (m,) or (m, k)
+        Values [any unit].
+    max_points : int
+        About the most points kept.
+
+    Returns
+    -------
+    t, y : ndarray
+        The thinned times [s] and values [unit of y].
     """
     n = t.size
     if n <= max_points:
@@ -106,12 +159,37 @@ def envelope(t: np.ndarray, y: np.ndarray, max_points: int = MAX_LINE_POINTS) ->
 
 
 def line(ax: Axes, t: np.ndarray, y: np.ndarray, **kw):
-    """Plot ``y`` against ``t`` on ``ax`` (through :func:`envelope`); returns the line."""
+    """Plot ``y`` against ``t`` on ``ax`` (through :func:`envelope`); returns the line.
+
+    Parameters
+    ----------
+    ax : Axes
+        The axes.
+    t : ndarray, shape (m,)
+        Times [s].
+    y : ndarray, shape (m,)
+        Values [any unit].
+    **kw
+        Keywords of ``Axes.plot``.
+
+    Returns
+    -------
+    Line2D
+        The line.
+    """
     return ax.plot(*envelope(t, np.asarray(y, dtype=float)), **kw)[0]
 
 
 def finish_time_axis(axes, t: np.ndarray) -> None:
-    """Grid and time limits on every axis, the time label on the bottom row."""
+    """Grid and time limits on every axis, the time label on the bottom row.
+
+    Parameters
+    ----------
+    axes : ndarray of Axes
+        The figure's axes, shape (nrows, ncols) or (nrows,).
+    t : ndarray, shape (m,)
+        The times drawn [s].
+    """
     for ax in np.ravel(axes):
         ax.grid(True, color="0.85", linewidth=0.6)
         ax.set_xlim(t[0], t[-1])
@@ -120,7 +198,18 @@ def finish_time_axis(axes, t: np.ndarray) -> None:
 
 
 def positive(values: np.ndarray) -> np.ndarray:
-    """Values with non-positive entries masked (NaN), for a log axis."""
+    """Values with non-positive entries masked (NaN), for a log axis.
+
+    Parameters
+    ----------
+    values : ndarray
+        Values for a log axis [any unit].
+
+    Returns
+    -------
+    ndarray
+        A copy, non-positive entries NaN [unit of values].
+    """
     values = np.asarray(values, dtype=float)
     return np.where(values > 0.0, values, np.nan)
 
@@ -183,6 +272,7 @@ def forked_map(job: Callable, items: Iterable, workers: int | None = None) -> li
         Called once per item; a closure is fine (forked processes inherit it, only
         the items and the results are pickled).
     items : iterable
+        The job's arguments.
     workers : int, optional
         Processes; default :func:`figure_workers`, at most one per item.
 
@@ -222,6 +312,7 @@ def write_figures(
     out_dir : str or Path
         Created if missing.
     names : iterable of str
+        The figures' names.
     draw : callable
         ``draw(name) -> Figure``.
     dpi : int
