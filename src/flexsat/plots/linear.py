@@ -44,7 +44,18 @@ FIGURES = (
 
 
 def frequency_grid_hz(n: int = 3000) -> np.ndarray:
-    """The frequency grid of every figure: 1 mHz to 200 Hz, log-spaced [Hz]."""
+    """The frequency grid of every figure: 1 mHz to 200 Hz, log-spaced [Hz].
+
+    Parameters
+    ----------
+    n : int
+        Number of frequencies.
+
+    Returns
+    -------
+    ndarray, shape (n,)
+        The frequencies [Hz].
+    """
     return np.geomspace(1e-3, 200.0, n)
 
 
@@ -53,7 +64,22 @@ def _siso(model: LinearModel, out: str, inp: str, f: np.ndarray) -> np.ndarray:
 
 
 def plot_bode(flexible: LinearModel, rigid: LinearModel, output: str = "rate") -> Figure:
-    """Bode diagrams tau_a -> omega_a (``output="rate"``) or -> attitude, a = x, y, z."""
+    """Bode diagrams tau_a -> omega_a (``output="rate"``) or -> attitude, a = x, y, z.
+
+    Parameters
+    ----------
+    flexible : LinearModel
+        The flexible satellite's model.
+    rigid : LinearModel
+        The rigid reference model.
+    output : {"rate", "attitude"}
+        The output of the response.
+
+    Returns
+    -------
+    Figure
+        The figure.
+    """
     outs = {"rate": ("omega_x", "omega_y", "omega_z"), "attitude": ("phi", "theta", "psi")}
     unit = {"rate": "rad/s / N m", "attitude": "rad / N m"}[output]
     f = frequency_grid_hz()
@@ -76,7 +102,20 @@ def plot_bode(flexible: LinearModel, rigid: LinearModel, output: str = "rate") -
 
 
 def plot_singular_values(flexible: LinearModel, rigid: LinearModel) -> Figure:
-    """Singular values of the 3 x 3 torque -> rate response, flexible and rigid."""
+    """Singular values of the 3 x 3 torque -> rate response, flexible and rigid.
+
+    Parameters
+    ----------
+    flexible : LinearModel
+        The flexible satellite's model.
+    rigid : LinearModel
+        The rigid reference model.
+
+    Returns
+    -------
+    Figure
+        The figure.
+    """
     f = frequency_grid_hz()
     rate, torque = ["omega_x", "omega_y", "omega_z"], ["tau_x", "tau_y", "tau_z"]
     fig, axes = style.figure(1, 1, size=(9.0, 5.5))
@@ -95,7 +134,18 @@ def plot_singular_values(flexible: LinearModel, rigid: LinearModel) -> Figure:
 
 
 def plot_pole_zero(flexible: LinearModel) -> Figure:
-    """Poles of the model and the zeros of tau_a -> omega_a per axis (s-plane, [rad/s])."""
+    """Poles of the model and the zeros of tau_a -> omega_a per axis (s-plane, [rad/s]).
+
+    Parameters
+    ----------
+    flexible : LinearModel
+        The flexible satellite's model.
+
+    Returns
+    -------
+    Figure
+        The figure.
+    """
     fig, axes = style.figure(1, 1, size=(9.0, 6.0))
     ax = axes[0, 0]
     poles = flexible.poles()
@@ -117,7 +167,20 @@ def plot_pole_zero(flexible: LinearModel) -> Figure:
 
 
 def plot_effective_inertia(frequencies_hz: np.ndarray, J_eff: np.ndarray) -> Figure:
-    """Bars of the modal effective inertia per appendage mode and body axis [kg m^2]."""
+    """Bars of the modal effective inertia per appendage mode and body axis [kg m^2].
+
+    Parameters
+    ----------
+    frequencies_hz : ndarray, shape (n,)
+        The appendage modes' frequencies [Hz].
+    J_eff : ndarray, shape (n, 3)
+        Their effective inertia about each body axis [kg m^2].
+
+    Returns
+    -------
+    Figure
+        The figure.
+    """
     fig, axes = style.figure(1, 1, size=(10.0, 5.5))
     ax = axes[0, 0]
     keep = J_eff.max(axis=1) > 1e-6 * J_eff.max()
@@ -137,7 +200,22 @@ def plot_effective_inertia(frequencies_hz: np.ndarray, J_eff: np.ndarray) -> Fig
 def plot_loops(
     loops: dict[str, LinearModel], margins: dict[str, LoopMargins], modes_hz: np.ndarray
 ) -> Figure:
-    """Loop gain per axis: Bode with 0 dB, -180 deg, crossovers and flexible modes marked."""
+    """Loop gain per axis: Bode with 0 dB, -180 deg, crossovers and flexible modes marked.
+
+    Parameters
+    ----------
+    loops : dict of str to LinearModel
+        The loop gain of each axis, by axis name.
+    margins : dict of str to LoopMargins
+        Their margins, by axis name.
+    modes_hz : ndarray
+        The flexible modes marked [Hz].
+
+    Returns
+    -------
+    Figure
+        The figure.
+    """
     f = frequency_grid_hz()
     fig, axes = style.figure(2, 3, size=(14.0, 7.0), height_ratios=(2, 1))
     for a, axis in enumerate(style.AXES):
@@ -168,7 +246,18 @@ def plot_loops(
 
 
 def plot_nichols(loops: dict[str, LinearModel]) -> Figure:
-    """Nichols plot of the loop gains: open-loop phase [deg] against gain [dB]."""
+    """Nichols plot of the loop gains: open-loop phase [deg] against gain [dB].
+
+    Parameters
+    ----------
+    loops : dict of str to LinearModel
+        The loop gain of each axis, by axis name.
+
+    Returns
+    -------
+    Figure
+        The figure.
+    """
     f = frequency_grid_hz()
     fig, axes = style.figure(1, 1, size=(9.0, 6.5))
     ax = axes[0, 0]
@@ -188,7 +277,20 @@ def plot_nichols(loops: dict[str, LinearModel]) -> Figure:
 def plot_loop_family(
     loops: dict[str, dict[str, LinearModel]], margins: dict[str, dict[str, dict]]
 ) -> Figure:
-    """Loop-gain magnitude per axis, one curve per case; the legend gives its delay margin."""
+    """Loop-gain magnitude per axis, one curve per case; the legend gives its delay margin.
+
+    Parameters
+    ----------
+    loops : dict of str to dict of str to LinearModel
+        Per case id, the loop gain of each axis.
+    margins : dict of str to dict of str to dict
+        Per case id, the margins of each axis (delay margin [s]).
+
+    Returns
+    -------
+    Figure
+        The figure.
+    """
     f = frequency_grid_hz()
     fig, axes = style.figure(1, 3, size=(15.0, 5.5))
     for a, axis in enumerate(style.AXES):
@@ -222,7 +324,30 @@ def write_linear_figures(
     *,
     dpi: int = 110,
 ) -> list[Path]:
-    """Write the figures of :data:`FIGURES` (the loop figures only with ``loops``)."""
+    """Write the figures of :data:`FIGURES` (the loop figures only with ``loops``).
+
+    Parameters
+    ----------
+    out_dir : str or Path
+        Where the files go; created if missing.
+    flexible : LinearModel
+        The flexible satellite's model.
+    rigid : LinearModel
+        The rigid reference model.
+    effective : tuple of ndarray
+        Frequencies [Hz] and effective inertias [kg m^2] of the appendage modes.
+    loops : dict of str to LinearModel, optional
+        The loop gain of each axis.
+    margins : dict of str to LoopMargins, optional
+        Their margins.
+    dpi : int
+        Resolution [dots per inch].
+
+    Returns
+    -------
+    list of Path
+        The files written.
+    """
     modes_hz = effective[0]
     draw = {
         "bode_rate": lambda: plot_bode(flexible, rigid, "rate"),

@@ -44,6 +44,15 @@ def _metrics(plant, fields: dict) -> dict:
 def avionics_study(plant, out: str | Path, quick: bool = False) -> dict:
     """Run (a) and (b) on ``plant``; write the JSON and the figure under ``out``.
 
+    Parameters
+    ----------
+    plant : Plant
+        The satellite.
+    out : str or Path
+        The part's folder.
+    quick : bool
+        The short version (fewer delays, shorter runs).
+
     Returns
     -------
     dict
@@ -108,7 +117,24 @@ def _delay_figure(sweep: list[dict], path: Path) -> Path:
 
 def render_avionics(root: Path, outputs: dict, cell) -> tuple[list, list, str]:
     """Table rows for the report: the side-by-side metrics, the delay sweep, and the
-    sentence of the boundaries. ``cell(relative_json, *path)`` makes a traced cell."""
+    sentence of the boundaries. ``cell(relative_json, *path)`` makes a traced cell.
+
+    Parameters
+    ----------
+    root : Path
+        The study folder.
+    outputs : dict
+        The avionics part's outputs (manifest).
+    cell : callable
+        ``cell(relative_json, *path)`` makes a traced table cell.
+
+    Returns
+    -------
+    metrics, sweep : list
+        The table rows.
+    boundaries : str
+        The sentence.
+    """
     import json
 
     rel = outputs["json"]

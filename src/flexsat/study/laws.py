@@ -60,6 +60,11 @@ def _distribution(values: list[float]) -> dict:
 def law_statistics(rows: list[dict]) -> dict:
     """One variant's figures over a campaign's case rows (``run_case`` rows).
 
+    Parameters
+    ----------
+    rows : list of dict
+        The case rows.
+
     Returns
     -------
     dict

@@ -31,7 +31,18 @@ _REDUCTIONS = ("modal", "balanced")
 
 
 def parse_about(text: str) -> str | np.ndarray:
-    """``"rest"`` or ``"spin:wx,wy,wz"`` (body rate [rad/s]) -> ``"rest"`` or the vector."""
+    """``"rest"`` or ``"spin:wx,wy,wz"`` (body rate [rad/s]) -> ``"rest"`` or the vector.
+
+    Parameters
+    ----------
+    text : str
+        The option's value.
+
+    Returns
+    -------
+    str or ndarray, shape (3,)
+        ``"rest"`` or the body rate [rad/s].
+    """
     if text == "rest":
         return "rest"
     head, _, tail = text.partition(":")
@@ -45,7 +56,18 @@ def parse_about(text: str) -> str | np.ndarray:
 
 
 def parse_reduction(text: str | None) -> tuple[str, int] | None:
-    """``"balanced:16"`` or ``"modal:16"`` -> (method, order); ``None`` -> no reduction."""
+    """``"balanced:16"`` or ``"modal:16"`` -> (method, order); ``None`` -> no reduction.
+
+    Parameters
+    ----------
+    text : str or None
+        The option's value.
+
+    Returns
+    -------
+    tuple of (str, int) or None
+        Method and order.
+    """
     if text is None:
         return None
     method, _, order = text.partition(":")
@@ -79,8 +101,21 @@ def write_linearize(
 ) -> tuple[object, dict]:
     """Linearize; with ``out``, ``model.npz``, ``model.mat``, ``linear.json``, figures.
 
-    ``actuated`` names appendage coordinates given an input each, as in
-    :func:`flexsat.linear.linearize`.
+    Parameters
+    ----------
+    plant : Plant
+        The satellite.
+    about : str or ndarray, shape (3,)
+        ``"rest"`` or a steady body rate [rad/s] (:func:`parse_about`).
+    outputs : list of str, optional
+        Output groups (default: the model's).
+    reduction : tuple of (str, int), optional
+        Method and order (:func:`parse_reduction`).
+    out : Path, optional
+        Where the files go.
+    actuated : list of str, optional
+        Appendage coordinates given an input each, as in
+        :func:`flexsat.linear.linearize`.
 
     Returns
     -------
@@ -150,10 +185,18 @@ def write_margins(plant: Plant, scenario=None, out: Path | None = None) -> dict:
     Parameters
     ----------
     plant : Plant
+        The satellite.
     scenario : SlewScenario, optional
         Its controller (PD, SMC or ASMC) is linearized about rest, the sliding-mode
         laws inside their boundary layer with Lambda and JK at their steady-state
         values; default: the PD law's default gains.
+    out : Path, optional
+        Where the figures and ``margins.json`` go.
+
+    Returns
+    -------
+    dict
+        The margins per axis.
     """
     from flexsat.linear import linearize
     from flexsat.linear.frequency import (
@@ -193,6 +236,17 @@ def family_margins(
     Each case perturbs the truth plant; the controller keeps the design model of
     ``plant`` (the campaign's base configuration), as in the campaigns. With ``out``,
     ``margins_family.json`` and ``loop_family.png`` (one curve per case and axis).
+
+    Parameters
+    ----------
+    plant : Plant
+        The design (base) satellite.
+    campaign : str or Path
+        The campaign file.
+    scenario : SlewScenario, optional
+        The controller, as for :func:`write_margins`.
+    out : Path, optional
+        Where the files go.
 
     Returns
     -------

@@ -34,6 +34,18 @@ __all__ = [
 def prepare_output_dir(path: str | Path, option: str = "--out") -> Path:
     """Create an output folder now and check it can be written, before any work.
 
+    Parameters
+    ----------
+    path : str or Path
+        The folder.
+    option : str
+        The command-line option that named it, for the message.
+
+    Returns
+    -------
+    Path
+        The folder.
+
     Raises
     ------
     ConfigError
@@ -52,7 +64,20 @@ def prepare_output_dir(path: str | Path, option: str = "--out") -> Path:
 
 
 def write_json(path: str | Path, payload: dict) -> Path:
-    """Write ``payload`` as strict, indented JSON (to a temporary name, then moved)."""
+    """Write ``payload`` as strict, indented JSON (to a temporary name, then moved).
+
+    Parameters
+    ----------
+    path : str or Path
+        The file.
+    payload : dict
+        JSON-like data (non-finite floats become null).
+
+    Returns
+    -------
+    Path
+        ``path``.
+    """
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     partial = path.with_suffix(path.suffix + ".partial")
@@ -63,6 +88,11 @@ def write_json(path: str | Path, payload: dict) -> Path:
 
 def derived_properties(plant: Plant) -> dict:
     """What flexsat derives from a config: hub inertia, panel masses, joint tuning.
+
+    Parameters
+    ----------
+    plant : Plant
+        The satellite.
 
     Returns
     -------
@@ -85,6 +115,15 @@ def derived_properties(plant: Plant) -> dict:
 
 def write_modal(plant: Plant, out: Path | None = None, animate: list[int] | None = None):
     """Modal analysis; with ``out``, ``modal.json`` and the modal figures there.
+
+    Parameters
+    ----------
+    plant : Plant
+        The satellite.
+    out : Path, optional
+        Where the files go.
+    animate : list of int, optional
+        Modes (1-based) to animate as GIFs.
 
     Returns
     -------
@@ -112,6 +151,7 @@ def fly_openloop(plant: Plant, scenario=None, out: Path | None = None, progress=
     Parameters
     ----------
     plant : Plant
+        The satellite.
     scenario : OpenLoopScenario, optional
         Default: the thesis's 1 N m yaw pulse.
     out : Path, optional
@@ -156,10 +196,13 @@ def fly_slew(plant: Plant, scenario=None, out: Path | None = None, progress=None
     Parameters
     ----------
     plant : Plant
+        The satellite.
     scenario : SlewScenario, optional
         Default: the thesis's 45/45/45 deg ASMC slew.
     out : Path, optional
+        Where the files go (records that do not fit in memory stream there).
     progress : bool or None
+        Progress bar: None shows it on a terminal only.
     figures : bool
         With ``out``, also draw the figure set (result.nc and metrics.json always).
 
@@ -212,6 +255,7 @@ def fly_campaign(definition, config, store: Path, *, progress: bool = True, **ba
     Parameters
     ----------
     definition : CampaignDefinition
+        The campaign.
     config : SatelliteConfig
         The base plant the campaign varies.
     store : Path

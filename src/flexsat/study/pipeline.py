@@ -48,7 +48,25 @@ REPORT = "report.html"
 
 @dataclass
 class StudyContext:
-    """What every part gets: the satellite, the output folder and the options."""
+    """What every part gets: the satellite, the output folder and the options.
+
+    Parameters
+    ----------
+    config : SatelliteConfig
+        The satellite studied.
+    out : Path
+        The study folder.
+    quick : bool
+        The short study (``--quick``).
+    progress : bool or None
+        Progress bars: None shows them on a terminal only.
+    workers : int or None
+        Processes of the campaigns and figures (None: the default).
+    controllers : tuple of str
+        The comparison's laws; empty: every registered law.
+    results : dict
+        Part name -> its returned outputs, filled as the parts run.
+    """
 
     config: SatelliteConfig
     out: Path
@@ -76,7 +94,21 @@ class StudyContext:
 
 @dataclass(frozen=True)
 class Part:
-    """One section of the study: a name (its folder), a title, and the function."""
+    """One section of the study: a name (its folder), a title, and the function.
+
+    Parameters
+    ----------
+    name : str
+        The part's name, also its folder.
+    title : str
+        Its title in the report.
+    run : callable
+        ``run(context) -> outputs``.
+    needs : tuple of str
+        Parts whose outputs it reads (run first).
+    full_only : bool
+        Skipped with ``--quick``.
+    """
 
     name: str
     title: str

@@ -538,11 +538,21 @@ def _avionics(root: Path, outputs: dict, context: dict) -> str:
 class Section:
     """One section of the report: what it draws, from which part's outputs.
 
-    ``draw(root, outputs, context) -> html`` gets the study folder, the part's
-    outputs (the manifest's ``outputs`` of part ``part``) and the context
-    (``source``, ``nominal``); ``caveat`` is shown at the top of the section when
-    the configuration is not the thesis's nominal case (its thesis values then do
-    not apply as they are).
+    Parameters
+    ----------
+    name : str
+        The section's anchor.
+    draw : callable
+        ``draw(root, outputs, context) -> html`` gets the study folder, the part's
+        outputs (the manifest's ``outputs`` of part ``part``) and the context
+        (``source``, ``nominal``).
+    part : str, optional
+        The part whose outputs it draws; default: the section's name.
+    title : str, optional
+        Default: the part's title.
+    caveat : str, optional
+        Shown at the top of the section when the configuration is not the thesis's
+        nominal case (its thesis values then do not apply as they are).
     """
 
     name: str
