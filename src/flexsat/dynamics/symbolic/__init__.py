@@ -81,10 +81,8 @@ from flexsat.dynamics.symbolic.derivation import SymbolicModel, _derive
 from flexsat.dynamics.symbolic.reference import ReferenceModel, ReferenceParameters
 from flexsat.dynamics.symbolic.rotations import (
     euler_rate_matrix,
-    rot_x,
-    rot_y,
-    rot_z,
     rot_zyx,
+    rotation,
 )
 from flexsat.dynamics.symbolic.symbols import (
     AppendageSymbols,
@@ -104,10 +102,8 @@ __all__ = [
     "derive",
     "euler_rate_matrix",
     "reference_model",
-    "rot_x",
-    "rot_y",
-    "rot_z",
     "rot_zyx",
+    "rotation",
 ]
 
 

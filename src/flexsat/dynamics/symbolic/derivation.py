@@ -8,7 +8,7 @@ from typing import Literal
 import sympy as sp
 
 from flexsat.dynamics.symbolic.printing import _equations_latex, _equations_pretty, _tidy
-from flexsat.dynamics.symbolic.rotations import euler_rate_matrix, rot_y, rot_z, rot_zyx
+from flexsat.dynamics.symbolic.rotations import euler_rate_matrix, rot_zyx, rotation
 from flexsat.dynamics.symbolic.symbols import (
     AppendageSymbols,
     HubSymbols,
@@ -155,7 +155,7 @@ def _derive(n_appendages: int, panel_rates: PanelRates) -> SymbolicModel:
         o = 6 + 6 * i
         eta, rho = q[o : o + 3, 0], q[o + 3 : o + 6, 0]
         rho_dot = qd[o + 3 : o + 6, 0]
-        R_BM = rot_z(app.mount_yaw) * rot_y(app.sadm)
+        R_BM = rotation("z", app.mount_yaw) * rotation("y", app.sadm)
         R_MP = rot_zyx(rho[0], rho[1], rho[2])
         d = sp.Matrix([0, app.span_sign * app.length / 2, 0])
         # Panel CoM position in B (eq. 2.29) and its exact time derivative (chain rule).

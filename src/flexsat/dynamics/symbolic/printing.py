@@ -8,7 +8,7 @@ from typing import TYPE_CHECKING, Any
 
 import sympy as sp
 
-from flexsat.dynamics.symbolic.rotations import euler_rate_matrix, rot_y, rot_z
+from flexsat.dynamics.symbolic.rotations import euler_rate_matrix, rotation
 from flexsat.dynamics.symbolic.symbols import _AXES
 
 if TYPE_CHECKING:
@@ -20,7 +20,7 @@ _PRETTY_COLUMNS = 100
 def _display_parts(m: SymbolicModel, i: int) -> tuple[sp.Matrix, sp.Matrix]:
     """R_BM and d of appendage ``i``, rebuilt for display."""
     app = m.appendages[i]
-    R_BM = rot_z(app.mount_yaw) * rot_y(app.sadm)
+    R_BM = rotation("z", app.mount_yaw) * rotation("y", app.sadm)
     d = sp.Matrix([0, app.span_sign * app.length / 2, 0])
     return R_BM, d
 

@@ -4,14 +4,20 @@ from __future__ import annotations
 
 import sympy as sp
 
-__all__ = ["euler_rate_matrix", "rot_x", "rot_y", "rot_z", "rot_zyx"]
+__all__ = ["euler_rate_matrix", "rot_zyx", "rotation"]
 
 
-def rot_x(a: sp.Expr) -> sp.Matrix:
-    """Rotation by ``a`` about X: child-frame components to parent-frame components.
+_AXES = {"x": 0, "y": 1, "z": 2}
+
+
+def rotation(axis: str, a: sp.Expr) -> sp.Matrix:
+    """Elementary rotation by ``a`` about ``axis``: child-frame components to
+    parent-frame components.
 
     Parameters
     ----------
+    axis : {"x", "y", "z"}
+        The rotation axis, shared by both frames.
     a : sympy.Expr
         Angle [rad].
 
@@ -20,42 +26,12 @@ def rot_x(a: sp.Expr) -> sp.Matrix:
     sympy.Matrix
         3 x 3 rotation matrix [-].
     """
+    k = _AXES[axis]
+    i, j = (k + 1) % 3, (k + 2) % 3  # the plane turned, in right-handed order
     c, s = sp.cos(a), sp.sin(a)
-    return sp.Matrix([[1, 0, 0], [0, c, -s], [0, s, c]])
-
-
-def rot_y(a: sp.Expr) -> sp.Matrix:
-    """Rotation by ``a`` about Y: child-frame components to parent-frame components.
-
-    Parameters
-    ----------
-    a : sympy.Expr
-        Angle [rad].
-
-    Returns
-    -------
-    sympy.Matrix
-        3 x 3 rotation matrix [-].
-    """
-    c, s = sp.cos(a), sp.sin(a)
-    return sp.Matrix([[c, 0, s], [0, 1, 0], [-s, 0, c]])
-
-
-def rot_z(a: sp.Expr) -> sp.Matrix:
-    """Rotation by ``a`` about Z: child-frame components to parent-frame components.
-
-    Parameters
-    ----------
-    a : sympy.Expr
-        Angle [rad].
-
-    Returns
-    -------
-    sympy.Matrix
-        3 x 3 rotation matrix [-].
-    """
-    c, s = sp.cos(a), sp.sin(a)
-    return sp.Matrix([[c, -s, 0], [s, c, 0], [0, 0, 1]])
+    R = sp.eye(3)
+    R[i, i], R[i, j], R[j, i], R[j, j] = c, -s, s, c
+    return R
 
 
 def rot_zyx(a_x: sp.Expr, a_y: sp.Expr, a_z: sp.Expr) -> sp.Matrix:
@@ -71,7 +47,7 @@ def rot_zyx(a_x: sp.Expr, a_y: sp.Expr, a_z: sp.Expr) -> sp.Matrix:
     sympy.Matrix
         3 x 3 rotation matrix, child (body) to parent components [-].
     """
-    return rot_z(a_z) * rot_y(a_y) * rot_x(a_x)
+    return rotation("z", a_z) * rotation("y", a_y) * rotation("x", a_x)
 
 
 def euler_rate_matrix(a_x: sp.Expr, a_y: sp.Expr) -> sp.Matrix:
