@@ -27,7 +27,21 @@ HUB_UNITS = ("m", "m", "m", "rad", "rad", "rad")
 
 @dataclass(frozen=True)
 class CoordinateBlock:
-    """The coordinates of one appendage: q[offset : offset + count]."""
+    """The coordinates of one appendage: q[offset : offset + count].
+
+    Parameters
+    ----------
+    appendage : str
+        The appendage's name.
+    model : str
+        Its model's registry key (``"plate"``, ``"chain"``, ``"modal"``...).
+    offset : int
+        Index of its first coordinate in q.
+    names : tuple of str
+        Its coordinates' names, in order.
+    units : tuple of str
+        Their units (``"m"``, ``"rad"``, ``"m sqrt(kg)"``...).
+    """
 
     appendage: str
     model: str
@@ -46,7 +60,13 @@ class CoordinateBlock:
 
 @dataclass(frozen=True)
 class StateLayout:
-    """Offsets of q, q_dot, each appendage's coordinates and the energy accumulators."""
+    """Offsets of q, q_dot, each appendage's coordinates and the energy accumulators.
+
+    Parameters
+    ----------
+    blocks : tuple of CoordinateBlock
+        One per appendage, in config order (the hub's six coordinates come first).
+    """
 
     blocks: tuple[CoordinateBlock, ...]
 

@@ -24,16 +24,17 @@ def mirror_operator(plant: Plant, plane: str = "xz", rtol: float = 1e-9) -> np.n
     Parameters
     ----------
     plant : Plant
+        The satellite.
     plane : {"xz", "yz"}
         Hub coordinate plane of the reflection.
     rtol : float
-        Relative tolerance when matching appendage geometry and properties.
+        Relative tolerance when matching appendage geometry and properties [-].
 
     Returns
     -------
     ndarray, shape (n_dof, n_dof) or None
-        P with P @ P = I, M(P q) = P M(q) P and h(P q, P q_dot) = P h(q, q_dot) when
-        the plant is mirror symmetric; None otherwise.
+        P [-] with P @ P = I, M(P q) = P M(q) P and h(P q, P q_dot) = P h(q, q_dot)
+        when the plant is mirror symmetric; None otherwise.
     """
     flip = np.ones(3)
     flip[_PLANES[plane]] = -1.0

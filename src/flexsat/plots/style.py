@@ -81,7 +81,7 @@ def figure(nrows: int, ncols: int = 1, *, size=(11.0, 7.5), sharex=True, **grid)
     -------
     fig : Figure
         The figure.
-    axes : ndarray of Axes, shape (nrows, ncols)
+    axes : grid of Axes, shape (nrows, ncols)
         Its axes.
     """
     fig = Figure(figsize=size, layout="constrained")
@@ -185,7 +185,7 @@ def finish_time_axis(axes, t: np.ndarray) -> None:
 
     Parameters
     ----------
-    axes : ndarray of Axes
+    axes : grid of Axes
         The figure's axes, shape (nrows, ncols) or (nrows,).
     t : ndarray, shape (m,)
         The times drawn [s].
