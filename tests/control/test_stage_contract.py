@@ -12,7 +12,7 @@ from typing import Literal
 import numpy as np
 import pytest
 from numba import njit
-from pydantic import Field
+from pydantic import Field, ValidationError
 
 from flexsat.control import Channel, StageConfig, StageSpec, register_stage
 from flexsat.control.quaternion import euler_zyx_to_quaternion, target_quaternion
@@ -22,6 +22,7 @@ from flexsat.control.stages import (
     SENSOR_SIGNATURE,
     SENSORS,
     ActuatorStageConfig,
+    validate_stage,
 )
 from flexsat.dynamics.linalg3 import euler_rate_matrix, load_seg, mv
 from flexsat.simulate import SlewScenario, run_slew
@@ -66,6 +67,10 @@ def scaling_actuator_step(tau_cmd, t, dt, params, state, tau_applied, record):
         tau_applied[a] = params[0] * tau_cmd[a]
     record[0] = params[0]
     return 0
+
+
+class PlainActuatorConfig(StageConfig):
+    kind: Literal["plain"] = "plain"  # no limits: an actuation stage only
 
 
 BIASED = StageSpec(role="sensor", name="biased", config=BiasedSensorConfig,
@@ -126,3 +131,35 @@ def test_actuator_stage_replaces_the_static_one(stages, nominal_plant):
     from flexsat.plots.slew import plot_disturbances
 
     plot_disturbances(ds)  # says there is no static disturbance model to draw
+
+
+@pytest.mark.parametrize(
+    ("role", "default"),
+    [("sensor", "ideal"), ("actuator", "static"), ("reference", "step"),
+     ("joint_actuator", "none")],
+)  # fmt: skip
+def test_one_validator_serves_every_role(role, default):
+    # A table without kind selects the role's default stage; each field of the slew
+    # scenario is validated by the role it is named after.
+    assert validate_stage(role, {}).kind == default
+    assert getattr(SlewScenario(), role).kind == default
+
+
+def test_a_stage_without_limits_is_refused_as_the_final_actuator():
+    with pytest.raises(ValidationError, match="actuator_stages, before the final"):
+        SlewScenario(actuator={"kind": "notch"})
+    # ...but is accepted in the chain before it
+    chained = SlewScenario(actuator_stages=[{"kind": "notch"}])
+    assert chained.actuator_stages[0].kind == "notch"
+
+
+def test_registration_checks_the_config_the_role_needs():
+    plain = StageSpec(role="actuator", name="plain", config=PlainActuatorConfig,
+                      step=scaling_actuator_step)  # fmt: skip
+    with pytest.raises(ValueError, match="must derive ActuatorStageConfig"):
+        register_stage(plain, default=True)  # the default [actuator] needs limits
+    joint = StageSpec(role="joint_actuator", name="plain", config=PlainActuatorConfig,
+                      step=scaling_actuator_step)  # fmt: skip
+    with pytest.raises(ValueError, match="must derive JointActuatorConfig"):
+        register_stage(joint)
+    assert ACTUATORS.default == "static" and "plain" not in ACTUATORS.names()
