@@ -19,6 +19,7 @@ __all__ = [
     "inertia3",
     "linear_sliding_feedback",
     "sat",
+    "surface_attributes",
 ]
 
 
@@ -31,6 +32,33 @@ def linear_sliding_feedback(J: np.ndarray, lam: float, jk: float, phi: float) ->
     """
     k = jk / phi
     return np.hstack([0.5 * k * lam * np.eye(3), 0.5 * lam * np.asarray(J) + k * np.eye(3)])
+
+
+def surface_attributes(
+    lambda_min: float, lambda_max: float, phi: float | None = None, jk_floor: float | None = None
+) -> dict[str, float]:
+    """A sliding-mode law's :meth:`~flexsat.control.laws.LawConfig.plot_attributes`.
+
+    Parameters
+    ----------
+    lambda_min, lambda_max : float
+        Slopes of the surface at its two ends, equal for a constant slope [rad/s].
+    phi : float, optional
+        Boundary-layer width Phi [rad/s]; None: the law has none.
+    jk_floor : float, optional
+        Floor of the robust gain JK [N m]; None: the law has none.
+
+    Returns
+    -------
+    dict of str to float
+        The attributes the slew plots read, in their units.
+    """
+    out = {"surface_lambda_min_rad_s": lambda_min, "surface_lambda_max_rad_s": lambda_max}
+    if phi is not None:
+        out["boundary_layer_rad_s"] = phi
+    if jk_floor is not None:
+        out["jk_floor_nm"] = jk_floor
+    return out
 
 
 @njit(cache=True)

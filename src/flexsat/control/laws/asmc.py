@@ -29,6 +29,7 @@ from flexsat.control.laws._sliding import (
     inertia3,
     linear_sliding_feedback,
     sat,
+    surface_attributes,
 )
 from flexsat.control.laws.registry import LAW_SIGNATURE, LawConfig, LawSpec
 from flexsat.dynamics.linalg3 import cross, mv
@@ -111,13 +112,8 @@ class ASMCConfig(LawConfig):
         ), dtype=float)  # fmt: skip
 
     def plot_attributes(self) -> dict[str, float | str]:
-        return {
-            "surface_lambda_min_rad_s": self.lambda_min,
-            "surface_lambda_max_rad_s": self.lambda_max,
-            "boundary_layer_rad_s": self.phi,
-            "jk_floor_nm": self.jk_min_nm,
-            "theta_threshold_deg": self.theta_threshold_deg,
-        }
+        return {**surface_attributes(self.lambda_min, self.lambda_max, self.phi, self.jk_min_nm),
+                "theta_threshold_deg": self.theta_threshold_deg}  # fmt: skip
 
     def linear_feedback(self, J: np.ndarray) -> np.ndarray:
         # At the target: Lambda_target = lambda_max (eq. 4.27 at theta = 0), never cut

@@ -24,7 +24,7 @@ from numba import njit
 from pydantic import Field
 
 from flexsat.config.models import Positive
-from flexsat.control.laws._sliding import clip_and_store, errors, inertia3, sat
+from flexsat.control.laws._sliding import clip_and_store, errors, inertia3, sat, surface_attributes
 from flexsat.control.laws.registry import LAW_SIGNATURE, LawConfig, LawSpec
 from flexsat.control.registry import Channel
 from flexsat.dynamics.linalg3 import cross, mv
@@ -78,12 +78,7 @@ class ISMCConfig(LawConfig):
         ), dtype=float)  # fmt: skip
 
     def plot_attributes(self) -> dict[str, float | str]:
-        return {
-            "surface_lambda_min_rad_s": self.lambda_,
-            "surface_lambda_max_rad_s": self.lambda_,
-            "boundary_layer_rad_s": self.phi,
-            "jk_floor_nm": self.jk_nm,
-        }
+        return surface_attributes(self.lambda_, self.lambda_, self.phi, self.jk_nm)
 
 
 @njit(LAW_SIGNATURE, cache=True)

@@ -21,6 +21,7 @@ from flexsat.control.laws._sliding import (
     inertia3,
     linear_sliding_feedback,
     sat,
+    surface_attributes,
 )
 from flexsat.control.laws.registry import LAW_SIGNATURE, LawConfig, LawSpec
 from flexsat.dynamics.linalg3 import cross, mv
@@ -70,12 +71,7 @@ class SMCConfig(LawConfig):
         )  # fmt: skip
 
     def plot_attributes(self) -> dict[str, float | str]:
-        return {
-            "surface_lambda_min_rad_s": self.lambda_,
-            "surface_lambda_max_rad_s": self.lambda_,
-            "boundary_layer_rad_s": self.phi,
-            "jk_floor_nm": self.jk_nm,
-        }
+        return surface_attributes(self.lambda_, self.lambda_, self.phi, self.jk_nm)
 
     def linear_feedback(self, J: np.ndarray) -> np.ndarray:
         return linear_sliding_feedback(J, self.lambda_, self.jk_nm, self.phi)

@@ -35,7 +35,7 @@ from numba import njit
 from pydantic import Field, model_validator
 
 from flexsat.config.models import Positive
-from flexsat.control.laws._sliding import clip_and_store, errors, inertia3
+from flexsat.control.laws._sliding import clip_and_store, errors, inertia3, surface_attributes
 from flexsat.control.laws.registry import LAW_SIGNATURE, LawConfig, LawSpec
 from flexsat.control.registry import Channel
 from flexsat.dynamics.linalg3 import cross, mv
@@ -128,7 +128,7 @@ class STSMCConfig(LawConfig):
         ), dtype=float)  # fmt: skip
 
     def plot_attributes(self) -> dict[str, float | str]:
-        return {"surface_lambda_min_rad_s": self.lambda_, "surface_lambda_max_rad_s": self.lambda_}
+        return surface_attributes(self.lambda_, self.lambda_)
 
 
 @njit(cache=True)
