@@ -24,7 +24,9 @@ __all__ = [
     "cross",
     "dot",
     "euler_rate_bias",
+    "euler_rate_bias_cs",
     "euler_rate_matrix",
+    "euler_rate_matrix_cs",
     "euler_rate_matrix_inv",
     "load_m33",
     "load_m33_at",
@@ -35,6 +37,7 @@ __all__ = [
     "mtv",
     "mv",
     "rot_zyx",
+    "rot_zyx_cs",
     "scale",
     "scale_m",
     "skew",
@@ -123,9 +126,12 @@ def skew(v):
 @njit(cache=True, error_model="numpy")
 def rot_zyx(phi, theta, psi):
     """Rz(psi) Ry(theta) Rx(phi): body (child) components to parent components (eq. 2.25)."""
-    c1, s1 = cos(phi), sin(phi)
-    c2, s2 = cos(theta), sin(theta)
-    c3, s3 = cos(psi), sin(psi)
+    return rot_zyx_cs(cos(phi), sin(phi), cos(theta), sin(theta), cos(psi), sin(psi))
+
+
+@njit(cache=True, error_model="numpy")
+def rot_zyx_cs(c1, s1, c2, s2, c3, s3):
+    """:func:`rot_zyx` from the cosines and sines of (phi, theta, psi)."""
     return (
         (c3 * c2, c3 * s2 * s1 - s3 * c1, c3 * s2 * c1 + s3 * s1),
         (s3 * c2, s3 * s2 * s1 + c3 * c1, s3 * s2 * c1 - c3 * s1),
@@ -136,8 +142,12 @@ def rot_zyx(phi, theta, psi):
 @njit(cache=True, error_model="numpy")
 def euler_rate_matrix(phi, theta):
     """S(Theta) of eq. 2.28: body rate = S @ ZYX Euler-angle rates."""
-    c1, s1 = cos(phi), sin(phi)
-    c2, s2 = cos(theta), sin(theta)
+    return euler_rate_matrix_cs(cos(phi), sin(phi), cos(theta), sin(theta))
+
+
+@njit(cache=True, error_model="numpy")
+def euler_rate_matrix_cs(c1, s1, c2, s2):
+    """:func:`euler_rate_matrix` from the cosines and sines of (phi, theta)."""
     return ((1.0, 0.0, -s2), (0.0, c1, c2 * s1), (0.0, -s1, c2 * c1))
 
 
@@ -153,8 +163,12 @@ def euler_rate_matrix_inv(phi, theta):
 @njit(cache=True, error_model="numpy")
 def euler_rate_bias(phi, theta, dphi, dtheta, dpsi):
     """dS/dt @ Theta_dot: the part of the body angular acceleration not from Theta_ddot."""
-    c1, s1 = cos(phi), sin(phi)
-    c2, s2 = cos(theta), sin(theta)
+    return euler_rate_bias_cs(cos(phi), sin(phi), cos(theta), sin(theta), dphi, dtheta, dpsi)
+
+
+@njit(cache=True, error_model="numpy")
+def euler_rate_bias_cs(c1, s1, c2, s2, dphi, dtheta, dpsi):
+    """:func:`euler_rate_bias` from the cosines and sines of (phi, theta)."""
     return (
         -c2 * dtheta * dpsi,
         -s1 * dphi * dtheta + (c2 * c1 * dphi - s2 * s1 * dtheta) * dpsi,
