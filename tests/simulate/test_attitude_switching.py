@@ -96,11 +96,15 @@ def test_through_the_pole_equals_the_same_motion_away_from_it(
 
 # -- conservation: 120 s of tumbling through +-90 deg -----------------------------------
 
+# A pitch tumble over both poles. The hub's x axis passes over a pole when
+# it is normal to the angular momentum H and H is horizontal: the roll rate -0.18 deg/s
+# cancels the body-x component of H that the panels' deflections and rates carry
+# (H_B = (0, 4.623, 0.058) N m s), and the roll -0.72 deg turns H_B onto N's y axis.
 _FREE_TUMBLE = {
     "duration_s": 120.0, "dt_s": 1e-4, "record_dt_s": 0.01, "torque": [],
     "initial": {
-        "attitude_deg": [0.0, -5.0, 30.0],
-        "rate_deg_s": [0.05, 6.0, 0.03],
+        "attitude_deg": [-0.72, 0.0, 0.0],
+        "rate_deg_s": [-0.18, 6.0, 0.03],
         "appendages": [
             {"name": "panel_1", "rho_deg": [0.5, -0.3, 0.8]},
             {"name": "panel_2", "rho_deg": [-0.2, 0.4, 0.1], "rho_rate_deg_s": [0.5, 0, 0]},
@@ -111,14 +115,18 @@ _FREE_TUMBLE = {
 
 def test_conservation_through_the_pole(nominal_plant):
     # zeta = 0, no torque: total momentum within 1e-10 and energy within 1e-8 of their
-    # initial values. Measured 1e-13 and 6e-9 at dt = 1e-4 s: the momentum is a linear
-    # invariant (round-off only); the energy drift is the RK4 truncation of the
+    # initial values. Measured 1.1e-13 and 6.6e-9 at dt = 1e-4 s: the momentum is a
+    # linear invariant (round-off only); the energy drift is the RK4 truncation of the
     # ~100 Hz joint modes, (omega dt)^6 / 144 per step, as without a pole.
     undamped = nominal_plant.with_joints(nominal_plant.stiffness, np.zeros((2, 6)))
     ds = run_openloop(undamped, OpenLoopScenario.model_validate(_FREE_TUMBLE)).dataset
-    # The panels' deformation tilts the momentum 3 deg off the pitch axis: the hub
-    # passes within 3 deg of the pole (re-based at each 60 deg), twice a turn.
-    assert np.abs(ds["euler_deg"].values[:, 1]).max() > 85.0
+    # Over +90 deg and -90 deg: measured within 0.18 deg of +90 at 15 s and 0.26 deg of
+    # -90 at 45 s (a record every 0.06 deg of pitch; the later passes miss by more, as
+    # the panels' nutation moves H_B), roll and yaw turning by 180 deg across each;
+    # re-based at each 60 deg of pitch.
+    pitch = ds["euler_deg"].values[:, 1]
+    assert pitch.max() > 89.5
+    assert pitch.min() < -89.5
     energy = ds["total_energy"].values
     H = ds["angular_momentum"].values
     assert np.abs(energy - energy[0]).max() / energy[0] <= 1e-8
@@ -126,7 +134,7 @@ def test_conservation_through_the_pole(nominal_plant):
 
 
 def test_the_damped_energy_balance_closes_through_the_pole(nominal_plant):
-    # With the thesis's damping the dissipated energy (0.05 J of 0.31 J here) is
+    # With the thesis's damping the dissipated energy (0.05 J of 0.30 J here) is
     # integrated with the motion; the balance closes to 7e-13 J measured, round-off
     # of the 0.3 J summed over 1.2 million steps; bound 1e-11 J.
     ds = run_openloop(nominal_plant, OpenLoopScenario.model_validate(_FREE_TUMBLE)).dataset

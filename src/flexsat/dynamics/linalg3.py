@@ -24,7 +24,9 @@ __all__ = [
     "cross",
     "dot",
     "euler_rate_bias",
+    "euler_rate_bias_cs",
     "euler_rate_matrix",
+    "euler_rate_matrix_cs",
     "euler_rate_matrix_inv",
     "load_m33",
     "load_m33_at",
@@ -35,6 +37,7 @@ __all__ = [
     "mtv",
     "mv",
     "rot_zyx",
+    "rot_zyx_cs",
     "scale",
     "scale_m",
     "skew",
@@ -267,9 +270,23 @@ def rot_zyx(phi, theta, psi):
     tuple of 3 rows of 3 float
         The rotation matrix [-].
     """
-    c1, s1 = cos(phi), sin(phi)
-    c2, s2 = cos(theta), sin(theta)
-    c3, s3 = cos(psi), sin(psi)
+    return rot_zyx_cs(cos(phi), sin(phi), cos(theta), sin(theta), cos(psi), sin(psi))
+
+
+@njit(cache=True, error_model="numpy")
+def rot_zyx_cs(c1, s1, c2, s2, c3, s3):
+    """:func:`rot_zyx` from the cosines and sines of (phi, theta, psi).
+
+    Parameters
+    ----------
+    c1, s1, c2, s2, c3, s3 : float
+        Cosines and sines of roll, pitch and yaw [-].
+
+    Returns
+    -------
+    tuple of 3 rows of 3 float
+        The rotation matrix [-].
+    """
     return (
         (c3 * c2, c3 * s2 * s1 - s3 * c1, c3 * s2 * c1 + s3 * s1),
         (s3 * c2, s3 * s2 * s1 + c3 * c1, s3 * s2 * c1 - c3 * s1),
@@ -291,8 +308,23 @@ def euler_rate_matrix(phi, theta):
     tuple of 3 rows of 3 float
         S [-].
     """
-    c1, s1 = cos(phi), sin(phi)
-    c2, s2 = cos(theta), sin(theta)
+    return euler_rate_matrix_cs(cos(phi), sin(phi), cos(theta), sin(theta))
+
+
+@njit(cache=True, error_model="numpy")
+def euler_rate_matrix_cs(c1, s1, c2, s2):
+    """:func:`euler_rate_matrix` from the cosines and sines of (phi, theta).
+
+    Parameters
+    ----------
+    c1, s1, c2, s2 : float
+        Cosines and sines of roll and pitch [-].
+
+    Returns
+    -------
+    tuple of 3 rows of 3 float
+        S [-].
+    """
     return ((1.0, 0.0, -s2), (0.0, c1, c2 * s1), (0.0, -s1, c2 * c1))
 
 
@@ -332,8 +364,25 @@ def euler_rate_bias(phi, theta, dphi, dtheta, dpsi):
     tuple of 3 float
         dS/dt @ Theta_dot, body frame B [rad/s^2].
     """
-    c1, s1 = cos(phi), sin(phi)
-    c2, s2 = cos(theta), sin(theta)
+    return euler_rate_bias_cs(cos(phi), sin(phi), cos(theta), sin(theta), dphi, dtheta, dpsi)
+
+
+@njit(cache=True, error_model="numpy")
+def euler_rate_bias_cs(c1, s1, c2, s2, dphi, dtheta, dpsi):
+    """:func:`euler_rate_bias` from the cosines and sines of (phi, theta).
+
+    Parameters
+    ----------
+    c1, s1, c2, s2 : float
+        Cosines and sines of roll and pitch [-].
+    dphi, dtheta, dpsi : float
+        ZYX Euler-angle rates [rad/s].
+
+    Returns
+    -------
+    tuple of 3 float
+        dS/dt @ Theta_dot, body frame B [rad/s^2].
+    """
     return (
         -c2 * dtheta * dpsi,
         -s1 * dphi * dtheta + (c2 * c1 * dphi - s2 * s1 * dtheta) * dpsi,

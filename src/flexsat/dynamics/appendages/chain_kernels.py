@@ -26,7 +26,7 @@ and recursive Newton-Euler algorithms and allocate one scratch row per chain.
 
 from __future__ import annotations
 
-from math import cos
+from math import cos, sin
 
 import numpy as np
 from numba import njit
@@ -57,14 +57,16 @@ from flexsat.dynamics.linalg3 import (
     add,
     cross,
     dot,
-    euler_rate_bias,
+    euler_rate_bias_cs,
     euler_rate_matrix,
+    euler_rate_matrix_cs,
     load_m33_at,
     load_seg,
     mm,
     mtv,
     mv,
     rot_zyx,
+    rot_zyx_cs,
     scale,
     skew,
     sub,
@@ -185,15 +187,6 @@ def _mul6(a, k, ua, ul):
 
 
 @njit(cache=True, error_model="numpy")
-def _unit(j):
-    """The j-th unit motion vector (j in 0..5) as (angular, linear)."""
-    e = (1.0 if j % 3 == 0 else 0.0, 1.0 if j % 3 == 1 else 0.0, 1.0 if j % 3 == 2 else 0.0)
-    if j < 3:
-        return e, _ZERO
-    return _ZERO, e
-
-
-@njit(cache=True, error_model="numpy")
 def _put3(x, k, v):
     x[k], x[k + 1], x[k + 2] = v
 
@@ -206,13 +199,19 @@ def _put_m33(x, k, m):
 
 @njit(cache=True, error_model="numpy")
 def _store_inertia(w, k, m, c, J):
-    """w[k:k+36] = the spatial inertia at the origin, row-major."""
-    for j in range(6):
-        ua, ul = _unit(j)
-        n, f = _inertia_mul(m, c, J, ua, ul)
-        for r in range(3):
-            w[k + 6 * r + j] = n[r]
-            w[k + 6 * (r + 3) + j] = f[r]
+    """w[k:k+36] = the spatial inertia at the origin, row-major, in closed form:
+    [[J + m (|c|^2 1 - c c^T), m [c]x], [-m [c]x, m 1]] (the matrix of _inertia_mul)."""
+    c2 = dot(c, c)
+    mc = scale(m, c)
+    mcx = skew(mc)
+    for r in range(3):
+        for e in range(3):
+            w[k + 6 * r + e] = J[r][e] - mc[r] * c[e]
+            w[k + 6 * r + 3 + e] = mcx[r][e]
+            w[k + 6 * (r + 3) + e] = -mcx[r][e]
+            w[k + 6 * (r + 3) + 3 + e] = 0.0
+        w[k + 7 * r] += m * c2
+        w[k + 7 * (r + 3)] = m
 
 
 @njit(cache=True, error_model="numpy")
@@ -232,10 +231,10 @@ def _msum(a, b, sign):
 
 @njit(cache=True, error_model="numpy")
 def _add_block(dst, d, r0, c0, m, swap):
+    top = d + 6 * ((r0 + swap) % 6) + (c0 + swap) % 6
     for r in range(3):
-        row = d + 6 * ((r0 + r + swap) % 6)
         for c in range(3):
-            dst[row + (c0 + c + swap) % 6] += m[r][c]
+            dst[top + 6 * r + c] += m[r][c]
 
 
 @njit(cache=True, error_model="numpy")
@@ -244,20 +243,30 @@ def _add_congruence(src, s, R, pos, dst, d, swap):
 
     X = diag(R^T, R^T) T with T = [[1, 0], [-[pos]x, 1]]: with the blocks of src
     rotated to the parent's axes, [[A, B], [C, D]], the result is
-    [[A + [p]C - (B + [p]D)[p], B + [p]D], [C - D[p], D]] ([p] = [pos]x).
+    [[A + [p]C - (B + [p]D)[p], B + [p]D], [C - D[p], D]] ([p] = [pos]x). src is a
+    spatial inertia, symmetric: C = B^T, D = D^T, so the lower-left block is the
+    transposed upper-right one and C is never rotated.
     ``swap`` = 3 writes it in the hub exchange order [force; torque] x [a; omega_dot].
     """
     Rt = transpose(R)
     A = mm(R, mm(_block(src, s, 0, 0), Rt))
     B = mm(R, mm(_block(src, s, 0, 3), Rt))
-    C = mm(R, mm(_block(src, s, 3, 0), Rt))
     D = mm(R, mm(_block(src, s, 3, 3), Rt))
     P = skew(pos)
     upper_right = _msum(B, mm(P, D), 1.0)
-    _add_block(dst, d, 0, 0, _msum(_msum(A, mm(P, C), 1.0), mm(upper_right, P), -1.0), swap)
+    upper_left = _msum(_msum(A, mm(P, transpose(B)), 1.0), mm(upper_right, P), -1.0)
+    _add_block(dst, d, 0, 0, upper_left, swap)
     _add_block(dst, d, 0, 3, upper_right, swap)
-    _add_block(dst, d, 3, 0, _msum(C, mm(D, P), -1.0), swap)
+    _add_block(dst, d, 3, 0, transpose(upper_right), swap)
     _add_block(dst, d, 3, 3, D, swap)
+
+
+@njit(cache=True, error_model="numpy")
+def _cos_sin(angle, free):
+    """(cos, sin) of a joint angle; (1, 0), without evaluating either, where it is locked."""
+    if free != 0.0:
+        return cos(angle), sin(angle)
+    return 1.0, 0.0
 
 
 @njit(cache=True, error_model="numpy")
@@ -287,23 +296,26 @@ def _joint_pose(q, qd, o, p, g, first):
                 ry, dry = v, dv
             else:
                 rz, drz = v, dv
+    free_x, free_z = p[g + G_FREE + 3], p[g + G_FREE + 5]
+    c1, s1 = _cos_sin(rx, free_x)
+    c2, s2 = _cos_sin(ry, p[g + G_FREE + 4])
+    c3, s3 = _cos_sin(rz, free_z)
     status = STATUS_OK
-    if p[g + G_FREE + 3] != 0.0 and p[g + G_FREE + 5] != 0.0 and abs(cos(ry)) < MIN_COS:
+    if free_x != 0.0 and free_z != 0.0 and abs(c2) < MIN_COS:
         status = STATUS_JOINT_GIMBAL_LOCK
-    R_JP = rot_zyx(rx, ry, rz)
-    S_rho = euler_rate_matrix(rx, ry)
+    R_JP = rot_zyx_cs(c1, s1, c2, s2, c3, s3)
+    S_rho = euler_rate_matrix_cs(c1, s1, c2, s2)
     t = (x, y, z)
-    if first:
+    if first:  # J_0 is the mount frame M
         R_PJ = load_m33_at(p, H_R_BM)
-        origin = load_seg(p, H_MOUNT)
-    else:
-        R_PJ = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
-        origin = load_seg(p, g - SEG + G_NEXT)
-    pos = add(origin, mv(R_PJ, t))
-    R = mm(R_PJ, R_JP)
+        pos = add(load_seg(p, H_MOUNT), mv(R_PJ, t))
+        R = mm(R_PJ, R_JP)
+    else:  # J_k is parallel to the parent's frame
+        pos = add(load_seg(p, g - SEG + G_NEXT), t)
+        R = R_JP
     omega_rel = mv(S_rho, (drx, dry, drz))
     v_lin = mtv(R_JP, (dx, dy, dz))
-    c_ang = euler_rate_bias(rx, ry, drx, dry, drz)
+    c_ang = euler_rate_bias_cs(c1, s1, c2, s2, drx, dry, drz)
     c_lin = scale(-1.0, cross(omega_rel, v_lin))
     return R, pos, R_JP, S_rho, omega_rel, v_lin, c_ang, c_lin, status
 
