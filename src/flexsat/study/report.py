@@ -530,8 +530,7 @@ def _avionics(root: Path, outputs: dict, context: dict) -> str:
         _table(["delay [s]", "R1", "R2", "APE [deg]", "max rate error [deg/s]", "unstable"],
                sweep, "Sweep over the computational delay"),
         _table(["metric", "arrays held", "arrays turning"], sadm,
-               "Ideal loop, plates on a solar-array drive (docs/control.md, "
-               "'Solar-array drive (SADM)')"),
+               "Ideal loop, plates on a solar-array drive: held and turning"),
         f"<p>{_esc(sentence)}</p>",
         _figures(root, outputs["figures"]),
     ])  # fmt: skip
