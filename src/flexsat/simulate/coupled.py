@@ -87,8 +87,8 @@ def chain_wrench(x, n, t, derivatives, params, flow):
 
 
 @njit(cache=True, inline="always")
-def _rates(x, n, t, derivatives, params, flow, Q, k, kc, packed):
-    status = chain_wrench(x, n, t, derivatives, params, flow)
+def _rates(x, n, t, derivatives, params, flow, Q, k, kc, packed, evaluate=True):
+    status = chain_wrench(x, n, t, derivatives, params, flow) if evaluate else 0
     h, w = flow.held, flow.wrench
     torque = (h[0] + w[0], h[1] + w[1], h[2] + w[2])
     status |= augmented_derivative(x, torque, n, Q, k, packed)
@@ -97,7 +97,7 @@ def _rates(x, n, t, derivatives, params, flow, Q, k, kc, packed):
 
 
 @njit(cache=True)
-def rk4_coupled_step(x, t, dt, n, Q, scratch, derivatives, params, flow, packed):
+def rk4_coupled_step(x, t, dt, n, Q, scratch, derivatives, params, flow, packed, fresh):
     """One RK4 step of the plant state ``x`` and the chain state ``flow.state``, in place.
 
     The held torque is ``flow.held``. On a non-zero status both states are left
@@ -126,6 +126,11 @@ def rk4_coupled_step(x, t, dt, n, Q, scratch, derivatives, params, flow, packed)
         The chain's state and work arrays.
     packed : PackedPlant
         ``Plant.packed``.
+    fresh : bool
+        ``flow.dot`` and ``flow.wrench`` already hold the derivatives at
+        (x, ``flow.state``, t) (the control instant's
+        :func:`~flexsat.simulate.loops.run_actuators` left them), so the first RK4
+        stage reuses them instead of evaluating them again (the same numbers).
 
     Returns
     -------
@@ -136,7 +141,7 @@ def rk4_coupled_step(x, t, dt, n, Q, scratch, derivatives, params, flow, packed)
     c, ce, kc = flow.state, flow.eval, flow.k
     k1, k2, k3, k4, stage = scratch[0], scratch[1], scratch[2], scratch[3], scratch[4]
     ce[:] = c
-    status = _rates(x, n, t, derivatives, params, flow, Q, k1, kc[0], packed)
+    status = _rates(x, n, t, derivatives, params, flow, Q, k1, kc[0], packed, not fresh)
     for j in range(size):
         stage[j] = x[j] + 0.5 * dt * k1[j]
     for j in range(m):
@@ -202,7 +207,7 @@ def rk4_coupled_hold(x, t0, dt, n_steps, derivatives, params, flow, packed):
     Q = np.empty(n)
     for k in range(n_steps):
         status = rk4_coupled_step(x, t0 + k * dt, dt, n, Q, scratch, derivatives, params, flow,
-                                  packed)  # fmt: skip
+                                  packed, False)  # fmt: skip
         if status != STATUS_OK:
             return status, k
     return STATUS_OK, n_steps

@@ -349,8 +349,9 @@ def rk4_closed_loop(x, clock, stages, d, records, plant, frame):
         if k == clock.n_steps:
             break
         if clock.continuous:
+            fresh = k % clock.control_every == 0  # run_actuators evaluated them at (x, t)
             status = rk4_coupled_step(x, t, clock.dt, n, d.Q, scratch, stages.derivative,
-                                      d.actuator_params, d.flow, plant)  # fmt: skip
+                                      d.actuator_params, d.flow, plant, fresh)  # fmt: skip
         else:
             torque = (d.tau_applied[0], d.tau_applied[1], d.tau_applied[2])
             status = rk4_step(x, clock.dt, torque, n, d.Q, scratch, plant)

@@ -521,7 +521,7 @@ def _avionics(root: Path, outputs: dict, context: dict) -> str:
     def cell(relative, *path):
         return _Source(root, relative).cell(*path)
 
-    side, sweep, sentence = render_avionics(root, outputs, cell)
+    side, sweep, sadm, sentence = render_avionics(root, outputs, cell)
     return "".join([
         "<p>The thesis's slew with a gyro, a star tracker, the MEKF and four reaction "
         "wheels beside the ideal loop, then the ideal loop with a computational delay "
@@ -529,6 +529,8 @@ def _avionics(root: Path, outputs: dict, context: dict) -> str:
         _table(["metric", "ideal", "avionics"], side, "Ideal loop and realistic avionics"),
         _table(["delay [s]", "R1", "R2", "APE [deg]", "max rate error [deg/s]", "unstable"],
                sweep, "Sweep over the computational delay"),
+        _table(["metric", "arrays held", "arrays turning"], sadm,
+               "Ideal loop, plates on a solar-array drive: held and turning"),
         f"<p>{_esc(sentence)}</p>",
         _figures(root, outputs["figures"]),
     ])  # fmt: skip

@@ -2,9 +2,10 @@
 
 Built in: the thesis's ideal sensor and static actuator; the reference generators
 (the thesis's ``step`` and the shaped ``eigenaxis`` slew) and the joint actuators
-(``none``, the thesis's hub-only control, and ``rate_feedback``, hybrid active
-damping). Write your own stage in your own file (see ``docs/control.md``): a
-parameter model, a compiled step of its role's signature and one registration line.
+(``none``, the thesis's hub-only control, ``rate_feedback``, hybrid active
+damping, and ``sadm_drive``, the solar-array drive). Write your own stage in your
+own file (see ``docs/control.md``): a parameter model, a compiled step of its role's
+signature and one registration line.
 """
 
 from flexsat.control.stages.delay import DELAY
@@ -34,6 +35,7 @@ from flexsat.control.stages.registry import (
     register_stage,
     validate_stage,
 )
+from flexsat.control.stages.sadm_drive import SADM_DRIVE
 from flexsat.control.stages.star_tracker import STAR_TRACKER
 from flexsat.control.stages.static_actuator import STATIC_ACTUATOR
 from flexsat.control.stages.step_reference import STEP_REFERENCE
@@ -68,6 +70,7 @@ register_stage(STEP_REFERENCE, default=True)
 register_stage(EIGENAXIS_REFERENCE)
 register_stage(NO_JOINT_ACTUATOR, default=True)
 register_stage(JOINT_RATE_FEEDBACK)
+register_stage(SADM_DRIVE)
 register_stage(WHEELS)
 register_stage(DELAY)
 register_stage(NOTCH)

@@ -57,7 +57,11 @@ _N, _IS, _UMAX, _WMAX, _CV, _CC, _WC, _TAU, _KNULL, _WBIAS, _W0 = range(11)
 _A = 11  # A, row-major (3, MAX_WHEELS)
 _PINV = _A + 3 * MAX_WHEELS  # A^+, row-major (MAX_WHEELS, 3)
 _NULL = _PINV + 3 * MAX_WHEELS  # I - A^+ A, row-major (MAX_WHEELS, MAX_WHEELS)
-_SIZE = _NULL + MAX_WHEELS * MAX_WHEELS
+# derived constants the derivative reads (multiplications instead of divisions):
+# 1 / I_s, 1 / tau_m, 1 / omega_c, the momentum limit I_s Omega_max, I_s Omega_0
+_INV_IS = _NULL + MAX_WHEELS * MAX_WHEELS
+_INV_TAU, _INV_WC, _HMAX, _H0 = _INV_IS + 1, _INV_IS + 2, _INV_IS + 3, _INV_IS + 4
+_SIZE = _INV_IS + 5
 # state: h (N), motor torque u (N), command u_cmd (N), motor work, friction loss
 _H, _U, _UCMD = 0, MAX_WHEELS, 2 * MAX_WHEELS
 _WM, _WF = 3 * MAX_WHEELS, 3 * MAX_WHEELS + 1
@@ -156,7 +160,10 @@ class WheelsConfig(ActuatorStageConfig):
                 self.viscous_nm_s_rad, self.coulomb_nm, self.coulomb_smoothing_rad_s,
                 self.motor_time_constant_s, self.null_space_gain_1_s,
                 self.bias_speed_rpm * _RPM, self.initial_speed_rpm * _RPM]  # fmt: skip
-        return np.concatenate([head, A.ravel(), pinv.ravel(), null.ravel()])
+        derived = [1.0 / self.spin_inertia_kg_m2, 1.0 / self.motor_time_constant_s,
+                   1.0 / self.coulomb_smoothing_rad_s, self.spin_inertia_kg_m2 * head[3],
+                   self.spin_inertia_kg_m2 * head[10]]  # fmt: skip
+        return np.concatenate([head, A.ravel(), pinv.ravel(), null.ravel(), derived])
 
 
 @njit(cache=True, inline="always")
@@ -165,24 +172,29 @@ def _momentum(p, s, i):
     return p[_IS] * p[_W0] + s[_H + i]
 
 
-@njit(DERIVATIVE_SIGNATURE, cache=True)
+@njit(DERIVATIVE_SIGNATURE, cache=True, error_model="numpy")
 def wheels_derivative(x, n_dof, t, params, state, state_dot, wrench):
-    """h_dot, u_dot, motor power, friction power; the wheels' wrench on the hub."""
+    """h_dot, u_dot, motor power, friction power; the wheels' wrench on the hub.
+
+    Evaluated at every RK4 stage: it multiplies by the packed reciprocals instead of
+    dividing, and with ``error_model="numpy"`` carries no zero-division checks (the
+    divisors are validated positive).
+    """
     p, s = params, state
     n = int(p[_N])
     w = true_body_rate(x, n_dof)
     hx, hy, hz = 0.0, 0.0, 0.0
     for i in range(n):
         ax, ay, az = p[_A + i], p[_A + MAX_WHEELS + i], p[_A + 2 * MAX_WHEELS + i]
-        h = _momentum(p, s, i)
-        speed = h / p[_IS] - (ax * w[0] + ay * w[1] + az * w[2])  # Omega_i
+        h = p[_H0] + s[_H + i]  # the state holds the change from I_s Omega_0
+        speed = h * p[_INV_IS] - (ax * w[0] + ay * w[1] + az * w[2])  # Omega_i
         u = s[_U + i]
-        if abs(h) >= p[_IS] * p[_WMAX] and u * h > 0.0:
+        if abs(h) >= p[_HMAX] and u * h > 0.0:
             u = 0.0  # the drive cuts the torque that would pass the momentum limit
-        friction = p[_CV] * speed + p[_CC] * tanh(speed / p[_WC])
+        friction = p[_CV] * speed + p[_CC] * tanh(speed * p[_INV_WC])
         h_dot = u - friction
         state_dot[_H + i] = h_dot
-        state_dot[_U + i] = (s[_UCMD + i] - s[_U + i]) / p[_TAU]
+        state_dot[_U + i] = (s[_UCMD + i] - s[_U + i]) * p[_INV_TAU]
         state_dot[_WM] += u * speed
         state_dot[_WF] += friction * speed
         wrench[0] -= ax * h_dot
