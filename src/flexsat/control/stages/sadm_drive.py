@@ -47,7 +47,7 @@ _Rate = Annotated[float, Field(ge=-360.0, le=360.0, allow_inf_nan=False)]
 class SADMDriveConfig(JointActuatorConfig):
     """Drive motors on mount coordinates following a commanded profile (module docstring)."""
 
-    kind: Literal["sadm_drive"] = "sadm_drive"
+    kind: Literal["sadm_drive"] = Field("sadm_drive", description="the stage's registered name")
     coordinates: list[str] = Field(
         min_length=1,
         description="driven coordinates: '<appendage>.<coordinate>', or '<coordinate>' for "

@@ -95,6 +95,22 @@ def with_sadm(config: SatelliteConfig, rotor_inertia_kg_m2: float, rotor_mass_kg
 
     The joints keep the stiffness and damping the plant tunes them to (eqs. 2.14-2.15),
     so the driven satellite is the same satellite with one more coordinate per plate.
+
+    Parameters
+    ----------
+    config : SatelliteConfig
+        The satellite.
+    rotor_inertia_kg_m2 : float
+        Each drive rotor's inertia about the SADM axis [kg m^2].
+    rotor_mass_kg : float
+        Each drive rotor's mass [kg].
+    names : tuple of str, optional
+        The plates to put on a drive [-]; default every plate.
+
+    Returns
+    -------
+    SatelliteConfig
+        The driven satellite: each chosen plate a two-segment chain [-].
     """
     from flexsat.dynamics.plant import Plant
 
