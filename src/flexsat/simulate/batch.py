@@ -106,7 +106,7 @@ def fly_batch(items, out):
     """Fly every slew of ``items`` (a typed List of :class:`BatchItem`) to its end,
     across the numba threads; ``out[i]`` = (status, steps done, rows written), int64."""
     for i in prange(len(items)):
-        it = items[i]
+        it = items[np.int64(i)]  # the prange index is unsigned; the List takes int64
         status, done, rows = fly(it.x, it.timing, it.stages, it.data, it.rec_t, it.rec_x,
                                  it.rec_ctrl, it.rec_frame, it.plant, it.frame, 0, 0,
                                  it.timing.n_steps + 1)  # fmt: skip
