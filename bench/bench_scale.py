@@ -62,6 +62,10 @@ def main(argv: list[str] | None = None) -> dict:
     with tempfile.TemporaryDirectory(prefix="flexsat-bench-scale-") as tmp:
         for model in models:
             campaign = definition(args.duration, model == "reduced")
+            for runner in ("pool", "ensemble"):  # warm up: compiled code loaded in this process
+                run_campaign(definition(1.0, model == "reduced"), nominal(),
+                             Path(tmp) / f"warm-{model}-{runner}", workers=1, n_random=1,
+                             progress=False, runner=runner)  # fmt: skip
             for backend in backends:
                 for workers in (1, 2):
                     store = Path(tmp) / f"{model}-{backend}-{workers}"
