@@ -58,7 +58,17 @@ class BatchItem(NamedTuple):
 
 
 def slew_timing(run) -> SlewTiming:
-    """The :class:`SlewTiming` of a :class:`~flexsat.simulate.closedloop.PreparedSlew`."""
+    """The :class:`SlewTiming` of a prepared slew.
+
+    Parameters
+    ----------
+    run : PreparedSlew
+        The slew (:func:`flexsat.simulate.closedloop.prepare_slew`).
+
+    Returns
+    -------
+    SlewTiming
+    """
     s = run.scenario
     return SlewTiming(s.dt_s, s.n_steps, s.control_every, s.record_every,
                       chunk_steps(s.record_every, s.control_every),
@@ -66,7 +76,17 @@ def slew_timing(run) -> SlewTiming:
 
 
 def batch_item(run) -> BatchItem:
-    """The :class:`BatchItem` of a :class:`~flexsat.simulate.closedloop.PreparedSlew`."""
+    """The :class:`BatchItem` of a prepared slew (its arrays, not copies).
+
+    Parameters
+    ----------
+    run : PreparedSlew
+        The slew (:func:`flexsat.simulate.closedloop.prepare_slew`).
+
+    Returns
+    -------
+    BatchItem
+    """
     return BatchItem(run.x, slew_timing(run), run.stages, run.data, run.rec_t, run.rec_x,
                      run.rec_ctrl, run.rec_frame, run.plant.packed, run.frame)  # fmt: skip
 
@@ -76,8 +96,36 @@ def fly(x, timing, stages, d, rec_t, rec_x, rec_ctrl, rec_frame, plant, frame, d
         max_chunks):  # fmt: skip
     """Advance a slew by up to ``max_chunks`` compiled chunks from step ``done``.
 
-    ``x`` and ``frame`` are advanced in place, records written from row ``rows``.
     Stops after the run's last step or at the first non-zero status.
+
+    Parameters
+    ----------
+    x : ndarray, shape (x_size,)
+        Plant state (q, q̇, work in, dissipated; SI), advanced in place.
+    timing : SlewTiming
+        The slew's clock.
+    stages : LoopStages
+        The compiled law and stages (:mod:`flexsat.simulate.loops`).
+    d : LoopData
+        The loop's arrays.
+    rec_t : ndarray, shape (m,)
+        Record times [s], written from row ``rows``.
+    rec_x : ndarray, shape (m, x_size)
+        Recorded plant states (SI).
+    rec_ctrl : ndarray, shape (m, record_size)
+        Recorded control rows (SI).
+    rec_frame : ndarray, shape (m, 9)
+        Recorded attitude references R_NF [-].
+    plant : PackedPlant
+        The plant's named structure (``Plant.packed``).
+    frame : ndarray, shape (9,)
+        Attitude reference R_NF of ``x`` [-], updated in place.
+    done : int
+        Steps already taken.
+    rows : int
+        Record rows already written.
+    max_chunks : int
+        At most this many chunks in this call.
 
     Returns
     -------
@@ -103,8 +151,15 @@ def fly(x, timing, stages, d, rec_t, rec_x, rec_ctrl, rec_frame, plant, frame, d
 
 @njit(cache=True, nogil=True, parallel=True)
 def fly_batch(items, out):
-    """Fly every slew of ``items`` (a typed List of :class:`BatchItem`) to its end,
-    across the numba threads; ``out[i]`` = (status, steps done, rows written), int64."""
+    """Fly every slew of a batch to its end, across the numba threads.
+
+    Parameters
+    ----------
+    items : numba.typed.List of BatchItem
+        Slews of one numba type, each flown on its own arrays.
+    out : ndarray, shape (len(items), 3), int64
+        Written: per slew, status, steps done, record rows written.
+    """
     for i in prange(len(items)):
         it = items[np.int64(i)]  # the prange index is unsigned; the List takes int64
         status, done, rows = fly(it.x, it.timing, it.stages, it.data, it.rec_t, it.rec_x,
