@@ -5,10 +5,14 @@ Goal (campaigns at scale): 1000 random Monte Carlo cases of the 120 s thesis sle
 <= 30 s on 2 cores with the reduced model (root translations locked, 10 ms step and
 control period), the full model (1 ms) beside it; >= 90 % parallel efficiency from 1
 to 2 workers, local and Dask. Each configuration runs the same cases into a fresh
-temporary store; the wall time includes starting the workers.
+temporary store; the wall time includes starting the workers. Backends: ``local``
+(the process pool; 1 worker runs in this process), ``ensemble`` (batches in one
+compiled call, 1 or 2 numba threads, in this process) and ``dask`` (LocalCluster,
+each task an ensemble). The CPU time per case is that of this process (threads
+included): given for the runs that stay in it.
 
 ``--cases N`` (default 999 random + the nominal), ``--duration S`` (default 120),
-``--only full|reduced``, ``--backends local,dask``. Run with
+``--only full|reduced``, ``--backends local,ensemble,dask``. Run with
 ``python bench/bench_scale.py`` (or ``make bench``); on a shared machine the numbers
 are pessimistic.
 """
@@ -18,6 +22,7 @@ from __future__ import annotations
 import argparse
 import os
 import tempfile
+import time
 from pathlib import Path
 
 from rich.console import Console
@@ -44,7 +49,7 @@ def main(argv: list[str] | None = None) -> dict:
     parser.add_argument("--cases", type=int, default=999, help="random cases (+ the nominal)")
     parser.add_argument("--duration", type=float, default=120.0, help="slew length [s]")
     parser.add_argument("--only", choices=("full", "reduced"), default=None)
-    parser.add_argument("--backends", default="local,dask")
+    parser.add_argument("--backends", default="local,ensemble,dask")
     args = parser.parse_args(argv)
     console = Console(width=150)
     models = [args.only] if args.only else ["reduced", "full"]
@@ -53,23 +58,34 @@ def main(argv: list[str] | None = None) -> dict:
     console.print(f"{n} cases of {args.duration:g} s, {os.cpu_count()} cores, load "
                   f"{', '.join(f'{x:.2f}' for x in os.getloadavg())}")  # fmt: skip
     walls: dict[tuple[str, str, int], float] = {}
+    cpus: dict[tuple[str, str, int], float] = {}  # CPU s per case, runs in this process
     with tempfile.TemporaryDirectory(prefix="flexsat-bench-scale-") as tmp:
         for model in models:
             campaign = definition(args.duration, model == "reduced")
+            for runner in ("pool", "ensemble"):  # warm up: compiled code loaded in this process
+                run_campaign(definition(1.0, model == "reduced"), nominal(),
+                             Path(tmp) / f"warm-{model}-{runner}", workers=1, n_random=1,
+                             progress=False, runner=runner)  # fmt: skip
             for backend in backends:
                 for workers in (1, 2):
                     store = Path(tmp) / f"{model}-{backend}-{workers}"
-                    options = ({"workers": workers} if backend == "local"
-                               else {"dask_local": workers})  # fmt: skip
+                    options = {"local": {"workers": workers},
+                               "ensemble": {"workers": workers, "runner": "ensemble"},
+                               "dask": {"dask_local": workers}}[backend]  # fmt: skip
+                    cpu = time.process_time()
                     run = run_campaign(campaign, nominal(), store, n_random=args.cases,
                                        progress=False, **options)  # fmt: skip
                     walls[model, backend, workers] = run["wall_time_s"]
-                    console.print(f"  {model:7s} {backend:5s} x{workers}: "
+                    here = backend == "ensemble" or (backend == "local" and workers == 1)
+                    if here:
+                        cpus[model, backend, workers] = (time.process_time() - cpu) / n
+                    console.print(f"  {model:7s} {backend:8s} x{workers}: "
                                   f"{run['wall_time_s']:.1f} s ({n / run['wall_time_s']:.2f} "
-                                  "cases/s)")  # fmt: skip
+                                  "cases/s)" + (f", {cpus[model, backend, workers]:.3f} CPU s "
+                                                "per case" if here else ""))  # fmt: skip
     table = Table(title=f"{n} random Monte Carlo cases ({args.duration:g} s slews)")
     for column in ("model", "backend", "x1 (s)", "x2 (s)", "cases/s x2", "efficiency",
-                   "1000 cases x2 (s)", "<= 30 s", ">= 90 %"):  # fmt: skip
+                   "1000 cases x2 (s)", "CPU s/case x1", "<= 30 s", ">= 90 %"):  # fmt: skip
         table.add_column(column, justify="left" if column in ("model", "backend") else "right")
     results = {}
     for model in models:
@@ -79,12 +95,16 @@ def main(argv: list[str] | None = None) -> dict:
             efficiency = one / two / 2
             speed = ("met" if per_1000 <= GOAL_S else "not met") if model == "reduced" else "-"
             scaling = "met" if efficiency >= GOAL_EFFICIENCY else "not met"
+            cpu = cpus.get((model, backend, 1), float("nan"))
             table.add_row(model, backend, f"{one:.1f}", f"{two:.1f}", f"{n / two:.2f}",
-                          f"{efficiency:.0%}", f"{per_1000:.0f}", speed, scaling)  # fmt: skip
+                          f"{efficiency:.0%}", f"{per_1000:.0f}", f"{cpu:.3f}", speed,
+                          scaling)  # fmt: skip
             results[f"{model} {backend}"] = {"wall_1_s": one, "wall_2_s": two,
                                              "cases_per_s_2": n / two, "efficiency": efficiency,
-                                             "per_1000_cases_2_s": per_1000}  # fmt: skip
+                                             "per_1000_cases_2_s": per_1000,
+                                             "cpu_per_case_1_s": cpu}  # fmt: skip
     console.print(table)
+    console.print(f"load {', '.join(f'{x:.2f}' for x in os.getloadavg())}")
     return {"cases": n, "duration_s": args.duration, "results": results}
 
 

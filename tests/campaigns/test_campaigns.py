@@ -119,14 +119,21 @@ def test_rows_carry_the_verdicts_over_the_window(thesis_campaigns):
         assert metrics["r1_pass"] == (metrics["ape_deg"] < 0.05)
 
 
-def test_local_and_dask_give_identical_rows(tmp_path):
+def test_serial_pool_ensemble_and_dask_give_identical_rows(tmp_path):
+    # Bit for bit: the ensemble (threads, one compiled call per batch; every Dask task
+    # is one) flies the same compiled chunks as a case alone.
     definition = _short("sensitivity", 5.0)
     run_campaign(definition, nominal(), tmp_path / "local", workers=2, progress=False)
     run_campaign(definition, nominal(), tmp_path / "serial", workers=1, progress=False)
+    run_campaign(definition, nominal(), tmp_path / "ensemble", workers=2, runner="ensemble",
+                 progress=False)  # fmt: skip
     run_campaign(definition, nominal(), tmp_path / "dask", dask_local=2, progress=False)
     local = _table(tmp_path / "local")
     pd.testing.assert_frame_equal(local, _table(tmp_path / "serial"))
+    pd.testing.assert_frame_equal(local, _table(tmp_path / "ensemble"))
     pd.testing.assert_frame_equal(local, _table(tmp_path / "dask"))
+    with pytest.raises(ConfigError, match="runner: 'threads' is not one of pool, ensemble"):
+        run_campaign(definition, nominal(), tmp_path / "bad", runner="threads", progress=False)
 
 
 def test_kill_and_resume_loses_nothing_and_recomputes_nothing(tmp_path):

@@ -38,6 +38,7 @@ __all__ = [
     "HISTORY_DT_S",
     "HISTORY_KEY",
     "HISTORY_UNITS",
+    "RUNNERS",
     "CampaignInterrupted",
     "case_history",
     "replay_case",
@@ -47,6 +48,9 @@ __all__ = [
     "summarize",
 ]
 
+
+RUNNERS = ("pool", "ensemble")
+"""Local runners of :func:`run_campaign`."""
 
 _CASE_ID = re.compile(r"^[A-Za-z0-9_+\-][A-Za-z0-9_.+\-]*$")
 
@@ -222,13 +226,25 @@ def run_case(case: ResolvedCase) -> dict:
         ``inputs``, ``metrics`` (:func:`flexsat.analysis.slew_metrics`, SI or the
         key's unit).
     """
-    from flexsat.analysis.effort import effort_metrics
-    from flexsat.analysis.requirements import slew_metrics
-    from flexsat.config.models import SatelliteConfig
-    from flexsat.dynamics.plant import Plant
-    from flexsat.simulate import SlewScenario, run_slew
+    from flexsat.simulate import run_slew
 
-    row = {
+    row = case_row(case)
+    start = time.perf_counter()
+    if case.error:  # refused while streaming: a failed row, nothing to run
+        row.update(status="failed", error=case.error, metrics={}, case_wall_time_s=0.0)
+        return row
+    try:
+        plant, scenario = case_inputs(case)
+        finish_row(row, run_slew(plant, scenario, progress=False))
+    except Exception as exc:  # a failed case is data, not a crash of the campaign
+        fail_row(row, exc)
+    row["case_wall_time_s"] = time.perf_counter() - start
+    return row
+
+
+def case_row(case: ResolvedCase) -> dict:
+    """The head of a case's row: its id, inputs and seeds (what it was run from)."""
+    return {
         "case_id": case.case_id,
         "inputs_digest": case.digest,
         "root_seed": case.root_seed,
@@ -236,25 +252,36 @@ def run_case(case: ResolvedCase) -> dict:
         "parameters": case.parameters,
         "inputs": {"plant": case.plant, "scenario": case.scenario},  # for replay
     }
-    start = time.perf_counter()
-    if case.error:  # refused while streaming: a failed row, nothing to run
-        row.update(status="failed", error=case.error, metrics={}, case_wall_time_s=0.0)
-        return row
-    try:
-        plant = Plant.from_config(SatelliteConfig.model_validate(case.plant))
-        scenario = SlewScenario.model_validate(case.scenario)
-        result = run_slew(plant, scenario, progress=False)
-        row[HISTORY_KEY] = case_history(result.dataset)
-        metrics = slew_metrics(result.dataset)  # the stored scenario's requirements
-        metrics.update(effort_metrics(result.dataset))
-        metrics.pop("wall_time_s")
-        status, message = metrics.pop("status"), metrics.pop("message")
-        row.update(status=status, error=message, metrics=metrics)
-    except Exception as exc:  # a failed case is data, not a crash of the campaign
-        last = traceback.extract_tb(exc.__traceback__)[-1]
-        row.update(status="failed", error=f"{type(exc).__name__}: {exc} ({last.name})", metrics={})
-    row["case_wall_time_s"] = time.perf_counter() - start
-    return row
+
+
+def case_inputs(case: ResolvedCase):
+    """The validated ``(Plant, SlewScenario)`` of a resolved case."""
+    from flexsat.config.models import SatelliteConfig
+    from flexsat.dynamics.plant import Plant
+    from flexsat.simulate import SlewScenario
+
+    plant = Plant.from_config(SatelliteConfig.model_validate(case.plant))
+    return plant, SlewScenario.model_validate(case.scenario)
+
+
+def finish_row(row: dict, result) -> None:
+    """Fill a row from its slew's :class:`~flexsat.simulate.result.Result`: history,
+    status and metrics (the stored scenario's requirements, control effort)."""
+    from flexsat.analysis.effort import effort_metrics
+    from flexsat.analysis.requirements import slew_metrics
+
+    row[HISTORY_KEY] = case_history(result.dataset)
+    metrics = slew_metrics(result.dataset)
+    metrics.update(effort_metrics(result.dataset))
+    metrics.pop("wall_time_s")
+    status, message = metrics.pop("status"), metrics.pop("message")
+    row.update(status=status, error=message, metrics=metrics)
+
+
+def fail_row(row: dict, exc: Exception) -> None:
+    """Mark a row failed by ``exc``: its type, message and the function that raised."""
+    last = traceback.extract_tb(exc.__traceback__)[-1]
+    row.update(status="failed", error=f"{type(exc).__name__}: {exc} ({last.name})", metrics={})
 
 
 class CampaignInterrupted(FlexsatError):
@@ -271,6 +298,7 @@ def run_campaign(
     scheduler: str | None = None,
     dask_local: int | None = None,
     progress: bool = True,
+    runner: str = "pool",
 ) -> dict:
     """Run (or finish) a campaign into the store at ``out``.
 
@@ -296,6 +324,11 @@ def run_campaign(
         Start a Dask LocalCluster with this many single-threaded worker processes.
     progress : bool
         Show a progress bar on the terminal.
+    runner : {"pool", "ensemble"}
+        Local runs only: ``pool``, one case per worker process at a time;
+        ``ensemble``, batches of cases flown in one compiled call in this process
+        across ``workers`` threads (:mod:`flexsat.campaigns.ensemble`). Both store
+        the same rows; Dask tasks always fly their batch as an ensemble.
 
     Returns
     -------
@@ -318,13 +351,15 @@ def run_campaign(
 
         return run_worst_case(definition, definition.worst_case, satellite, out,
                               workers=workers, resume=resume)  # fmt: skip
+    if runner not in RUNNERS:
+        raise ConfigError(f"runner: {runner!r} is not one of {', '.join(RUNNERS)}")
     cases = CaseStream(definition, satellite, n_random)  # checks what it can up front
     store = CampaignStore(out)
     if store.root.exists() and not store.root.is_dir():
         raise ConfigError(f"--out {store.root}: exists and is not a folder")
     start = time.perf_counter()
     failed = 0
-    with _backend(workers, scheduler, dask_local) as execute, store.opened(
+    with _backend(workers, scheduler, dask_local, runner) as execute, store.opened(
         campaign_fingerprint(definition, satellite, cases), definition.name, resume
     ):
         todo = _Todo(cases, store)
@@ -462,12 +497,7 @@ class _Interrupts:
 def _lost_case(case: ResolvedCase, exitcode: int | None) -> dict:
     """The failed row of a case whose worker process died running it (twice)."""
     return {
-        "case_id": case.case_id,
-        "inputs_digest": case.digest,
-        "root_seed": case.root_seed,
-        "stream_index": case.stream_index,
-        "parameters": case.parameters,
-        "inputs": {"plant": case.plant, "scenario": case.scenario},
+        **case_row(case),
         "status": "failed",
         "error": f"its worker process died running it (exit code {exitcode}), twice",
         "metrics": {},
@@ -476,7 +506,7 @@ def _lost_case(case: ResolvedCase, exitcode: int | None) -> dict:
 
 
 @contextlib.contextmanager
-def _backend(workers, scheduler, dask_local):
+def _backend(workers, scheduler, dask_local, runner="pool"):
     """Connect to (or start) the backend, then yield ``execute(cases, size) -> rows``
     (``size``: at most how many cases will come, to size the pool)."""
     if scheduler or dask_local:
@@ -484,6 +514,11 @@ def _backend(workers, scheduler, dask_local):
             yield lambda todo, size: _dask(client, todo)
         return
     workers = workers or os.cpu_count() or 1
+    if runner == "ensemble":
+        from flexsat.campaigns.ensemble import run_ensemble
+
+        yield lambda todo, size: run_ensemble(todo, threads=workers)
+        return
 
     def execute(todo: Iterable[ResolvedCase], size: int) -> Iterator[dict]:
         source = iter(todo)
@@ -528,7 +563,8 @@ DASK_BATCH = 8
 
 
 def run_batch(cases: list[ResolvedCase]) -> list[dict]:
-    """Rows of :func:`run_case` for each case, in one task (never raises).
+    """Rows of :func:`run_case` for each case, in one task (never raises): the batch
+    flown as one ensemble (:func:`flexsat.campaigns.ensemble.run_ensemble`, one thread).
 
     Parameters
     ----------
@@ -540,7 +576,9 @@ def run_batch(cases: list[ResolvedCase]) -> list[dict]:
     list of dict
         One row per case, in order.
     """
-    return [run_case(case) for case in cases]
+    from flexsat.campaigns.ensemble import run_ensemble
+
+    return list(run_ensemble(cases, threads=1, batch=len(cases)))
 
 
 def _dask(client, todo) -> Iterator[dict]:

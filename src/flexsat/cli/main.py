@@ -11,6 +11,7 @@ import math
 import shutil
 import sys
 import warnings
+from enum import StrEnum
 from pathlib import Path
 from typing import Annotated
 
@@ -56,6 +57,13 @@ ConfigOption = Annotated[
 JsonOption = Annotated[
     bool, typer.Option("--json", help="Print one JSON object (SI units) instead of tables.")
 ]
+
+
+class CampaignRunner(StrEnum):
+    """Local campaign runners (flexsat.campaigns.runner.RUNNERS)."""
+
+    pool = "pool"
+    ensemble = "ensemble"
 
 
 def _version(value: bool) -> None:
@@ -509,6 +517,11 @@ def campaign(
     dask_local: Annotated[
         int | None, typer.Option(min=1, help="Start a Dask LocalCluster with N workers.")
     ] = None,
+    runner: Annotated[
+        CampaignRunner,
+        typer.Option(help="Local runs: 'pool' (a case per worker process) or 'ensemble' "
+                     "(batches in one compiled call, --workers threads)."),
+    ] = CampaignRunner.pool,
     cases: Annotated[
         int | None, typer.Option(help="Number of random cases (random campaigns).")
     ] = None,
@@ -572,6 +585,7 @@ def campaign(
     summary = fly_campaign(
         definition, load_config(config), store, workers=workers, resume=resume, n_random=cases,
         scheduler=scheduler, dask_local=dask_local, progress=not json_output,
+        runner=runner.value,
     )  # fmt: skip
     if json_output:
         typer.echo(json.dumps(jsonable(summary)))

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import math
 import time
-from typing import Protocol
+from typing import NamedTuple, Protocol
 
 import numpy as np
 
@@ -20,7 +20,8 @@ from flexsat.dynamics.plant import Plant
 from flexsat.dynamics.rigid import rigid_inertia
 from flexsat.dynamics.status import STATUS_CONTROL_FAILED
 from flexsat.errors import ConfigError, SimulationError
-from flexsat.simulate.common import PROGRESS_MIN_STEPS, chunk_steps, progress_bar, run_attributes
+from flexsat.simulate.batch import fly, slew_timing
+from flexsat.simulate.common import PROGRESS_MIN_STEPS, progress_bar, run_attributes
 from flexsat.simulate.coupled import LoopFlow, rk4_coupled_hold
 from flexsat.simulate.layout import LoopLayout
 from flexsat.simulate.loops import (
@@ -36,7 +37,16 @@ from flexsat.simulate.openloop import initial_state
 from flexsat.simulate.result import Result, build_dataset
 from flexsat.simulate.scenario import SlewScenario
 
-__all__ = ["Controller", "design_inertia", "loop_layout", "run_slew", "slew_design_inertia"]
+__all__ = [
+    "Controller",
+    "PreparedSlew",
+    "design_inertia",
+    "finish_slew",
+    "loop_layout",
+    "prepare_slew",
+    "run_slew",
+    "slew_design_inertia",
+]
 
 
 class Controller(Protocol):
@@ -121,24 +131,81 @@ def run_slew(
         run stops cleanly with its history and ``status = "failed"``.
     """
     scenario = scenario or SlewScenario()
+    run = prepare_slew(plant, scenario, design_J)
+    layout = run.layout
+    if controller is not None and (layout.reference.name != REFERENCES.default
+                                   or layout.joint_actuator.name != JOINT_ACTUATORS.default):
+        raise ConfigError("a Python controller flies the step reference without joint "
+                          "actuators: remove [reference] and [joint_actuator]")  # fmt: skip
+    steps = scenario.n_steps
+    show = steps >= PROGRESS_MIN_STEPS if progress is None else progress
+    if controller is None:  # compile or load the loop now (0 steps): the wall time is the run's
+        idle = LoopClock(0.0, scenario.dt_s, 0, False, scenario.control_every,
+                         scenario.record_every, layout.continuous)  # fmt: skip
+        rk4_closed_loop(run.x.copy(), idle, run.stages, run.data,
+                        LoopRecords(run.rec_t, run.rec_x, run.rec_ctrl, 0, run.rec_frame),
+                        plant.packed, identity_frame())  # fmt: skip
+    start = time.perf_counter()
+    with progress_bar(show, scenario.duration_s) as (bar, task):
+        if controller is None:
+            status, done, rows = _compiled_loop(run, bar, task)
+        else:
+            status, done, rows = _python_loop(plant, scenario, run.x, run.frame, run.stages,
+                                              run.data, run.rec_t, run.rec_x, run.rec_ctrl,
+                                              run.rec_frame, bar, task, controller,
+                                              layout.continuous)  # fmt: skip
+    return finish_slew(run, status, done, rows, time.perf_counter() - start, controller is None)
+
+
+class PreparedSlew(NamedTuple):
+    """One slew ready for the compiled loop: its arrays, its stages, its record buffers.
+
+    What :func:`prepare_slew` builds and :func:`finish_slew` turns into a
+    :class:`~flexsat.simulate.result.Result`; the loop advances ``x`` and ``frame``
+    in place and fills the record buffers (rows of NaN until written).
+    """
+
+    plant: Plant
+    scenario: SlewScenario
+    law: object  # the registered law (flexsat.control.laws)
+    layout: LoopLayout
+    J: np.ndarray  # (3, 3) design inertia [kg m^2]
+    x: np.ndarray  # (x_size,) plant state, advanced in place
+    frame: np.ndarray  # (9,) attitude reference R_NF of x, updated in place
+    data: LoopData
+    stages: LoopStages
+    rec_t: np.ndarray  # (m,) [s]
+    rec_x: np.ndarray  # (m, x_size)
+    rec_ctrl: np.ndarray  # (m, record_size)
+    rec_frame: np.ndarray  # (m, 9)
+
+
+def prepare_slew(plant: Plant, scenario: SlewScenario,
+                 design_J: np.ndarray | None = None) -> PreparedSlew:  # fmt: skip
+    """Everything a slew's compiled loop reads and writes, allocated once.
+
+    Parameters
+    ----------
+    plant : Plant
+        The truth model.
+    scenario : SlewScenario
+        The slew.
+    design_J : ndarray, shape (3, 3), optional
+        The controller's inertia [kg m^2]; default :func:`slew_design_inertia`.
+
+    Returns
+    -------
+    PreparedSlew
+        Initial state, loop data, stages and record buffers sized for the whole run
+        (``n_steps // record_every + 2`` rows: the last good state of a failed run too).
+    """
     J = np.ascontiguousarray(
         slew_design_inertia(plant, scenario) if design_J is None else design_J, dtype=float
     )
     law = get_law(scenario.controller.kind)
     layout = loop_layout(plant, scenario)
-    if controller is not None and (layout.reference.name != REFERENCES.default
-                                   or layout.joint_actuator.name != JOINT_ACTUATORS.default):
-        raise ConfigError("a Python controller flies the step reference without joint "
-                          "actuators: remove [reference] and [joint_actuator]")  # fmt: skip
     q0, qd0 = initial_state(plant, scenario)
-    steps, every = scenario.n_steps, scenario.record_every
-    n_records = steps // every + 2  # + the last good state of a failed run
-    rec_t = np.full(n_records, np.nan)
-    rec_x = np.full((n_records, layout.plant.size), np.nan)
-    rec_ctrl = np.full((n_records, layout.record_size), np.nan)
-    rec_frame = np.full((n_records, 9), np.nan)
-    x = np.concatenate([q0, qd0, [0.0, 0.0]])
-    frame = identity_frame()  # attitude reference R_NF (flexsat.dynamics.attitude)
+    n_records = scenario.n_steps // scenario.record_every + 2  # + the last good state
     data = _loop_data(layout, scenario, J, plant)
     stages = LoopStages(
         tuple(s.step for s in layout.sensors), (law.step,),
@@ -146,35 +213,51 @@ def run_slew(
         tuple(s.derivative or no_derivative for s in layout.actuators),
         (layout.reference.step,), (layout.joint_actuator.step,),
     )  # fmt: skip
-    show = steps >= PROGRESS_MIN_STEPS if progress is None else progress
-    if controller is None:  # compile or load the loop now (0 steps): the wall time is the run's
-        idle = LoopClock(0.0, scenario.dt_s, 0, False, scenario.control_every, every,
-                         layout.continuous)  # fmt: skip
-        rk4_closed_loop(x.copy(), idle, stages, data,
-                        LoopRecords(rec_t, rec_x, rec_ctrl, 0, rec_frame), plant.packed,
-                        identity_frame())  # fmt: skip
-    start = time.perf_counter()
-    with progress_bar(show, scenario.duration_s) as (bar, task):
-        if controller is None:
-            status, done, rows = _compiled_loop(plant, scenario, x, frame, stages, data, rec_t,
-                                                rec_x, rec_ctrl, rec_frame, bar, task,
-                                                layout.continuous)  # fmt: skip
-        else:
-            status, done, rows = _python_loop(plant, scenario, x, frame, stages, data, rec_t,
-                                              rec_x, rec_ctrl, rec_frame, bar, task,
-                                              controller, layout.continuous)  # fmt: skip
-    wall = time.perf_counter() - start
+    return PreparedSlew(
+        plant, scenario, law, layout, J, np.concatenate([q0, qd0, [0.0, 0.0]]),
+        identity_frame(),  # attitude reference R_NF (flexsat.dynamics.attitude)
+        data, stages, np.full(n_records, np.nan),
+        np.full((n_records, layout.plant.size), np.nan),
+        np.full((n_records, layout.record_size), np.nan), np.full((n_records, 9), np.nan),
+    )  # fmt: skip
+
+
+def finish_slew(run: PreparedSlew, status: int, done: int, rows: int, wall: float,
+                compiled_law: bool = True) -> Result:  # fmt: skip
+    """The :class:`~flexsat.simulate.result.Result` of a slew the loop has flown.
+
+    Parameters
+    ----------
+    run : PreparedSlew
+        The slew, its buffers filled by the loop.
+    status : int
+        The loop's status (0: finished; else :mod:`flexsat.dynamics.status`).
+    done : int
+        Steps taken.
+    rows : int
+        Record rows written.
+    wall : float
+        Wall time of the loop [s] (an attribute of the result).
+    compiled_law : bool
+        The scenario's compiled law flew it (False: a Python controller).
+
+    Returns
+    -------
+    Result
+    """
+    plant, scenario, law, layout, J, x, frame, data = run[:8]
+    rec_t, rec_x, rec_ctrl, rec_frame = run.rec_t, run.rec_x, run.rec_ctrl, run.rec_frame
     t_fail = done * scenario.dt_s if status else -1.0
     if status:  # keep the last good state as the final record
         rec_t[rows], rec_x[rows], rec_ctrl[rows], rec_frame[rows] = t_fail, x, data.held, frame
         rows += 1
     rec_t, rec_x, rec_ctrl, rec_frame = (a[:rows] for a in (rec_t, rec_x, rec_ctrl, rec_frame))
     attrs = run_attributes(plant, scenario, "closed-loop", status, t_fail, wall, done)
-    attrs["controller"] = law.name if controller is None else "python"
-    attrs["controller_label"] = law.label if controller is None else "Python law"
+    attrs["controller"] = law.name if compiled_law else "python"
+    attrs["controller_label"] = law.label if compiled_law else "Python law"
     attrs["sensor"] = " > ".join(s.name for s in layout.sensors)
     attrs["actuator"] = " > ".join(s.name for s in layout.actuators)
-    if controller is None:
+    if compiled_law:
         attrs.update(scenario.controller.plot_attributes())
         attrs["law_diagnostics"] = [channel.name for channel in law.diagnostics]
     attrs["reference"] = layout.reference.name
@@ -209,6 +292,8 @@ def run_slew(
         {"units": "deg/s", "long_name": "|omega - omega_d|: residual rate (jitter)"},
     )  # fmt: skip
     return Result(ds)
+
+
 
 
 def loop_layout(plant: Plant, scenario: SlewScenario) -> LoopLayout:
@@ -294,28 +379,19 @@ def _loop_data(layout: LoopLayout, scenario: SlewScenario, J: np.ndarray,
     )
 
 
-def _compiled_loop(plant, scenario, x, frame, stages, data, rec_t, rec_x, rec_ctrl, rec_frame,
-                   bar, task, continuous):  # fmt: skip
-    """The whole loop, stages and law included, in compiled chunks."""
-    steps, every, control = scenario.n_steps, scenario.record_every, scenario.control_every
-    chunk = chunk_steps(every, control)
-    done, rows, status = 0, 0, 0
-    while status == 0:
-        n_chunk = min(chunk, steps - done)
-        final = done + n_chunk == steps
-        clock = LoopClock(done * scenario.dt_s, scenario.dt_s, n_chunk, final, control, every,
-                          continuous)  # fmt: skip
-        status, ran, written = rk4_closed_loop(
-            x, clock, stages, data, LoopRecords(rec_t, rec_x, rec_ctrl, rows, rec_frame),
-            plant.packed, frame,
-        )
-        done += ran
-        rows += written
+def _compiled_loop(run: PreparedSlew, bar, task) -> tuple[int, int, int]:
+    """The whole loop, stages and law included, in compiled chunks (one call without a bar)."""
+    timing = slew_timing(run)
+    status, done, rows = 0, 0, 0
+    per_call = 1 if bar is not None else timing.n_steps + 1
+    while True:
+        status, done, rows = fly(run.x, timing, run.stages, run.data, run.rec_t, run.rec_x,
+                                 run.rec_ctrl, run.rec_frame, run.plant.packed, run.frame,
+                                 done, rows, per_call)  # fmt: skip
         if bar is not None:
-            bar.update(task, completed=done * scenario.dt_s)
-        if final:
-            break
-    return status, done, rows
+            bar.update(task, completed=done * run.scenario.dt_s)
+        if status != 0 or done == timing.n_steps:
+            return status, done, rows
 
 
 def _python_loop(plant, scenario, x, frame, stages, d, rec_t, rec_x, rec_ctrl, rec_frame, bar,

@@ -263,7 +263,8 @@ def fly_campaign(definition, config, store: Path, *, progress: bool = True, **ba
     progress : bool
         Show a progress bar.
     **backend
-        ``workers``, ``scheduler``, ``dask_local``, ``resume``, ``n_random``: passed on.
+        ``workers``, ``scheduler``, ``dask_local``, ``resume``, ``n_random``, ``runner``:
+        passed on.
 
     Returns
     -------

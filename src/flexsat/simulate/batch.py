@@ -1,0 +1,203 @@
+"""A whole slew in one compiled call, and many slews in one compiled call (threads).
+
+:func:`fly` runs a prepared slew (:func:`flexsat.simulate.closedloop.prepare_slew`)
+chunk by chunk exactly as the progress-reporting driver does (the same chunk
+boundaries, the same arithmetic), so a slew flown alone, in a batch or with a
+progress bar gives the same records bit for bit. :func:`fly_batch` runs a batch of
+prepared slews of one structure (same law, stage chains and appendage groups: one
+numba type) across ``numba.prange`` threads, each writing only its own arrays.
+Both release the GIL.
+"""
+
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import numpy as np
+from numba import config, njit, prange, set_num_threads, typeof
+from numba.typed import List
+
+from flexsat.simulate.common import chunk_steps
+from flexsat.simulate.loops import LoopClock, LoopRecords, rk4_closed_loop
+
+__all__ = [
+    "BatchItem",
+    "SlewTiming",
+    "batch_item",
+    "fly",
+    "fly_batch",
+    "fly_prepared",
+    "slew_timing",
+]
+
+
+class SlewTiming(NamedTuple):
+    """A slew's clock: RK4 step, length and the periods in steps."""
+
+    dt: float  # RK4 step [s]
+    n_steps: int  # steps of the whole run
+    control_every: int  # plant steps per control period
+    record_every: int  # plant steps per record
+    chunk: int  # steps per compiled chunk (flexsat.simulate.common.chunk_steps)
+    continuous: bool  # an actuation stage integrates states in the RK4 steps
+
+
+class BatchItem(NamedTuple):
+    """One prepared slew as :func:`fly_batch` takes it (arrays shared, not copied)."""
+
+    x: np.ndarray
+    timing: SlewTiming
+    stages: tuple
+    data: tuple
+    rec_t: np.ndarray
+    rec_x: np.ndarray
+    rec_ctrl: np.ndarray
+    rec_frame: np.ndarray
+    plant: tuple
+    frame: np.ndarray
+
+
+def slew_timing(run) -> SlewTiming:
+    """The :class:`SlewTiming` of a prepared slew.
+
+    Parameters
+    ----------
+    run : PreparedSlew
+        The slew (:func:`flexsat.simulate.closedloop.prepare_slew`).
+
+    Returns
+    -------
+    SlewTiming
+    """
+    s = run.scenario
+    return SlewTiming(s.dt_s, s.n_steps, s.control_every, s.record_every,
+                      chunk_steps(s.record_every, s.control_every),
+                      run.layout.continuous)  # fmt: skip
+
+
+def batch_item(run) -> BatchItem:
+    """The :class:`BatchItem` of a prepared slew (its arrays, not copies).
+
+    Parameters
+    ----------
+    run : PreparedSlew
+        The slew (:func:`flexsat.simulate.closedloop.prepare_slew`).
+
+    Returns
+    -------
+    BatchItem
+    """
+    return BatchItem(run.x, slew_timing(run), run.stages, run.data, run.rec_t, run.rec_x,
+                     run.rec_ctrl, run.rec_frame, run.plant.packed, run.frame)  # fmt: skip
+
+
+@njit(cache=True, nogil=True)
+def fly(x, timing, stages, d, rec_t, rec_x, rec_ctrl, rec_frame, plant, frame, done, rows,
+        max_chunks):  # fmt: skip
+    """Advance a slew by up to ``max_chunks`` compiled chunks from step ``done``.
+
+    Stops after the run's last step or at the first non-zero status.
+
+    Parameters
+    ----------
+    x : ndarray, shape (x_size,)
+        Plant state (q, q̇, work in, dissipated; SI), advanced in place.
+    timing : SlewTiming
+        The slew's clock.
+    stages : LoopStages
+        The compiled law and stages (:mod:`flexsat.simulate.loops`).
+    d : LoopData
+        The loop's arrays.
+    rec_t : ndarray, shape (m,)
+        Record times [s], written from row ``rows``.
+    rec_x : ndarray, shape (m, x_size)
+        Recorded plant states (SI).
+    rec_ctrl : ndarray, shape (m, record_size)
+        Recorded control rows (SI).
+    rec_frame : ndarray, shape (m, 9)
+        Recorded attitude references R_NF [-].
+    plant : PackedPlant
+        The plant's named structure (``Plant.packed``).
+    frame : ndarray, shape (9,)
+        Attitude reference R_NF of ``x`` [-], updated in place.
+    done : int
+        Steps already taken.
+    rows : int
+        Record rows already written.
+    max_chunks : int
+        At most this many chunks in this call.
+
+    Returns
+    -------
+    status, steps_done, rows_written : int
+        Totals since the start of the run.
+    """
+    status = 0
+    for _ in range(max_chunks):
+        n_chunk = min(timing.chunk, timing.n_steps - done)
+        final = done + n_chunk == timing.n_steps
+        clock = LoopClock(done * timing.dt, timing.dt, n_chunk, final, timing.control_every,
+                          timing.record_every, timing.continuous)  # fmt: skip
+        status, ran, written = rk4_closed_loop(
+            x, clock, stages, d, LoopRecords(rec_t, rec_x, rec_ctrl, rows, rec_frame), plant,
+            frame,
+        )
+        done += ran
+        rows += written
+        if final or status != 0:
+            break
+    return status, done, rows
+
+
+@njit(cache=True, nogil=True, parallel=True)
+def fly_batch(items, out):
+    """Fly every slew of a batch to its end, across the numba threads.
+
+    Parameters
+    ----------
+    items : numba.typed.List of BatchItem
+        Slews of one numba type, each flown on its own arrays.
+    out : ndarray, shape (len(items), 3), int64
+        Written: per slew, status, steps done, record rows written.
+    """
+    for i in prange(len(items)):
+        it = items[np.int64(i)]  # the prange index is unsigned; the List takes int64
+        status, done, rows = fly(it.x, it.timing, it.stages, it.data, it.rec_t, it.rec_x,
+                                 it.rec_ctrl, it.rec_frame, it.plant, it.frame, 0, 0,
+                                 it.timing.n_steps + 1)  # fmt: skip
+        out[i, 0], out[i, 1], out[i, 2] = status, done, rows
+
+
+def fly_prepared(runs: list, threads: int = 1) -> np.ndarray:
+    """Fly prepared slews to their ends, those of one structure in one compiled call.
+
+    Slews are grouped by the numba type of their :class:`BatchItem` (law, stage
+    chains, appendage groups): each group is one call of :func:`fly_batch` across
+    ``threads`` numba threads (set for the calling thread only).
+
+    Parameters
+    ----------
+    runs : list of PreparedSlew
+        The slews (:func:`flexsat.simulate.closedloop.prepare_slew`), flown in place.
+    threads : int
+        numba threads across the slews of a group.
+
+    Returns
+    -------
+    ndarray, shape (len(runs), 3), int64
+        Per slew, in the given order: status, steps done, record rows written.
+    """
+    groups: dict = {}
+    for index, run in enumerate(runs):
+        item = batch_item(run)
+        groups.setdefault(typeof(item), []).append((index, item))
+    out = np.zeros((len(runs), 3), dtype=np.int64)
+    set_num_threads(max(1, min(threads, config.NUMBA_NUM_THREADS)))
+    for members in groups.values():
+        items = List()
+        for _, item in members:
+            items.append(item)
+        flown = np.zeros((len(members), 3), dtype=np.int64)
+        fly_batch(items, flown)
+        out[[index for index, _ in members]] = flown
+    return out
