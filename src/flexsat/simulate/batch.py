@@ -32,7 +32,23 @@ __all__ = [
 
 
 class SlewTiming(NamedTuple):
-    """A slew's clock: RK4 step, length and the periods in steps."""
+    """A slew's clock: RK4 step, length and the periods in steps.
+
+    Attributes
+    ----------
+    dt : float
+        RK4 step [s].
+    n_steps : int
+        Steps of the whole run [-].
+    control_every : int
+        Plant steps per control period [-].
+    record_every : int
+        Plant steps per record [-].
+    chunk : int
+        Steps per compiled chunk (:func:`flexsat.simulate.common.chunk_steps`) [-].
+    continuous : bool
+        An actuation stage integrates states in the RK4 steps [-].
+    """
 
     dt: float  # RK4 step [s]
     n_steps: int  # steps of the whole run
@@ -43,7 +59,31 @@ class SlewTiming(NamedTuple):
 
 
 class BatchItem(NamedTuple):
-    """One prepared slew as :func:`fly_batch` takes it (arrays shared, not copied)."""
+    """One prepared slew as :func:`fly_batch` takes it (arrays shared, not copied).
+
+    Attributes
+    ----------
+    x : ndarray, shape (x_size,)
+        Plant state [m, rad, m/s, rad/s, J], advanced in place.
+    timing : SlewTiming
+        The slew's clock [-].
+    stages : tuple
+        The compiled law and stages (``LoopStages``) [-].
+    data : tuple
+        The loop's arrays (``LoopData``) [-].
+    rec_t : ndarray, shape (m,)
+        Record times [s].
+    rec_x : ndarray, shape (m, x_size)
+        Recorded plant states [m, rad, m/s, rad/s, J].
+    rec_ctrl : ndarray, shape (m, record_size)
+        Recorded control rows [SI units of each channel].
+    rec_frame : ndarray, shape (m, 9)
+        Recorded attitude references R_NF [-].
+    plant : tuple
+        The plant's named structure (``Plant.packed``) [-].
+    frame : ndarray, shape (9,)
+        Attitude reference R_NF of ``x`` [-], updated in place.
+    """
 
     x: np.ndarray
     timing: SlewTiming
@@ -101,7 +141,8 @@ def fly(x, timing, stages, d, rec_t, rec_x, rec_ctrl, rec_frame, plant, frame, d
     Parameters
     ----------
     x : ndarray, shape (x_size,)
-        Plant state (q, q̇, work in, dissipated; SI), advanced in place.
+        Plant state (q, q̇, work in, dissipated) [m, rad, m/s, rad/s, J], advanced in
+        place.
     timing : SlewTiming
         The slew's clock.
     stages : LoopStages
@@ -111,9 +152,9 @@ def fly(x, timing, stages, d, rec_t, rec_x, rec_ctrl, rec_frame, plant, frame, d
     rec_t : ndarray, shape (m,)
         Record times [s], written from row ``rows``.
     rec_x : ndarray, shape (m, x_size)
-        Recorded plant states (SI).
+        Recorded plant states [m, rad, m/s, rad/s, J].
     rec_ctrl : ndarray, shape (m, record_size)
-        Recorded control rows (SI).
+        Recorded control rows [SI units of each channel].
     rec_frame : ndarray, shape (m, 9)
         Recorded attitude references R_NF [-].
     plant : PackedPlant
@@ -158,7 +199,7 @@ def fly_batch(items, out):
     items : numba.typed.List of BatchItem
         Slews of one numba type, each flown on its own arrays.
     out : ndarray, shape (len(items), 3), int64
-        Written: per slew, status, steps done, record rows written.
+        Written: per slew, status, steps done, record rows written [-].
     """
     for i in prange(len(items)):
         it = items[np.int64(i)]  # the prange index is unsigned; the List takes int64
@@ -185,7 +226,7 @@ def fly_prepared(runs: list, threads: int = 1) -> np.ndarray:
     Returns
     -------
     ndarray, shape (len(runs), 3), int64
-        Per slew, in the given order: status, steps done, record rows written.
+        Per slew, in the given order: status, steps done, record rows written [-].
     """
     groups: dict = {}
     for index, run in enumerate(runs):

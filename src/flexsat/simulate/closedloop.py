@@ -163,6 +163,35 @@ class PreparedSlew(NamedTuple):
     What :func:`prepare_slew` builds and :func:`finish_slew` turns into a
     :class:`~flexsat.simulate.result.Result`; the loop advances ``x`` and ``frame``
     in place and fills the record buffers (rows of NaN until written).
+
+    Attributes
+    ----------
+    plant : Plant
+        The satellite [-].
+    scenario : SlewScenario
+        The slew [-].
+    law : object
+        The registered law (:mod:`flexsat.control.laws`) [-].
+    layout : LoopLayout
+        Where the states and records live [-].
+    J : ndarray, shape (3, 3)
+        Design inertia [kg m^2].
+    x : ndarray, shape (x_size,)
+        Plant state [m, rad, m/s, rad/s, J], advanced in place.
+    frame : ndarray, shape (9,)
+        Attitude reference R_NF of ``x`` [-], updated in place.
+    data : LoopData
+        The loop's arrays [-].
+    stages : LoopStages
+        The compiled law and stages [-].
+    rec_t : ndarray, shape (m,)
+        Record times [s].
+    rec_x : ndarray, shape (m, x_size)
+        Recorded plant states [m, rad, m/s, rad/s, J].
+    rec_ctrl : ndarray, shape (m, record_size)
+        Recorded control rows [SI units of each channel].
+    rec_frame : ndarray, shape (m, 9)
+        Recorded attitude references R_NF [-].
     """
 
     plant: Plant
