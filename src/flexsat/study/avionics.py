@@ -7,7 +7,8 @@ the smallest delay at which R1, then R2, is lost, and the one at which the loop
 goes unstable, with the figure of the pointing and jitter figures against delay;
 (c) the rotating solar arrays are not modelled (``docs/control.md``, 'Not
 modelled yet'), and the part says so. Writes ``avionics/avionics.json`` and
-``avionics/delay_boundary.png``.
+``avionics/delay_boundary.png``. The runs are independent: they fly in forked
+processes side by side (:func:`flexsat.parallel.forked_map`).
 """
 
 from __future__ import annotations
@@ -19,7 +20,7 @@ import numpy as np
 from flexsat.analysis.requirements import slew_metrics
 from flexsat.simulate import SlewScenario, run_slew
 
-__all__ = ["AVIONICS", "DELAYS_S", "QUICK_DELAYS_S", "avionics_study", "render_avionics"]
+__all__ = ["AVIONICS", "DELAYS_S", "QUICK_DELAYS_S", "avionics_study", "delayed", "render_avionics"]
 
 AVIONICS = {
     "sensor_stages": [{"kind": "gyro"}, {"kind": "star_tracker"}, {"kind": "mekf"}],
@@ -33,6 +34,12 @@ _KEYS = ("r1_pass", "r2_pass", "r3_pass", "ape_deg", "rpe_deg", "max_rate_error_
 UNSTABLE_POINTING_DEG = 1.0
 """A delayed run is called unstable when it diverged (stopped) or ends farther than
 this from the target (the nominal slew ends within 0.003 deg)."""
+
+
+def delayed(periods: int) -> dict:
+    """Slew scenario fields of the ideal loop with the torque command held back by
+    ``periods`` whole control periods (the ``delay`` actuator stage)."""
+    return {"actuator_stages": [{"kind": "delay", "periods": periods}]}
 
 
 def _metrics(plant, fields: dict) -> dict:
@@ -49,16 +56,17 @@ def avionics_study(plant, out: str | Path, quick: bool = False) -> dict:
     dict
         ``json`` and ``figures``: paths written.
     """
+    from flexsat.parallel import forked_map
+
     out = Path(out)
-    side_by_side = {"ideal": _metrics(plant, {}), "avionics": _metrics(plant, AVIONICS)}
-    delays = QUICK_DELAYS_S if quick else DELAYS_S
     control_dt = SlewScenario().control_dt_s
+    periods = [round(delay / control_dt) for delay in (QUICK_DELAYS_S if quick else DELAYS_S)]
+    runs = [{}, AVIONICS, *(delayed(n) for n in periods)]
+    ideal, avionics, *delayed = forked_map(lambda fields: _metrics(plant, fields), runs)
+    side_by_side = {"ideal": ideal, "avionics": avionics}
     sweep = []
-    for delay in delays:
-        periods = round(delay / control_dt)
-        fields = {"actuator_stages": [{"kind": "delay", "periods": periods}]}
-        row = _metrics(plant, fields)
-        row["delay_s"] = periods * control_dt
+    for n, row in zip(periods, delayed, strict=True):
+        row["delay_s"] = n * control_dt
         row["unstable"] = row["status"] != "ok" or not (
             row["final_pointing_error_deg"] < UNSTABLE_POINTING_DEG)  # fmt: skip
         sweep.append(row)
