@@ -62,10 +62,10 @@ def avionics_study(plant, out: str | Path, quick: bool = False) -> dict:
     control_dt = SlewScenario().control_dt_s
     periods = [round(delay / control_dt) for delay in (QUICK_DELAYS_S if quick else DELAYS_S)]
     runs = [{}, AVIONICS, *(delayed(n) for n in periods)]
-    ideal, avionics, *delayed = forked_map(lambda fields: _metrics(plant, fields), runs)
+    ideal, avionics, *swept = forked_map(lambda fields: _metrics(plant, fields), runs)
     side_by_side = {"ideal": ideal, "avionics": avionics}
     sweep = []
-    for n, row in zip(periods, delayed, strict=True):
+    for n, row in zip(periods, swept, strict=True):
         row["delay_s"] = n * control_dt
         row["unstable"] = row["status"] != "ok" or not (
             row["final_pointing_error_deg"] < UNSTABLE_POINTING_DEG)  # fmt: skip
