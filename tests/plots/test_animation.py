@@ -160,6 +160,15 @@ def test_animation_is_deterministic(openloop: Result, tmp_path: Path) -> None:
     assert a.read_bytes() == b.read_bytes()
 
 
+def test_frames_rendered_by_forked_processes_are_the_same(openloop: Result, tmp_path: Path,
+                                                          monkeypatch) -> None:  # fmt: skip
+    monkeypatch.setenv("FLEXSAT_FIGURE_WORKERS", "1")
+    here = write_animation(openloop, tmp_path / "here.gif", max_frames=5)
+    monkeypatch.setenv("FLEXSAT_FIGURE_WORKERS", "2")
+    forked = write_animation(openloop, tmp_path / "forked.gif", max_frames=5)
+    assert here.read_bytes() == forked.read_bytes()
+
+
 def test_failed_run_is_drawn_up_to_its_last_finite_state(openloop: Result) -> None:
     ds = openloop.dataset.copy(deep=True)
     ds["q"][-50:, 7] = np.nan

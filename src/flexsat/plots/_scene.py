@@ -4,7 +4,8 @@
   axes, created once and moved frame by frame (blitting).
 - :func:`frame_view`: fixed limits, one scale on X, Y and Z, labels and view.
 - :class:`CanvasPillowWriter` / :class:`CanvasFFMpegWriter`: movie writers that take
-  each frame from the Agg canvas as the caller rendered it (no full redraw).
+  each frame from the Agg canvas as the caller rendered it (no full redraw), or as
+  RGBA bytes rendered elsewhere (``add_rgba``).
 
 Private to :mod:`flexsat.plots`.
 """
@@ -166,9 +167,8 @@ def frame_view(ax, lo: np.ndarray, hi: np.ndarray, *, min_depth: float = 0.3,
     ax.tick_params(labelsize=7)
 
 
-def _canvas_image(canvas) -> Image.Image:
-    size = canvas.get_width_height(physical=True)
-    return Image.frombuffer("RGBA", size, canvas.buffer_rgba(), "raw", "RGBA", 0, 1)
+def _rgba_image(size: tuple[int, int], rgba) -> Image.Image:
+    return Image.frombuffer("RGBA", size, rgba, "raw", "RGBA", 0, 1)
 
 
 class CanvasPillowWriter(PillowWriter):
@@ -184,7 +184,12 @@ class CanvasPillowWriter(PillowWriter):
         self.comment = comment
 
     def grab_frame(self, **savefig_kwargs) -> None:
-        self._frames.append(_canvas_image(self.fig.canvas).convert("RGB"))
+        self.add_rgba(self.fig.canvas.buffer_rgba())
+
+    def add_rgba(self, rgba) -> None:
+        """Append a frame rendered elsewhere: RGBA bytes of the figure's size."""
+        size = self.fig.canvas.get_width_height(physical=True)
+        self._frames.append(_rgba_image(size, rgba).convert("RGB"))
 
     def finish(self) -> None:
         # One palette for the whole GIF, from a few frames spread over the sequence:
@@ -210,4 +215,8 @@ class CanvasFFMpegWriter(FFMpegWriter):
         self.frame_format = "rgba"
 
     def grab_frame(self, **savefig_kwargs) -> None:
-        self._proc.stdin.write(bytes(self.fig.canvas.buffer_rgba()))
+        self.add_rgba(self.fig.canvas.buffer_rgba())
+
+    def add_rgba(self, rgba) -> None:
+        """Pipe a frame rendered elsewhere: RGBA bytes of the figure's size."""
+        self._proc.stdin.write(bytes(rgba))

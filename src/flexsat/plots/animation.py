@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import json
 import math
+import mmap
 import subprocess
 from dataclasses import dataclass
 from pathlib import Path
@@ -36,6 +37,7 @@ from matplotlib.figure import Figure
 
 from flexsat.dynamics.plant import Plant
 from flexsat.errors import FlexsatError
+from flexsat.parallel import figure_workers, forked_map
 from flexsat.plots._scene import (
     AXIS_COLOURS,
     CanvasFFMpegWriter,
@@ -320,6 +322,21 @@ def _time_format(frames: RunFrames) -> str:
     return f"{{:.{decimals}f}}"
 
 
+def _body_length(shots: list[SatelliteGeometry]) -> float:
+    """Drawn length of the hub body axes [m]."""
+    return _BODY_AXIS_SCALE * float(np.linalg.norm(shots[0].axes[0]))
+
+
+def _view_box(shots: list[SatelliteGeometry]) -> tuple[np.ndarray, np.ndarray]:
+    """Corners (lo, hi) of the box the view holds: every frame and the inertial axes [m]."""
+    inertial = _INERTIAL_SCALE * _body_length(shots)
+    lo, hi = np.full(3, -1.1 * inertial), np.full(3, 1.1 * inertial)
+    for g in shots:
+        glo, ghi = g.bounds()
+        lo, hi = np.minimum(lo, glo), np.maximum(hi, ghi)
+    return lo, hi
+
+
 def _draw_inertial_axes(ax, length: float) -> None:
     for k, colour in enumerate(AXIS_COLOURS):
         tip = np.zeros(3)
@@ -358,7 +375,9 @@ def write_animation(
     stated factor, hub body axes as coloured labelled arrows, inertial axes faint.
     The axes (metres) have one scale on X, Y and Z and limits fixed over the whole
     run. The title names the run and gives ``deformation ×N``; each frame shows
-    ``t = ... s`` and the hub Euler angles. 640 x 512 px, Agg, deterministic. A GIF
+    ``t = ... s`` and the hub Euler angles. 640 x 512 px, Agg, deterministic (the
+    frames are rendered by :func:`~flexsat.parallel.figure_workers` forked processes,
+    the same pixels as in one). A GIF
     gets one shared 255-colour palette and a comment
     ``"flexsat animation: deformation xN, K frames, t = t0..t1 s"`` (an MP4 the same
     as its ``comment`` metadata), so a file tells the magnification it shows.
@@ -411,52 +430,61 @@ def write_animation(
     path.parent.mkdir(parents=True, exist_ok=True)
 
     shots = [frames.geometry(k) for k in range(len(frames))]
-    fig = Figure(figsize=_FIGSIZE_IN, dpi=_DPI)
-    canvas = FigureCanvasAgg(fig)
-    ax = fig.add_axes((0.0, 0.04, 1.0, 0.84), projection="3d")
-    body_length = _BODY_AXIS_SCALE * float(np.linalg.norm(shots[0].axes[0]))
-    inertial = _INERTIAL_SCALE * body_length
-    lo, hi = np.full(3, -1.1 * inertial), np.full(3, 1.1 * inertial)
-    for g in shots:
-        glo, ghi = g.bounds()
-        lo, hi = np.minimum(lo, glo), np.maximum(hi, ghi)
-    frame_view(ax, lo, hi, min_depth=1.0, zoom=1.1)  # a cube: the body turns
-    _draw_inertial_axes(ax, inertial)
-    moving = SatelliteDrawing(ax, shots[0], colour="0.15", linewidth=1.2, fill=_PANEL_FILL,
-                              fill_alpha=0.75, hub_fill=_HUB_FILL, body_axes=True,
-                              axis_arrows=True, axis_scale=_BODY_AXIS_SCALE)  # fmt: skip
-    for line in moving.hub:
-        line.set_linewidth(0.7)
-    fig.suptitle(_title(result, frames), fontsize=9, y=0.985)
-    clock = fig.text(0.02, 0.85, "", fontsize=12, fontweight="bold", animated=True)
-    angles = fig.text(0.02, 0.815, "", fontsize=8, color="0.3", animated=True)
-    span = frames.time[-1] - frames.time[0]
-    speed = span / (len(frames) / int(fps)) if span > 0 else 0.0
-    fig.text(0.98, 0.85, f"{len(frames)} frames, playback {speed:.3g}× real time",
-             fontsize=7, color="0.45", ha="right")  # fmt: skip
-    when = _time_format(frames)
-    euler = np.degrees(frames.q[:, 3:6])
+    width, height = round(_FIGSIZE_IN[0] * _DPI), round(_FIGSIZE_IN[1] * _DPI)
+    # The frames are rendered by forked processes (figure_workers), each a contiguous
+    # run of them, into one anonymous shared mapping (RGBA rows, one per frame): no
+    # frame is pickled, and the writer takes them in order here.
+    shared = mmap.mmap(-1, len(shots) * height * width * 4)
+    movie = np.frombuffer(shared, dtype=np.uint8).reshape(len(shots), -1)
+    lo, hi = _view_box(shots)
 
-    for art in moving.artists():
-        art.set_animated(True)
-    canvas.draw()
-    background = canvas.copy_from_bbox(fig.bbox)
+    def render(chunk: np.ndarray) -> None:
+        fig = Figure(figsize=_FIGSIZE_IN, dpi=_DPI)
+        canvas = FigureCanvasAgg(fig)
+        ax = fig.add_axes((0.0, 0.04, 1.0, 0.84), projection="3d")
+        frame_view(ax, lo, hi, min_depth=1.0, zoom=1.1)  # a cube: the body turns
+        _draw_inertial_axes(ax, _INERTIAL_SCALE * _body_length(shots))
+        moving = SatelliteDrawing(ax, shots[0], colour="0.15", linewidth=1.2,
+                                  fill=_PANEL_FILL, fill_alpha=0.75, hub_fill=_HUB_FILL,
+                                  body_axes=True, axis_arrows=True,
+                                  axis_scale=_BODY_AXIS_SCALE)  # fmt: skip
+        for line in moving.hub:
+            line.set_linewidth(0.7)
+        fig.suptitle(_title(result, frames), fontsize=9, y=0.985)
+        clock = fig.text(0.02, 0.85, "", fontsize=12, fontweight="bold", animated=True)
+        angles = fig.text(0.02, 0.815, "", fontsize=8, color="0.3", animated=True)
+        span = frames.time[-1] - frames.time[0]
+        speed = span / (len(frames) / int(fps)) if span > 0 else 0.0
+        fig.text(0.98, 0.85, f"{len(frames)} frames, playback {speed:.3g}× real time",
+                 fontsize=7, color="0.45", ha="right")  # fmt: skip
+        when = _time_format(frames)
+        euler = np.degrees(frames.q[:, 3:6])
+        for art in moving.artists():
+            art.set_animated(True)
+        canvas.draw()
+        background = canvas.copy_from_bbox(fig.bbox)
+        for k in chunk:
+            canvas.restore_region(background)
+            moving.update(shots[k])
+            moving.draw(ax)
+            clock.set_text(f"t = {when.format(frames.time[k])} s")
+            roll, pitch, yaw = euler[k]
+            angles.set_text(f"roll {roll:+.1f}°  pitch {pitch:+.1f}°  yaw {yaw:+.1f}°")
+            fig.draw_artist(clock)
+            fig.draw_artist(angles)
+            movie[k] = np.frombuffer(canvas.buffer_rgba(), dtype=np.uint8).ravel()
+        fig.clear()
+
+    workers = min(figure_workers(), len(shots))
+    forked_map(render, np.array_split(np.arange(len(shots)), workers), workers)
+    sheet = Figure(figsize=_FIGSIZE_IN, dpi=_DPI)  # what the writer sizes the movie by
+    FigureCanvasAgg(sheet)
     try:
-        with writer.saving(fig, str(path), dpi=fig.dpi):
-            for k, geom in enumerate(shots):
-                canvas.restore_region(background)
-                moving.update(geom)
-                moving.draw(ax)
-                clock.set_text(f"t = {when.format(frames.time[k])} s")
-                roll, pitch, yaw = euler[k]
-                angles.set_text(f"roll {roll:+.1f}°  pitch {pitch:+.1f}°  yaw {yaw:+.1f}°")
-                fig.draw_artist(clock)
-                fig.draw_artist(angles)
-                writer.grab_frame()
+        with writer.saving(sheet, str(path), dpi=_DPI):
+            for rgba in movie:
+                writer.add_rgba(rgba)
     except (OSError, subprocess.CalledProcessError) as exc:  # ffmpeg failed, the pipe broke
         if path.suffix.lower() == ".gif":
             raise
         raise FlexsatError(f"ffmpeg could not write {path.name}: {exc}") from None
-    finally:
-        fig.clear()
     return path

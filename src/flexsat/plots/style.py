@@ -12,13 +12,12 @@ changes the global backend.
 - :func:`finish_time_axis`: grid, time limits and the time label of the bottom row.
 - :func:`positive`: values masked to the positive ones, for a log axis.
 - :func:`save_figure`, :func:`write_figures`: PNG files, one helper for every writer
-  (a set is drawn by :func:`figure_workers` forked processes).
+  (a set is drawn by :func:`figure_workers` forked processes, :func:`forked_map`,
+  both from :mod:`flexsat.parallel`).
 """
 
 from __future__ import annotations
 
-import multiprocessing
-import os
 from collections.abc import Callable, Iterable
 from pathlib import Path
 
@@ -26,6 +25,8 @@ import numpy as np
 import xarray as xr
 from matplotlib.axes import Axes
 from matplotlib.figure import Figure
+
+from flexsat.parallel import figure_workers, forked_map
 
 __all__ = [
     "AXES",
@@ -236,62 +237,6 @@ def save_figure(fig: Figure, path: str | Path, *, dpi: int) -> Path:
     fig.savefig(path, dpi=dpi)
     fig.clear()
     return path
-
-
-def figure_workers() -> int:
-    """Processes a figure set is drawn with: ``FLEXSAT_FIGURE_WORKERS``, else up to 2.
-
-    Drawing is pure Python in matplotlib (one core per process); two processes
-    halve a set's wall time on a 2-core machine. Processes are forked, so they
-    start in milliseconds with the data already in memory; where forking is not
-    available (Windows, macOS' default) figures are drawn in this process.
-    """
-    if "fork" not in multiprocessing.get_all_start_methods():
-        return 1
-    if multiprocessing.current_process().daemon:  # a pool's worker may not have children
-        return 1
-    given = os.environ.get("FLEXSAT_FIGURE_WORKERS")
-    if given is not None and given.strip().isdigit():
-        return max(1, int(given))
-    return max(1, min(2, os.cpu_count() or 1))
-
-
-_JOB: Callable | None = None  # the job of the running map, inherited by the forks
-
-
-def _run_job(item):
-    return _JOB(item)
-
-
-def forked_map(job: Callable, items: Iterable, workers: int | None = None) -> list:
-    """``[job(item) for item in items]``, by forked processes when there are several.
-
-    Parameters
-    ----------
-    job : callable
-        Called once per item; a closure is fine (forked processes inherit it, only
-        the items and the results are pickled).
-    items : iterable
-        The job's arguments.
-    workers : int, optional
-        Processes; default :func:`figure_workers`, at most one per item.
-
-    Returns
-    -------
-    list
-        The results, in the order of ``items``.
-    """
-    global _JOB
-    items = list(items)
-    workers = min(figure_workers() if workers is None else workers, len(items))
-    if workers <= 1:
-        return [job(item) for item in items]
-    _JOB = job
-    try:
-        with multiprocessing.get_context("fork").Pool(workers) as pool:
-            return pool.map(_run_job, items, chunksize=1)
-    finally:
-        _JOB = None
 
 
 def write_figures(

@@ -9,7 +9,9 @@ goes unstable, with the figure of the pointing and jitter figures against delay;
 drive (:func:`flexsat.dynamics.appendages.sadm.with_sadm`), the ideal loop with
 the drive holding its angle beside the drive turning at :data:`SADM_RATE_DEG_S`
 (``docs/control.md``, "Solar-array drive (SADM)"). Writes
-``avionics/avionics.json`` and ``avionics/delay_boundary.png``.
+``avionics/avionics.json`` and ``avionics/delay_boundary.png``. The runs of (a)
+and (b) are independent: they fly in forked processes side by side
+(:func:`flexsat.parallel.forked_map`).
 """
 
 from __future__ import annotations
@@ -24,7 +26,7 @@ from flexsat.dynamics.plant import Plant
 from flexsat.simulate import SlewScenario, run_slew
 
 __all__ = ["AVIONICS", "DELAYS_S", "QUICK_DELAYS_S", "SADM_DRIVE", "SADM_RATE_DEG_S",
-           "avionics_study", "render_avionics", "sadm_study"]
+           "avionics_study", "delayed", "render_avionics", "sadm_study"]
 
 AVIONICS = {
     "sensor_stages": [{"kind": "gyro"}, {"kind": "star_tracker"}, {"kind": "mekf"}],
@@ -48,6 +50,23 @@ _SADM_KEYS = ("array_angle_deg", "peak_drive_torque_nm", "peak_tracking_error_de
 UNSTABLE_POINTING_DEG = 1.0
 """A delayed run is called unstable when it diverged (stopped) or ends farther than
 this from the target (the nominal slew ends within 0.003 deg)."""
+
+
+def delayed(periods: int) -> dict:
+    """Slew scenario fields of the ideal loop with the torque command held back by
+    whole control periods (the ``delay`` actuator stage).
+
+    Parameters
+    ----------
+    periods : int
+        Control periods of delay [-].
+
+    Returns
+    -------
+    dict
+        The scenario fields [-].
+    """
+    return {"actuator_stages": [{"kind": "delay", "periods": periods}]}
 
 
 def _run(plant, fields: dict, duration_s: float | None):
@@ -130,17 +149,17 @@ def avionics_study(plant, out: str | Path, quick: bool = False,
     dict
         ``json`` and ``figures``: paths written.
     """
+    from flexsat.parallel import forked_map
+
     out = Path(out)
-    side_by_side = {"ideal": _metrics(plant, {}, duration_s),
-                    "avionics": _metrics(plant, AVIONICS, duration_s)}
-    delays = QUICK_DELAYS_S if quick else DELAYS_S
     control_dt = SlewScenario().control_dt_s
+    periods = [round(delay / control_dt) for delay in (QUICK_DELAYS_S if quick else DELAYS_S)]
+    runs = [{}, AVIONICS, *(delayed(n) for n in periods)]
+    ideal, avionics, *swept = forked_map(lambda fields: _metrics(plant, fields, duration_s), runs)
+    side_by_side = {"ideal": ideal, "avionics": avionics}
     sweep = []
-    for delay in delays:
-        periods = round(delay / control_dt)
-        fields = {"actuator_stages": [{"kind": "delay", "periods": periods}]}
-        row = _metrics(plant, fields, duration_s)
-        row["delay_s"] = periods * control_dt
+    for n, row in zip(periods, swept, strict=True):
+        row["delay_s"] = n * control_dt
         row["unstable"] = row["status"] != "ok" or not (
             row["final_pointing_error_deg"] < UNSTABLE_POINTING_DEG)  # fmt: skip
         sweep.append(row)

@@ -10,7 +10,8 @@ energy and the residual elastic energy (``docs/control.md``, "Comparing the laws
 over the campaigns"). The full study flies every case into a store per campaign
 and variant (``campaigns/<campaign>-<variant>``; the default law's is the
 campaigns part's own, resumed); the quick study flies the first
-:data:`QUICK_CASES` case(s) of each campaign in-process.
+:data:`QUICK_CASES` case(s) of each campaign, each distinct case once, in forked
+processes side by side.
 """
 
 from __future__ import annotations
@@ -116,15 +117,26 @@ def _with_base(definition, overrides: dict):
     return validate_config(data, source="law comparison", model=CampaignDefinition)
 
 
-def _rows(definition, config, store: Path | None, workers: int | None, progress: bool):
-    """The case rows: every case into ``store``, or the first QUICK_CASES in-process."""
+def _quick_rows(definitions: dict, config) -> dict:
+    """The first QUICK_CASES case rows of each definition, flown in forked processes
+    side by side; a case several definitions share (same digest of its plant and
+    scenario: the nominal opens both the sensitivity and the critical-case sets)
+    flies once."""
     from flexsat.campaigns import resolve_cases
     from flexsat.campaigns.runner import run_case
+    from flexsat.parallel import forked_map
+
+    cases = {key: resolve_cases(d, config)[:QUICK_CASES] for key, d in definitions.items()}
+    unique = {case.digest: case for chosen in cases.values() for case in chosen}
+    flown = dict(zip(unique, forked_map(run_case, unique.values()), strict=True))
+    return {key: [flown[case.digest] for case in chosen] for key, chosen in cases.items()}
+
+
+def _stored_rows(definition, config, store: Path, workers: int | None, progress: bool):
+    """Every case of ``definition`` into ``store`` (resumed), and their rows."""
     from flexsat.campaigns.store import CampaignStore
     from flexsat.study.outputs import fly_campaign
 
-    if store is None:
-        return [run_case(case) for case in resolve_cases(definition, config)[:QUICK_CASES]]
     fly_campaign(definition, config, store, progress=progress, workers=workers, resume=True)
     return CampaignStore(store).rows()
 
@@ -166,14 +178,20 @@ def law_comparison(
 
     variants = _variants(laws, default_law)
     payload: dict = {"quick": quick, "variants": list(variants), "campaigns": {}}
+    definitions = {}
     for name in campaigns or CAMPAIGNS:
         base = load_campaign(name)
-        per_variant = {}
         for variant, overrides in variants.items():
-            folder = name if not overrides else f"{name}-{variant}"
-            store = None if quick else out / "campaigns" / folder
-            rows = _rows(_with_base(base, overrides), config, store, workers, progress)
-            per_variant[variant] = law_statistics(rows)
-        payload["campaigns"][name] = per_variant
+            definitions[name, variant] = _with_base(base, overrides)
+    if quick:
+        rows = _quick_rows(definitions, config)
+    else:  # the default law's folder is the campaigns part's own store
+        rows = {}
+        for (name, variant), definition in definitions.items():
+            folder = name if not variants[variant] else f"{name}-{variant}"
+            rows[name, variant] = _stored_rows(definition, config, out / "campaigns" / folder,
+                                               workers, progress)  # fmt: skip
+    for (name, variant), chosen in rows.items():
+        payload["campaigns"].setdefault(name, {})[variant] = law_statistics(chosen)
     write_json(out / "laws" / "laws.json", payload)
     return payload

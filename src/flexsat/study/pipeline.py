@@ -27,6 +27,7 @@ from rich.markup import escape
 from flexsat import __version__
 from flexsat.config.models import SatelliteConfig
 from flexsat.control.laws import LAWS
+from flexsat.parallel import forked_map
 from flexsat.study.outputs import (
     derived_properties,
     fly_campaign,
@@ -140,12 +141,13 @@ def _openloop(ctx: StudyContext) -> dict:
     return {"json": files[-1], "result": files[0], "figures": files[1:-1]}
 
 
-def _slew_with(ctx: StudyContext, kind: str, figures: bool = True) -> dict:
+def _slew_with(ctx: StudyContext, kind: str, figures: bool = True, progress=None) -> dict:
     from flexsat.simulate import SlewScenario
 
     scenario = SlewScenario.model_validate({"controller": {"kind": kind}})
     out = ctx.out / "slew" / kind
-    result, metrics = fly_slew(ctx.plant, scenario, out, ctx.progress, figures=figures)
+    progress = ctx.progress if progress is None else progress
+    result, metrics = fly_slew(ctx.plant, scenario, out, progress, figures=figures)
     result.raise_for_status()
     files = _relative(ctx, metrics["files"])
     return {"json": files[-1], "result": files[0], "figures": files[1:-1]}
@@ -161,8 +163,11 @@ def _comparison(ctx: StudyContext) -> dict:
 
     runs = {LAWS.default: ctx.results["slew"]}
     # The report shows the comparison figure; each law's own figure set is drawn in
-    # the full study only (flexsat slew --out draws it for one law).
-    runs.update({kind: _slew_with(ctx, kind, figures=not ctx.quick) for kind in ctx.laws[1:]})
+    # the full study only (flexsat slew --out draws it for one law). The laws fly in
+    # forked processes side by side (no progress bars: they would interleave).
+    others = ctx.laws[1:]
+    flown = forked_map(lambda kind: _slew_with(ctx, kind, not ctx.quick, False), others)
+    runs.update(zip(others, flown, strict=True))
     datasets = {
         kind: Result.from_netcdf(ctx.out / run["result"]).dataset for kind, run in runs.items()
     }
@@ -310,11 +315,16 @@ def run_study(
 def _compile(ctx: StudyContext, console: Console) -> float:
     """Compile (or load from the disk cache) every kernel the study runs, up front.
 
-    A 20 ms open-loop run and a 20 ms slew per law compiled loop; the parts' wall
+    A 20 ms open-loop run and a 20 ms slew per compiled loop the parts fly: one per
+    law, the avionics chain, the delay stage and the hybrid damping; the parts' wall
     times then exclude compilation, which the manifest gives apart
-    (``compilation_s``). Returns its wall time [s].
+    (``compilation_s``), and the forked processes the parts fly their runs in
+    inherit the compiled loops instead of each compiling them. Returns its wall
+    time [s].
     """
     from flexsat.simulate import OpenLoopScenario, SlewScenario, run_openloop, run_slew
+    from flexsat.study.avionics import AVIONICS, delayed
+    from flexsat.study.laws import HYBRID_DAMPING
 
     console.print("compiling the simulation kernels (the first run only; later runs load "
                   "them from the disk cache)...", highlight=False)  # fmt: skip
@@ -322,9 +332,10 @@ def _compile(ctx: StudyContext, console: Console) -> float:
     short = {"duration_s": 0.02, "record_dt_s": 0.01}
     try:
         run_openloop(ctx.plant, OpenLoopScenario.model_validate(short), progress=False)
-        for kind in ctx.laws:
-            scenario = SlewScenario.model_validate({**short, "controller": {"kind": kind}})
-            run_slew(ctx.plant, scenario, progress=False)
+        loops = [{"controller": {"kind": kind}} for kind in ctx.laws]
+        loops += [AVIONICS, delayed(1), {"joint_actuator": HYBRID_DAMPING}]
+        for fields in loops:
+            run_slew(ctx.plant, SlewScenario.model_validate({**short, **fields}), progress=False)
     except Exception:  # the part that needs it reports the problem
         pass
     elapsed = time.perf_counter() - start
