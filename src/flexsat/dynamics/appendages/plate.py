@@ -15,6 +15,11 @@ absolute accelerations follow from its own Newton-Euler equations under the join
 wrench (pass 1), the hub's from its own equations (the engine), and q_ddot from the
 relative kinematics (pass 2). Cost is linear in the number of plates.
 
+A plate with locked joint DOFs (``locked_dofs``) holds them itself
+(``holds_locked``): its joint then has fewer than 6 DOFs and transmits the
+articulated inertia of its locked directions; pass 1 and 2 solve the joint's
+Newton-Euler equations on its free DOFs (docs/model.md, 'Locked coordinates').
+
 Compiled with ``error_model="numpy"`` (see :mod:`flexsat.dynamics.kernels`): no
 divisor can be zero, masses are validated positive and ``cos(rho_y)`` is checked
 against ``MIN_COS`` before any ``euler_rate_matrix_inv``.
