@@ -23,20 +23,27 @@ def _locked(names: list[str]) -> Plant:
     return Plant.from_config(SatelliteConfig.model_validate(data))
 
 
-def test_locked_accelerations_solve_the_free_rows_of_the_full_equations():
+@pytest.mark.parametrize(
+    "names",
+    [TRANSLATIONS, ["eta_ry"], ["eta_y", "eta_rz"], ["eta_x", "eta_rx", "eta_ry", "eta_rz"]],
+)
+def test_locked_accelerations_solve_the_free_rows_of_the_full_equations(names):
     # Independent formulation: M_ff q_ddot_f = (Q - h - C q_dot - k_el)_f from the
-    # plant's assembled M(q), h(q, q_dot), K and C (eqs. 2.39-2.47), numpy's solve.
-    # The kernel instead projects the articulated-body q_ddot with M(q) alone; both
-    # are rounding apart: 1e-12 relative (measured 7e-16; 18 x 18 solves of a matrix
-    # with condition number ~1e3).
-    reduced, full = _locked(TRANSLATIONS), Plant.from_config(nominal())
+    # plant's assembled M(q), h(q, q_dot), K and C (eqs. 2.39-2.47), numpy's solve,
+    # and the constraint forces lambda_L = (M q_ddot + h - F)_L. The plate's kernels
+    # instead solve the locked joint's Newton-Euler equations on its free subspace;
+    # both are rounding apart: 1e-12 relative (measured at most 3e-15 for q_ddot;
+    # 18 x 18 solves of a matrix with condition number ~1e3). lambda is a difference
+    # of forces ~100x larger than it for a single locked rotation: 1e-11 (measured 3e-14).
+    reduced, full = _locked(names), Plant.from_config(nominal())
     rng = np.random.default_rng(18)
     locked = list(reduced.locked_coordinates())
-    assert locked == [6, 7, 8, 12, 13, 14]
+    if names == TRANSLATIONS:
+        assert locked == [6, 7, 8, 12, 13, 14]
     free = [i for i in range(full.n_dof) if i not in locked]
     for _ in range(5):
         q, qd, Q = (0.1 * rng.normal(size=full.n_dof) for _ in range(3))
-        q[locked] = qd[locked] = 0.0
+        q[locked], qd[locked] = 0.05 * rng.normal(size=len(locked)), 0.0  # held off zero
         force = Q - full.bias_forces(q, qd) - full.elastic_forces(q) - full.damping_forces(qd)
         M = full.mass_matrix(q)
         expected = np.zeros(full.n_dof)
@@ -44,6 +51,18 @@ def test_locked_accelerations_solve_the_free_rows_of_the_full_equations():
         got = reduced.accelerations(q, qd, Q)
         assert np.max(np.abs(got - expected)) <= 1e-12 * np.max(np.abs(expected))
         assert np.all(got[locked] == 0.0)
+        reaction = (M @ expected - force)[locked]
+        lam = reduced.packed.reaction[1][locked]
+        assert np.max(np.abs(lam - reaction)) <= 1e-11 * np.max(np.abs(reaction))
+
+
+def test_the_plate_holds_its_locks_without_the_engine_projection():
+    # The plate's kernels hold its locked DOFs (docs/model.md, 'Locked coordinates'):
+    # no M(q) projection is packed, the 6 x 6 hub solve takes the locked joints'
+    # articulated inertia.
+    packed = _locked(TRANSLATIONS).packed
+    assert not packed.locked and packed.constrained and packed.articulated
+    assert packed.held.tolist() == [6, 7, 8, 12, 13, 14]
 
 
 def test_every_joint_locked_is_the_rigid_satellite():
@@ -63,7 +82,8 @@ def test_every_joint_locked_is_the_rigid_satellite():
 
 def test_nothing_locked_packs_no_projection():
     packed = Plant.from_config(nominal()).packed
-    assert not packed.locked and packed.free.size == 18
+    assert not packed.locked and not packed.constrained and packed.free.size == 18
+    assert not packed.articulated  # free plates transmit no inertia
 
 
 @pytest.mark.parametrize(

@@ -89,8 +89,10 @@ def finite_part(ds: xr.Dataset) -> xr.Dataset:
     bad = np.zeros(ds.sizes["time"], dtype=bool)
     for var in ds.data_vars.values():
         if "time" in var.dims and np.issubdtype(var.dtype, np.floating):
-            values = var.transpose("time", ...).values.reshape(ds.sizes["time"], -1)
+            by_time = var if var.dims[0] == "time" else var.transpose("time", ...)
+            values = by_time.values.reshape(ds.sizes["time"], -1)
             values = values[:, np.isfinite(values[0])]
             bad |= ~np.isfinite(values).all(axis=1)
-    first_bad = int(np.argmax(bad)) if bad.any() else ds.sizes["time"]
-    return ds.isel(time=slice(0, max(first_bad, 1)))
+    if not bad.any():
+        return ds  # a finite run: nothing to cut (and no copy)
+    return ds.isel(time=slice(0, max(int(np.argmax(bad)), 1)))

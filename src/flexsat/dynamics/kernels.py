@@ -192,9 +192,23 @@ def accelerations(q, qd, Q, packed, qdd):
         )
         if status != STATUS_OK:
             return status
+    if packed.constrained:
+        _constraint_forces(packed, qdd)
     if packed.locked:
         _hold_locked(q, packed, qdd)
     return STATUS_OK
+
+
+@njit(cache=True, error_model="numpy")
+def _constraint_forces(packed, qdd):
+    """Move the constraint forces the models that hold their locked coordinates left
+    in those rows of q_ddot to ``packed.reaction[1]`` (the other rows zero) and hold
+    the rows at 0 (docs/model.md, 'Locked coordinates')."""
+    reaction = packed.reaction[1]
+    reaction[:] = 0.0
+    for i in packed.held:
+        reaction[i] = qdd[i]
+        qdd[i] = 0.0
 
 
 @njit(cache=True, error_model="numpy")
@@ -206,7 +220,9 @@ def _hold_locked(q, packed, qdd):
     M_ff q_ddot_f = F_f - h_f = (M q_ddot_u)_f, where q_ddot_u (in ``qdd``) solved the
     unconstrained M q_ddot_u + h = F at the same state: no model term beyond M(q) is
     needed. M_ff is symmetric positive definite: Gaussian elimination without pivoting.
-    As a side result ``packed.reaction[1]`` holds the constraint forces lambda.
+    The same holds when ``qdd`` already has the coordinates of models that hold their
+    locks at zero (their constraint forces act on locked rows only). As a side result
+    the constraint forces lambda are added to ``packed.reaction[1]``.
     """
     M, A, free, unconstrained = packed.mass, packed.reduced, packed.free, packed.reaction[0]
     mass_matrix(q, packed, M)
@@ -236,13 +252,12 @@ def _hold_locked(q, packed, qdd):
     # lambda = M (q_ddot - q_ddot_u) on the locked rows (zero on the free ones, to
     # within rounding): the force the locked joints carry, reported in tau_flex.
     reaction = packed.reaction[1]
-    reaction[:] = 0.0
     for i in range(n):
         if not packed.is_free[i]:
             s = 0.0
             for j in range(n):
                 s += M[i, j] * (qdd[j] - unconstrained[j])
-            reaction[i] = s
+            reaction[i] += s
 
 
 @njit(cache=True, error_model="numpy")

@@ -41,8 +41,14 @@ class PackedPlant(NamedTuple):
         every evaluation; slots in the contract module) [SI per slot].
     solve : ndarray, shape (6, 7)
         Scratch of the 6 x 6 hub solve [SI].
+    constrained : bool
+        True if some appendage coordinates are locked (held at their initial value) [-];
+        ``reaction[1]`` then holds their constraint forces.
+    held : ndarray, shape (n_held,), int64
+        Indices [-] of the locked coordinates whose model holds them itself (``holds_locked``): its
+        pass 2 leaves their constraint forces in ``qdd``.
     locked : bool
-        True if some appendage coordinates are locked (held at their initial value):
+        True if some locked coordinates belong to a model that does not hold them:
         q_ddot is then projected on the free coordinates (:mod:`flexsat.dynamics.kernels`).
     free : ndarray, shape (n_free,), int64
         Indices of the free coordinates (all of them when nothing is locked) [-].
@@ -75,6 +81,8 @@ class PackedPlant(NamedTuple):
     articulated: bool
     hub: np.ndarray
     solve: np.ndarray
+    constrained: bool
+    held: np.ndarray
     locked: bool
     free: np.ndarray
     mass: np.ndarray

@@ -146,16 +146,24 @@ class Plant:
         hub_J = np.ascontiguousarray(self.hub_J, dtype=float)
         locked = self.locked_coordinates()
         free = np.array([i for i in range(self.layout.n_dof) if i not in locked], dtype=np.int64)
-        size = (self.layout.n_dof, free.size) if locked else (1, 1)
+        blocks = enumerate(self.layout.blocks)
+        owner = {i: k for k, b in blocks for i in range(b.offset, b.offset + b.count)}
+        held = [i for i in locked if self.models[owner[i]].holds_locked]
+        projected = len(held) < len(locked)  # some model leaves its locks to the engine
+        size = (self.layout.n_dof, free.size) if projected else (1, 1)
+        locking = {owner[i] for i in held}  # a joint holding locks transmits inertia
         return PackedPlant(
             n_dof=self.layout.n_dof,
             hub_mass=self.hub_mass,
             hub_J=hub_J,
             hub_J_inv=np.linalg.inv(hub_J),
-            articulated=any(m.transmits_inertia for m in self.models),
+            articulated=any(m.transmits_inertia or k in locking
+                            for k, m in enumerate(self.models)),
             hub=np.zeros(HUB_SIZE),
             solve=np.zeros((6, 7)),
-            locked=bool(locked),
+            constrained=bool(locked),
+            held=np.array(held, dtype=np.int64),
+            locked=projected,
             free=free,
             mass=np.zeros((size[0], size[0])),
             reduced=np.zeros((size[1], size[1] + 1)),

@@ -79,7 +79,7 @@ def derive_records(
         Q[3], Q[4], Q[5] = mtv(S, load_seg(tau_B[k], 0))
         status = accelerations(qk, qdk, Q, packed, qdd)
         # a locked joint carries its constraint force (left by accelerations)
-        joint = packed.reaction[1] if packed.locked else no_external
+        joint = packed.reaction[1] if packed.constrained else no_external
         status |= hub_joint_wrench(qk, qdk, joint, packed, wrench)
         if status == STATUS_OK:
             bias = euler_rate_bias(qk[3], qk[4], qdk[3], qdk[4], qdk[5])

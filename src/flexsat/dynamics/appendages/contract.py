@@ -207,6 +207,14 @@ class AppendageModel(ABC):
     transmits_inertia : bool
         False for a model on a full 6-DOF joint (the engine then skips the 6 x 6
         hub solve); True when ``pass1`` adds an articulated inertia.
+    holds_locked : bool
+        True when the model's kernels hold its locked coordinates themselves
+        (docs/model.md, 'Locked coordinates'): :meth:`pack` marks them in the row,
+        ``pass1`` then adds the locked joint's articulated inertia (the engine runs
+        the 6 x 6 hub solve for a plant with such a member) and ``pass2`` leaves in
+        each locked row of ``qdd`` its constraint force lambda, which the engine
+        moves to the plant's constraint forces and replaces by 0. False (default):
+        the engine projects the kernels' unconstrained answer with M(q).
     work_size : int
         Columns of the scratch rows ``work`` that pass 1 may leave for pass 2 (see
         :meth:`work_columns` for a scratch that grows with the appendage).
@@ -220,6 +228,7 @@ class AppendageModel(ABC):
     config_class: ClassVar[type[BaseModel]]
     kernels: ClassVar[AppendageKernels]
     transmits_inertia: ClassVar[bool] = False
+    holds_locked: ClassVar[bool] = False
     modifiers: ClassVar[dict[str, Callable[[dict, float], None]]] = {}
     work_size: ClassVar[int] = 0
 

@@ -15,6 +15,11 @@ absolute accelerations follow from its own Newton-Euler equations under the join
 wrench (pass 1), the hub's from its own equations (the engine), and q_ddot from the
 relative kinematics (pass 2). Cost is linear in the number of plates.
 
+A plate with locked joint DOFs (``locked_dofs``) holds them itself
+(``holds_locked``): its joint then has fewer than 6 DOFs and transmits the
+articulated inertia of its locked directions; pass 1 and 2 solve the joint's
+Newton-Euler equations on its free DOFs (docs/model.md, 'Locked coordinates').
+
 Compiled with ``error_model="numpy"`` (see :mod:`flexsat.dynamics.kernels`): no
 divisor can be zero, masses are validated positive and ``cos(rho_y)`` is checked
 against ``MIN_COS`` before any ``euler_rate_matrix_inv``.
@@ -36,6 +41,7 @@ from flexsat.dynamics.appendages.contract import (
     HUB_ALPHA,
     HUB_DISSIPATION,
     HUB_FORCE,
+    HUB_INERTIA,
     HUB_OMEGA,
     HUB_SBIAS,
     HUB_TORQUE,
@@ -94,7 +100,8 @@ P_J_INV = 25  # (9) its inverse
 P_K = 34  # (6) joint stiffness per DOF [N/m, N m/rad] (eq. 2.14)
 P_C = 40  # (6) joint damping per DOF [N s/m, N m s/rad] (eq. 2.15)
 P_TIP = 46  # (3) panel tip (mid-chord of the free edge), panel frame [m]
-N_PARAMS = 49
+P_LOCKED = 49  # (6) 1.0 where the joint DOF is locked (``locked_dofs``), else 0.0
+N_PARAMS = 55
 
 MIN_COS = 1e-9  # |cos(rho_y)| below this is treated as gimbal lock
 
@@ -128,15 +135,8 @@ def _rates(qd, o, p, R_BM, R_BP, S_rho):
 
 
 @njit(cache=True, error_model="numpy")
-def _joint_wrench(q, qd, Q, o, p):
-    """Joint wrench on the plate from its elastic, damping and external generalized forces.
-
-    By virtual work the 6 generalized forces on (eta, rho) are a force F_M at the
-    root (mount frame) and a torque N_P (panel frame) on the panel, with the
-    opposite pair on the hub: F_M = Q_eta, N_P = S(rho)^-T Q_rho.
-    Returns F_M, N_P, S(rho)^-1 and a status flag (S(rho)^-1 is undefined on a
-    gimbal lock).
-    """
+def _joint_forces(q, qd, Q, o, p):
+    """Elastic, damping and external generalized forces on the joint (Q_eta, Q_rho)."""
     k, c = P_K, P_C
     Q_eta = (
         Q[o] - p[k] * q[o] - p[c] * qd[o],
@@ -148,6 +148,20 @@ def _joint_wrench(q, qd, Q, o, p):
         Q[o + 4] - p[k + 4] * q[o + 4] - p[c + 4] * qd[o + 4],
         Q[o + 5] - p[k + 5] * q[o + 5] - p[c + 5] * qd[o + 5],
     )
+    return Q_eta, Q_rho
+
+
+@njit(cache=True, error_model="numpy")
+def _joint_wrench(q, qd, Q, o, p):
+    """Joint wrench on the plate from its elastic, damping and external generalized forces.
+
+    By virtual work the 6 generalized forces on (eta, rho) are a force F_M at the
+    root (mount frame) and a torque N_P (panel frame) on the panel, with the
+    opposite pair on the hub: F_M = Q_eta, N_P = S(rho)^-T Q_rho.
+    Returns F_M, N_P, S(rho)^-1 and a status flag (S(rho)^-1 is undefined on a
+    gimbal lock).
+    """
+    Q_eta, Q_rho = _joint_forces(q, qd, Q, o, p)
     if abs(cos(q[o + 4])) < MIN_COS:
         undefined = ((0.0, 0.0, 0.0), (0.0, 0.0, 0.0), (0.0, 0.0, 0.0))
         return Q_eta, Q_rho, undefined, STATUS_JOINT_GIMBAL_LOCK
@@ -177,7 +191,6 @@ W_OMEGA_REL = 12  # (3) omega_rel_P [rad/s]
 W_RDOT_G = 15  # (3) B-frame rate of r_G [m/s]
 W_S_INV = 18  # (9) S(rho)^-1, row-major
 W_RHO_BIAS = 27  # (3) S_dot(rho) rho_dot
-WORK_SIZE = 30
 
 
 @njit(cache=True, error_model="numpy")
@@ -189,6 +202,163 @@ def _store(w, k, v):
 def _store_m33(w, k, m):
     for a in range(3):
         w[k + 3 * a], w[k + 3 * a + 1], w[k + 3 * a + 2] = m[a]
+
+
+# Scratch of a member with locked joint DOFs (docs/model.md, 'Locked coordinates'):
+# z = (eta_ddot, rho_ddot) of its joint, J^T I_P J z + K A_hub = r + E lambda.
+W_MZ = 30  # (36) Mz = J^T I_P J, the joint's generalized mass, row-major 6 x 6
+W_K = 66  # (36) K = J^T I_P X, its coupling to the hub acceleration A_hub, row-major
+W_RV = 102  # (6) r = tau + J^T (b - I_P c): joint forces and velocity terms
+W_FREE = 108  # (6) the free DOFs' indices (0-5), as floats
+W_NF = 114  # (1) number of free DOFs
+W_SOLVE = 115  # (78) [Mz_FF | K_F | r_F], n_free rows, then D^-1 [K_F | r_F] in place
+W_WRENCH = 193  # (6) its wrench on the hub at A_hub = 0, [force_B, torque_B]
+WORK_SIZE = 199
+
+
+@njit(cache=True, error_model="numpy")
+def _add6(w, k, r0, c0, A, s):
+    """w[k + 6 (r0 + a) + c0 + b] += s A[a][b]: a 3 x 3 block of a row-major 6 x 6 at w[k]."""
+    for a in range(3):
+        for b in range(3):
+            w[k + 6 * (r0 + a) + c0 + b] += s * A[a][b]
+
+
+@njit(cache=True, error_model="numpy")
+def _is_locked(p):
+    for k in range(6):
+        if p[P_LOCKED + k] != 0.0:
+            return True
+    return False
+
+
+@njit(cache=True, error_model="numpy")
+def _locked_pass1(q, qd, Q, o, p, w, hub):
+    """Pass 1 of a plate whose joint has locked DOFs: articulated inertia and bias wrench.
+
+    The panel's absolute acceleration A_P = (a_G in B, alpha_P in P) is
+    X A_hub + J z + c, with A_hub = (a_hub_B, omega_dot_B), z = (eta_ddot, rho_ddot),
+    X = [[I, -[r_G]x], [0, R_BP^T]], J = [[R_BM, -R_BP [d]x S(rho)], [0, S(rho)]] and c
+    the velocity terms. Its Newton-Euler equations I_P A_P = J^-T (tau + E lambda) + b
+    (b the gyroscopic moment), projected by J^T, give Mz z + K A_hub = r + E lambda.
+    On the free rows F (z_L = 0): z_F = D^-1 (r_F - K_F A_hub), D = Mz_FF, so the hub
+    sees the articulated inertia X^T I_P X - K_F^T D^-1 K_F (added to ``hub``) and, at
+    A_hub = 0, the wrench X^T u - K_F^T D^-1 r_F with u = b - I_P c (into
+    ``w[W_WRENCH:]``). Returns a status.
+    """
+    R_BM, R_MP, R_BP, S_rho, r_P, r_G = _pose(q, o, p)
+    omega_rel_P, rdot_G_rel = _rates(qd, o, p, R_BM, R_BP, S_rho)
+    if abs(cos(q[o + 4])) < MIN_COS:
+        return STATUS_JOINT_GIMBAL_LOCK
+    Q_eta, Q_rho = _joint_forces(q, qd, Q, o, p)
+    omega_B = load_seg(hub, HUB_OMEGA)
+    m = p[P_MASS]
+    d = load_seg(p, P_COM)
+    J_p = load_m33_at(p, P_J)
+    omega_B_P = mtv(R_BP, omega_B)
+    omega_P = add(omega_B_P, omega_rel_P)
+    rho_bias = euler_rate_bias(q[o + 3], q[o + 4], qd[o + 3], qd[o + 4], qd[o + 5])
+    c_a = add(
+        add(cross(omega_B, cross(omega_B, r_G)), scale(2.0, cross(omega_B, rdot_G_rel))),
+        mv(R_BP, add(cross(rho_bias, d), cross(omega_rel_P, cross(omega_rel_P, d)))),
+    )
+    c_alpha = sub(rho_bias, cross(omega_rel_P, omega_B_P))
+    u_a = scale(-m, c_a)
+    u_w = scale(-1.0, add(cross(omega_P, mv(J_p, omega_P)), mv(J_p, c_alpha)))
+    J_t = scale_m(-1.0, mm(R_BP, mm(skew(d), S_rho)))  # d v_G / d rho_dot
+    G = skew(r_G)
+    R_MB = transpose(R_BM)
+    identity = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
+    w[W_MZ : W_MZ + 72] = 0.0  # Mz and K
+    _add6(w, W_MZ, 0, 0, identity, m)
+    _add6(w, W_MZ, 0, 3, mm(R_MB, J_t), m)
+    _add6(w, W_MZ, 3, 0, mtm(J_t, R_BM), m)
+    _add6(w, W_MZ, 3, 3, mtm(J_t, J_t), m)
+    _add6(w, W_MZ, 3, 3, mtm(S_rho, mm(J_p, S_rho)), 1.0)
+    _add6(w, W_K, 0, 0, R_MB, m)
+    _add6(w, W_K, 0, 3, mm(R_MB, G), -m)
+    _add6(w, W_K, 3, 0, transpose(J_t), m)
+    _add6(w, W_K, 3, 3, mtm(J_t, G), -m)
+    _add6(w, W_K, 3, 3, mtm(S_rho, mm(J_p, transpose(R_BP))), 1.0)
+    g_eta = mtv(R_BM, u_a)
+    g_rho = add(mtv(J_t, u_a), mtv(S_rho, u_w))
+    for a in range(3):
+        w[W_RV + a] = Q_eta[a] + g_eta[a]
+        w[W_RV + 3 + a] = Q_rho[a] + g_rho[a]
+    nf = 0
+    for k in range(6):
+        if p[P_LOCKED + k] == 0.0:
+            w[W_FREE + nf] = k
+            nf += 1
+    w[W_NF] = nf
+    # [D | K_F | r_F], eliminated without pivoting (D is symmetric positive definite).
+    nc = nf + 7
+    A = W_SOLVE
+    for r in range(nf):
+        i = int(w[W_FREE + r])
+        for c in range(nf):
+            w[A + nc * r + c] = w[W_MZ + 6 * i + int(w[W_FREE + c])]
+        for b in range(6):
+            w[A + nc * r + nf + b] = w[W_K + 6 * i + b]
+        w[A + nc * r + nf + 6] = w[W_RV + i]
+    for piv in range(nf):
+        for r in range(piv + 1, nf):
+            f = w[A + nc * r + piv] / w[A + nc * piv + piv]
+            for c in range(piv, nc):
+                w[A + nc * r + c] -= f * w[A + nc * piv + c]
+    for r in range(nf - 1, -1, -1):
+        for j in range(nf, nc):
+            s = w[A + nc * r + j]
+            for c in range(r + 1, nf):
+                s -= w[A + nc * r + c] * w[A + nc * c + j]
+            w[A + nc * r + j] = s / w[A + nc * r + r]
+    # The panel's spatial inertia about the hub centre of mass, X^T I_P X, less the
+    # free rows' Schur term K_F^T D^-1 K_F.
+    H = HUB_INERTIA
+    _add6(hub, H, 0, 0, identity, m)
+    _add6(hub, H, 0, 3, G, -m)
+    _add6(hub, H, 3, 0, G, m)
+    _add6(hub, H, 3, 3, mm(G, G), -m)
+    _add6(hub, H, 3, 3, mm(R_BP, mm(J_p, transpose(R_BP))), 1.0)
+    Xu = add(cross(r_G, u_a), mv(R_BP, u_w))
+    wrench = (u_a[0], u_a[1], u_a[2], Xu[0], Xu[1], Xu[2])
+    for a in range(6):
+        s = wrench[a]
+        for r in range(nf):
+            k_ra = w[W_K + 6 * int(w[W_FREE + r]) + a]
+            s -= k_ra * w[A + nc * r + nf + 6]
+            for b in range(6):
+                hub[H + 6 * a + b] -= k_ra * w[A + nc * r + nf + b]
+        w[W_WRENCH + a] = s
+    return STATUS_OK
+
+
+@njit(cache=True, error_model="numpy")
+def _locked_pass2(o, w, hub, qdd):
+    """z_F = D^-1 (r_F - K_F A_hub) on the free rows; on the locked rows the constraint
+    force lambda_L = (Mz z)_L + K_L A_hub - r_L (the engine moves it out of ``qdd``)."""
+    nf = int(w[W_NF])
+    nc = nf + 7
+    A = W_SOLVE
+    for k in range(6):
+        qdd[o + k] = 0.0
+    for r in range(nf):
+        z = w[A + nc * r + nf + 6]
+        for b in range(6):  # A_hub = hub[HUB_ACC : HUB_ACC + 6] (HUB_ALPHA follows HUB_ACC)
+            z -= w[A + nc * r + nf + b] * hub[HUB_ACC + b]
+        qdd[o + int(w[W_FREE + r])] = z
+    free = 0
+    for k in range(6):
+        if free < nf and int(w[W_FREE + free]) == k:
+            free += 1
+            continue
+        s = -w[W_RV + k]
+        for c in range(6):
+            s += w[W_K + 6 * k + c] * hub[HUB_ACC + c]
+        for r in range(nf):
+            i = int(w[W_FREE + r])
+            s += w[W_MZ + 6 * k + i] * qdd[o + i]
+        qdd[o + k] = s
 
 
 @njit(PASS1_SIGNATURE, cache=True, error_model="numpy")
@@ -206,6 +376,16 @@ def pass1(q, qd, Q, members, params, work, hub, qdd):
         o = members[j, 1]
         p = params[j]
         w = work[j]
+        if _is_locked(p):
+            status = _locked_pass1(q, qd, Q, o, p, w, hub)
+            if status != STATUS_OK:
+                return status
+            force_B = add(force_B, load_seg(w, W_WRENCH))
+            torque_B = add(torque_B, load_seg(w, W_WRENCH + 3))
+            for k in range(6):
+                v = qd[o + k]
+                dissipated += p[P_C + k] * v * v  # q_dot^T C q_dot (eq. 2.36)
+            continue
         R_BM, R_MP, R_BP, S_rho, r_P, r_G = _pose(q, o, p)
         omega_rel_P, rdot_G_rel = _rates(qd, o, p, R_BM, R_BP, S_rho)
         F_M, N_P, S_inv, status = _joint_wrench(q, qd, Q, o, p)
@@ -248,6 +428,9 @@ def pass2(q, qd, members, params, work, hub, qdd):
         o = members[j, 1]
         p = params[j]
         w = work[j]
+        if _is_locked(p):
+            _locked_pass2(o, w, hub, qdd)
+            continue
         R_BM = load_m33_at(p, P_R_BM)
         R_BP = load_m33_at(w, W_R_BP)
         r_G = load_seg(w, W_R_G)
@@ -419,6 +602,7 @@ class PlateModel(AppendageModel):
     config_class = AppendageConfig
     kernels = AppendageKernels(pass1, pass2, mass_matrix, bias_forces, observe, joint_wrench, tips)
     transmits_inertia = False
+    holds_locked = True
     modifiers: ClassVar[dict] = {"inertia": _scale_mass}
     work_size = WORK_SIZE
 
@@ -438,6 +622,8 @@ class PlateModel(AppendageModel):
         row[P_J : P_J + 9] = J.ravel()
         row[P_J_INV : P_J_INV + 9] = np.linalg.inv(J).ravel()
         row[P_TIP : P_TIP + 3] = (0.0, sign * config.length_m, 0.0)
+        for name in config.locked_dofs:  # held by pass 1 and 2 themselves
+            row[P_LOCKED + JOINT_DOFS.index(name)] = 1.0
         return row
 
     def tune(self, config: AppendageConfig, params: np.ndarray, inertia_diag: np.ndarray
