@@ -84,8 +84,13 @@ def test_rk4_agrees_with_tight_dop853(nominal_plant, thesis_run):
     # modes, which RK4 at 1 ms (omega dt ~ 0.6) integrates with a small phase and
     # amplitude error (docs/model.md, 'Integration'): measured 2e-7 rad/s,
     # 4e-5 rad/s^2 and 1.2e-3 N m (0.07 % of the 1.58 N m peak); bounds at about 5x those.
-    reference = run_openloop(nominal_plant, OpenLoopScenario(solver="dop853"))
-    a, b = thesis_run.dataset, reference.dataset
+    # DOP853 flies the first 30 s (the 10 s pulse, the peaks of tau_flex and 20 s of
+    # ringing): the differences over a part of the run are at most those over all of it,
+    # so the bounds measured over 120 s hold; a quarter of the cost.
+    reference = run_openloop(nominal_plant, OpenLoopScenario(solver="dop853", duration_s=30.0))
+    b = reference.dataset
+    a = thesis_run.dataset.isel(time=slice(0, b.sizes["time"]))
+    np.testing.assert_allclose(a["time"], b["time"], rtol=0, atol=1e-12)  # the same instants
     np.testing.assert_allclose(a["euler_deg"], b["euler_deg"], rtol=0, atol=5e-8)
     np.testing.assert_allclose(a["rho"], b["rho"], rtol=0, atol=1e-9)
     np.testing.assert_allclose(a["total_energy"], b["total_energy"], rtol=0, atol=5e-10)
