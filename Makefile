@@ -33,9 +33,12 @@ chromium:
 	    { $$SUDO apt-get update -q && $$SUDO env DEBIAN_FRONTEND=noninteractive apt-get install -y -q chromium; }; } >/dev/null 2>&1 || \
 	  echo "Chromium could not be installed: the report's browser test will be skipped."; }
 
+# The suite runs on TEST_WORKERS processes (pytest-xdist), a test file per process at a
+# time so that module fixtures are computed once (docs/performance.md, "The test suite").
+TEST_WORKERS ?= 2
 test: $(DEV) chromium
 	$(BIN)/ruff check src tests bench examples
-	$(BIN)/python -m pytest -q
+	$(BIN)/python -m pytest -q -n $(TEST_WORKERS) --dist loadfile
 	$(MAKE) docs
 
 # Every benchmark and the table of performance targets (docs/performance.md); the

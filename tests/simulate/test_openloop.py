@@ -84,8 +84,13 @@ def test_rk4_agrees_with_tight_dop853(nominal_plant, thesis_run):
     # modes, which RK4 at 1 ms (omega dt ~ 0.6) integrates with a small phase and
     # amplitude error (docs/model.md, 'Integration'): measured 2e-7 rad/s,
     # 4e-5 rad/s^2 and 1.2e-3 N m (0.07 % of the 1.58 N m peak); bounds at about 5x those.
-    reference = run_openloop(nominal_plant, OpenLoopScenario(solver="dop853"))
-    a, b = thesis_run.dataset, reference.dataset
+    # DOP853 flies the first 30 s (the 10 s pulse, the peaks of tau_flex and 20 s of
+    # ringing): the differences over a part of the run are at most those over all of it,
+    # so the bounds measured over 120 s hold; a quarter of the cost.
+    reference = run_openloop(nominal_plant, OpenLoopScenario(solver="dop853", duration_s=30.0))
+    b = reference.dataset
+    a = thesis_run.dataset.isel(time=slice(0, b.sizes["time"]))
+    np.testing.assert_allclose(a["time"], b["time"], rtol=0, atol=1e-12)  # the same instants
     np.testing.assert_allclose(a["euler_deg"], b["euler_deg"], rtol=0, atol=5e-8)
     np.testing.assert_allclose(a["rho"], b["rho"], rtol=0, atol=1e-9)
     np.testing.assert_allclose(a["total_energy"], b["total_energy"], rtol=0, atol=5e-10)
@@ -138,7 +143,13 @@ def test_conservation_at_small_step(undamped_plant):
 
 
 def test_conservation_with_dop853(undamped_plant):
-    energy, momentum = _drifts(_free_run(undamped_plant, solver="dop853", rtol=1e-10, atol=1e-12))
+    # The same invariants by an independent integrator, over 30 s rather than 120 s
+    # (a quarter of the cost): 3000 periods of the ~100 Hz joint modes, seven of the
+    # slowest flapping mode (0.25 Hz) and about 70 deg of rotation, so an energy or
+    # momentum error of the equations of motion shows many times over; DOP853's error
+    # at rtol 1e-10 accumulates with time, so the bounds of the 120 s run are kept.
+    energy, momentum = _drifts(_free_run(undamped_plant, solver="dop853", rtol=1e-10,
+                                         atol=1e-12, duration_s=30.0))  # fmt: skip
     assert abs(energy) <= 1e-7
     assert momentum <= 1e-8
 

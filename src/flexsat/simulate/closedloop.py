@@ -36,6 +36,7 @@ from flexsat.simulate.loops import (
 from flexsat.simulate.openloop import initial_state
 from flexsat.simulate.result import Result, build_dataset
 from flexsat.simulate.scenario import SlewScenario
+from flexsat.simulate.typed_call import TypedOnce
 
 __all__ = [
     "Controller",
@@ -434,6 +435,9 @@ def _python_loop(plant, scenario, x, frame, stages, d, rec_t, rec_x, rec_ctrl, r
     limit = scenario.actuator.reduction_factor * scenario.actuator.t_max_nm
     d.law_diag[:] = np.nan
     view = np.empty_like(x)
+    # the same arguments at every instant: typed once (flexsat.simulate.typed_call)
+    sensors, actuators = TypedOnce(run_sensors), TypedOnce(run_actuators)
+    coupled_hold, hold = TypedOnce(rk4_coupled_hold), TypedOnce(rk4_hold)
     rows, status, k = 0, 0, 0
     while True:
         t = k * scenario.dt_s
@@ -442,12 +446,12 @@ def _python_loop(plant, scenario, x, frame, stages, d, rec_t, rec_x, rec_ctrl, r
             if not is_identity(frame):  # re-based between steps: the sensors read N
                 inertial_view(x, n, frame, view)
                 sensed = view
-            status = run_sensors(sensed, n, t, stages, d)
+            status = sensors(sensed, n, t, stages, d)
             tau_cmd = np.asarray(controller(t, d.q_meas.copy(), d.omega_meas.copy()), dtype=float)
             if tau_cmd.shape != (3,) or not np.all(np.isfinite(tau_cmd)):
                 raise SimulationError(f"controller returned {tau_cmd!r} at t = {t:.6g} s")
             d.tau_cmd[:] = np.clip(tau_cmd, -limit, limit)
-            status |= run_actuators(x, n, t, control_dt, continuous, stages, d)
+            status |= actuators(x, n, t, control_dt, continuous, stages, d)
             if status:
                 return STATUS_CONTROL_FAILED, k, rows
         if k % every == 0:
@@ -457,11 +461,11 @@ def _python_loop(plant, scenario, x, frame, stages, d, rec_t, rec_x, rec_ctrl, r
             return 0, k, rows
         if continuous:  # re-based once per block (a few steps: far from the pole)
             rebase(x, n, frame)
-            status, ran = rk4_coupled_hold(x, t, scenario.dt_s, block, stages.derivative,
-                                           d.actuator_params, d.flow, plant.packed)  # fmt: skip
+            status, ran = coupled_hold(x, t, scenario.dt_s, block, stages.derivative,
+                                       d.actuator_params, d.flow, plant.packed)  # fmt: skip
         else:
             torque = (d.tau_applied[0], d.tau_applied[1], d.tau_applied[2])
-            status, ran = rk4_hold(x, scenario.dt_s, block, torque, plant.packed, frame)
+            status, ran = hold(x, scenario.dt_s, block, torque, plant.packed, frame)
         k += ran
         if status:
             return status, k, rows
