@@ -233,6 +233,69 @@ def _is_locked(p):
 
 
 @njit(cache=True, error_model="numpy")
+def _rotations_free(p):
+    """True when exactly the joint's translations are locked (the reduced plant's set)."""
+    for k in range(3):
+        if p[P_LOCKED + k] == 0.0 or p[P_LOCKED + 3 + k] != 0.0:
+            return False
+    return True
+
+
+@njit(cache=True, error_model="numpy")
+def _axpy(a, s, b):
+    """a + s b for 3 x 3 matrices."""
+    return (add(a[0], scale(s, b[0])), add(a[1], scale(s, b[1])), add(a[2], scale(s, b[2])))
+
+
+@njit(cache=True, error_model="numpy")
+def _inverse3(a):
+    """The inverse of a 3 x 3 matrix (adjugate over determinant; D is positive definite)."""
+    c0 = cross(a[1], a[2])
+    c1 = cross(a[2], a[0])
+    c2 = cross(a[0], a[1])
+    f = 1.0 / dot(a[0], c0)
+    return transpose((scale(f, c0), scale(f, c1), scale(f, c2)))
+
+
+@njit(cache=True, error_model="numpy")
+def _rotations_solve(w, hub, m, R_MB, J_t, G, S_rho, J_p, R_BP, u_a, Xu):
+    """The free-rows solve of :func:`_locked_pass1` for root translations locked, in
+    3 x 3 blocks: F = the rotations, D = Mz_33, K_F = [K_30 | K_33].
+
+    Leaves in ``w`` what :func:`_locked_pass2` reads (the general layout with three
+    free rows: D^-1 K_F, D^-1 r_F, the locked rows of Mz and K), takes K_F^T D^-1 K_F
+    off ``hub``'s inertia and writes the wrench at A_hub = 0.
+    """
+    D = _axpy(mtm(S_rho, mm(J_p, S_rho)), m, mtm(J_t, J_t))
+    K_30 = scale_m(m, transpose(J_t))
+    K_33 = _axpy(mtm(S_rho, mm(J_p, transpose(R_BP))), -m, mtm(J_t, G))
+    D_inv = _inverse3(D)
+    Y_0 = mm(D_inv, K_30)
+    Y_3 = mm(D_inv, K_33)
+    y = mv(D_inv, load_seg(w, W_RV + 3))
+    w[W_NF] = 3
+    nc = 10  # three free rows of [D | K_F | r_F]
+    Mz_03 = mm(R_MB, J_t)
+    K_03 = mm(R_MB, G)
+    for a in range(3):
+        w[W_FREE + a] = 3 + a
+        for b in range(3):
+            w[W_SOLVE + nc * a + 3 + b] = Y_0[a][b]
+            w[W_SOLVE + nc * a + 6 + b] = Y_3[a][b]
+            w[W_MZ + 6 * a + 3 + b] = m * Mz_03[a][b]
+            w[W_K + 6 * a + b] = m * R_MB[a][b]
+            w[W_K + 6 * a + 3 + b] = -m * K_03[a][b]
+        w[W_SOLVE + nc * a + 9] = y[a]
+    H = HUB_INERTIA
+    _add6(hub, H, 0, 0, mtm(K_30, Y_0), -1.0)
+    _add6(hub, H, 0, 3, mtm(K_30, Y_3), -1.0)
+    _add6(hub, H, 3, 0, mtm(K_33, Y_0), -1.0)
+    _add6(hub, H, 3, 3, mtm(K_33, Y_3), -1.0)
+    _store(w, W_WRENCH, sub(u_a, mtv(K_30, y)))
+    _store(w, W_WRENCH + 3, sub(Xu, mtv(K_33, y)))
+
+
+@njit(cache=True, error_model="numpy")
 def _locked_pass1(q, qd, Q, o, p, w, hub):
     """Pass 1 of a plate whose joint has locked DOFs: articulated inertia and bias wrench.
 
@@ -269,6 +332,23 @@ def _locked_pass1(q, qd, Q, o, p, w, hub):
     G = skew(r_G)
     R_MB = transpose(R_BM)
     identity = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
+    g_eta = mtv(R_BM, u_a)
+    g_rho = add(mtv(J_t, u_a), mtv(S_rho, u_w))
+    for a in range(3):
+        w[W_RV + a] = Q_eta[a] + g_eta[a]
+        w[W_RV + 3 + a] = Q_rho[a] + g_rho[a]
+    # The panel's spatial inertia about the hub centre of mass, X^T I_P X; the free
+    # rows' Schur term K_F^T D^-1 K_F comes off it below.
+    H = HUB_INERTIA
+    _add6(hub, H, 0, 0, identity, m)
+    _add6(hub, H, 0, 3, G, -m)
+    _add6(hub, H, 3, 0, G, m)
+    _add6(hub, H, 3, 3, mm(G, G), -m)
+    _add6(hub, H, 3, 3, mm(R_BP, mm(J_p, transpose(R_BP))), 1.0)
+    Xu = add(cross(r_G, u_a), mv(R_BP, u_w))
+    if _rotations_free(p):
+        _rotations_solve(w, hub, m, R_MB, J_t, G, S_rho, J_p, R_BP, u_a, Xu)
+        return STATUS_OK
     w[W_MZ : W_MZ + 72] = 0.0  # Mz and K
     _add6(w, W_MZ, 0, 0, identity, m)
     _add6(w, W_MZ, 0, 3, mm(R_MB, J_t), m)
@@ -280,11 +360,6 @@ def _locked_pass1(q, qd, Q, o, p, w, hub):
     _add6(w, W_K, 3, 0, transpose(J_t), m)
     _add6(w, W_K, 3, 3, mtm(J_t, G), -m)
     _add6(w, W_K, 3, 3, mtm(S_rho, mm(J_p, transpose(R_BP))), 1.0)
-    g_eta = mtv(R_BM, u_a)
-    g_rho = add(mtv(J_t, u_a), mtv(S_rho, u_w))
-    for a in range(3):
-        w[W_RV + a] = Q_eta[a] + g_eta[a]
-        w[W_RV + 3 + a] = Q_rho[a] + g_rho[a]
     nf = 0
     for k in range(6):
         if p[P_LOCKED + k] == 0.0:
@@ -312,15 +387,6 @@ def _locked_pass1(q, qd, Q, o, p, w, hub):
             for c in range(r + 1, nf):
                 s -= w[A + nc * r + c] * w[A + nc * c + j]
             w[A + nc * r + j] = s / w[A + nc * r + r]
-    # The panel's spatial inertia about the hub centre of mass, X^T I_P X, less the
-    # free rows' Schur term K_F^T D^-1 K_F.
-    H = HUB_INERTIA
-    _add6(hub, H, 0, 0, identity, m)
-    _add6(hub, H, 0, 3, G, -m)
-    _add6(hub, H, 3, 0, G, m)
-    _add6(hub, H, 3, 3, mm(G, G), -m)
-    _add6(hub, H, 3, 3, mm(R_BP, mm(J_p, transpose(R_BP))), 1.0)
-    Xu = add(cross(r_G, u_a), mv(R_BP, u_w))
     wrench = (u_a[0], u_a[1], u_a[2], Xu[0], Xu[1], Xu[2])
     for a in range(6):
         s = wrench[a]
