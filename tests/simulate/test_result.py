@@ -112,3 +112,17 @@ def test_the_open_loop_attitude_figure_draws_only_meaningful_signals(openloop):
     fig = openloop.plot("attitude")
     assert len(fig.axes) == 2
     assert "not drawn, numerically zero: roll" in fig._suptitle.get_text()
+
+
+def test_record_quaternions_are_scipys_zyx_rotations():
+    # Independent formulation: scipy's Rotation.from_euler("ZYX") composes the same
+    # elementary quaternions in the same order (so the same sign); rounding only:
+    # 1e-15 absolute on unit quaternions (measured 2e-16).
+    from scipy.spatial.transform import Rotation
+
+    from flexsat.simulate.result import _quaternions
+
+    euler = np.random.default_rng(18).uniform(-1.5, 1.5, size=(200, 3))
+    xyzw = Rotation.from_euler("ZYX", euler[:, ::-1]).as_quat()
+    expected = np.column_stack([xyzw[:, 3], xyzw[:, :3]])
+    assert np.max(np.abs(_quaternions(euler) - expected)) <= 1e-15

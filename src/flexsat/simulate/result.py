@@ -22,7 +22,6 @@ from pathlib import Path
 
 import numpy as np
 import xarray as xr
-from scipy.spatial.transform import Rotation
 
 from flexsat.dynamics.attitude import inertial_records, vectors_to_inertial
 from flexsat.dynamics.plant import Plant
@@ -290,10 +289,8 @@ def build_dataset(
         q, qd = inertial_records(q, qd, omega, frames)
         H = vectors_to_inertial(H, frames)
         H_rigid = vectors_to_inertial(H_rigid, frames)
-    rotations = Rotation.from_euler("ZYX", q[:, 5:2:-1])  # R_NB = Rz(psi) Ry(theta) Rx(phi)
     total = kinetic + elastic
-    quat_scalar_last = rotations.as_quat()
-    quaternion = np.column_stack([quat_scalar_last[:, 3], quat_scalar_last[:, :3]])
+    quaternion = _quaternions(q[:, 3:6])
     # Root motion per appendage, as its model defines it.
     blocks = list(zip(plant.models, plant.layout.blocks, strict=True))
     root = [model.root_motion(q[:, b.slice], b.names) for model, b in blocks]
@@ -346,6 +343,33 @@ def build_dataset(
         "dof": plant.dof_names(),
     }
     return xr.Dataset(data_vars, coords=coords, attrs=attrs)
+
+
+def _quaternions(euler: np.ndarray) -> np.ndarray:
+    """Scalar-first unit quaternions of R_NB = Rz(psi) Ry(theta) Rx(phi) (eq. 2.25).
+
+    The product q_z(psi) q_y(theta) q_x(phi) of the elementary rotations' quaternions
+    written out in half angles: scipy's ``Rotation.from_euler("ZYX", ...)`` composes the
+    same product (to 2e-16, same sign) at ten times the cost for a run's records.
+
+    Parameters
+    ----------
+    euler : ndarray, shape (m, 3)
+        ZYX Euler angles (phi, theta, psi) [rad].
+
+    Returns
+    -------
+    ndarray, shape (m, 4)
+        (q0, q1, q2, q3), q0 the scalar part [-].
+    """
+    c1, c2, c3 = np.cos(0.5 * euler).T
+    s1, s2, s3 = np.sin(0.5 * euler).T
+    return np.column_stack([
+        c1 * c2 * c3 + s1 * s2 * s3,
+        s1 * c2 * c3 - c1 * s2 * s3,
+        c1 * s2 * c3 + s1 * c2 * s3,
+        c1 * c2 * s3 - s1 * s2 * c3,
+    ])  # fmt: skip
 
 
 def _shown(value) -> str:
