@@ -139,6 +139,17 @@ def _inverse3(a00, a01, a02, a10, a11, a12, a20, a21, a22):
 def mekf_step(x, n_dof, t, params, state, q_meas, omega_meas, record):
     """Propagate with the gyro, update on a new star-tracker sample (module docstring)."""
     p, s = params, state
+    new_rate, fresh = False, False
+    for i in range(3):
+        new_rate |= omega_meas[i] != s[_WPREV + i]
+    for j in range(4):
+        fresh |= q_meas[j] != s[_QST + j]
+    if s[_ON] != 0.0 and not (new_rate or fresh):  # between samples: the estimate held
+        for i in range(3):
+            omega_meas[i] = omega_meas[i] - s[_B + i]
+        for j in range(4):
+            q_meas[j] = s[_Q + j]
+        return 0
     P = s[_P : _P + 36].reshape((6, 6))
     G = s[_PHI : _PHI + 36].reshape((6, 6))
     T = s[_T : _T + 36].reshape((6, 6))
@@ -153,10 +164,8 @@ def mekf_step(x, n_dof, t, params, state, q_meas, omega_meas, record):
             P[i, i] = p[_P0A + i] ** 2
             P[3 + i, 3 + i] = p[_P0B] ** 2
             s[_WPREV + i] = omega_meas[i]
+        new_rate, fresh = False, False  # the first samples initialize the estimate
     dt = t - s[_TPREV]
-    new_rate = False
-    for i in range(3):
-        new_rate |= omega_meas[i] != s[_WPREV + i]
     if new_rate and dt > 0.0:
         s[_TPREV] = t
         w0, w1, w2 = (omega_meas[0] - s[_B], omega_meas[1] - s[_B + 1],
@@ -181,9 +190,6 @@ def mekf_step(x, n_dof, t, params, state, q_meas, omega_meas, record):
             P[i, 3 + i] -= su2 * dt**2 / 2.0
             P[3 + i, i] -= su2 * dt**2 / 2.0
             P[3 + i, 3 + i] += su2 * dt
-    fresh = False
-    for j in range(4):
-        fresh |= q_meas[j] != s[_QST + j]
     if fresh:
         for j in range(4):
             s[_QST + j] = q_meas[j]

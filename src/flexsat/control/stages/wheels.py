@@ -222,8 +222,9 @@ def wheels_step(tau_cmd, t, dt, params, state, tau_applied, record):
         u = 0.0
         for a in range(3):
             u -= p[_PINV + 3 * i + a] * tau_cmd[a]
-        for j in range(n):
-            u -= p[_KNULL] * p[_NULL + MAX_WHEELS * i + j] * (_momentum(p, s, j) - bias)
+        if p[_KNULL] != 0.0:  # null-space momentum management, off by default
+            for j in range(n):
+                u -= p[_KNULL] * p[_NULL + MAX_WHEELS * i + j] * (_momentum(p, s, j) - bias)
         s[_UCMD + i] = min(p[_UMAX], max(-p[_UMAX], u))
         h = _momentum(p, s, i)
         hx += p[_A + i] * h
