@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 import xarray as xr
+from matplotlib.backends.backend_agg import FigureCanvasAgg
 
 from flexsat.plots import style
 
@@ -38,6 +39,42 @@ def test_time_axis_and_title():
     assert axes[1, 2].get_xlabel() == "time t [s]" and axes[0, 2].get_xlabel() == ""
     style.suptitle(fig, ds.assign_attrs(status="failed", message="diverged"), "What")
     assert fig._suptitle.get_text() == "What\nrun A  —  FAILED: diverged"
+
+
+@pytest.mark.parametrize(("shape", "size", "sharex"),
+                         [((3, 1), (11.0, 9.0), True), ((2, 3), (14.0, 7.0), True),
+                          ((2, 3), (15.0, 9.5), False), ((1, 1), (9.0, 5.5), True)])  # fmt: skip
+def test_fixed_layout_keeps_labels_titles_and_legend_apart(shape, size, sharex):
+    # Reference: the figure's own extents. Every axes' box with its tick labels, labels
+    # and title must lie inside the figure and clear of its neighbours and the legend
+    # (1 px of slack for anti-aliased text edges).
+    ds = xr.Dataset(coords={"time": np.linspace(0.0, 120.0, 50)}, attrs={"title": "run A"})
+    t = style.time_s(ds)
+    fig, axes = style.figure(*shape, size=size, sharex=sharex)
+    for k, ax in enumerate(axes.ravel()):
+        ax.semilogy(t, 1e-6 + np.exp(-t / 10.0), label=f"curve {k}")
+        ax.set_ylabel("pointing error [deg]")
+        ax.set_title(f"axis {k}: near the target (t ≥ 93.25 s)", fontsize=10)
+        if not sharex:
+            ax.set_xlabel("q_v,e [-]")
+    style.finish_time_axis(axes, t)
+    handles = [ax.get_lines()[0] for ax in axes.ravel()]
+    style.figure_legend(fig, handles, [h.get_label() for h in handles], ncols=4)
+    style.suptitle(fig, ds, "What the figure shows")
+    renderer = FigureCanvasAgg(fig).get_renderer()
+    fig.draw(renderer)
+    page = fig.bbox
+    boxes = [ax.get_tightbbox(renderer) for ax in axes.ravel()]
+    legend = fig.legends[0].get_window_extent(renderer)
+    title = fig._suptitle.get_window_extent(renderer)
+    for box in [*boxes, legend, title]:
+        assert box.x0 >= page.x0 - 1 and box.x1 <= page.x1 + 1
+        assert box.y0 >= page.y0 - 1 and box.y1 <= page.y1 + 1
+    for i, a in enumerate(boxes):
+        assert not a.padded(-1).overlaps(legend)
+        assert not a.padded(-1).overlaps(title)
+        for b in boxes[i + 1:]:
+            assert not a.padded(-1).overlaps(b.padded(-1))
 
 
 def test_write_figures_writes_in_order_and_creates_the_folder(tmp_path):

@@ -440,8 +440,8 @@ def plot_root_deformation(ds: xr.Dataset) -> Figure:
         axes[k, 1].set_ylabel(f"η_{style.AXES[k]} [{eta_units}]")
         axes[k, 1].set_title(f"root translation η_{style.AXES[k]}", fontsize=10)
     handles, _ = axes[0, 0].get_legend_handles_labels()
-    fig.legend(handles=[*handles, *_torque_patches(ds)], loc="outside lower center",
-               ncols=len(handles) + 1, fontsize=9)  # fmt: skip
+    items = [*handles, *_torque_patches(ds)]
+    style.figure_legend(fig, items, [item.get_label() for item in items], len(handles) + 1)
     style.finish_time_axis(axes, t)
     style.suptitle(fig, ds, "Appendage root-joint deformations (mount frame)")
     return fig
@@ -483,8 +483,8 @@ def plot_tip_displacement(ds: xr.Dataset) -> Figure:
         ax.set_ylabel("tip displacement [mm]")
         ax.set_title(f"{name}  (peak |δ| = {norm.max():.3g} mm)", fontsize=10)
     handles, _ = axes[0, 0].get_legend_handles_labels()
-    fig.legend(handles=[*handles, *_torque_patches(ds)], loc="outside lower center",
-               ncols=len(handles) + 1, fontsize=9)  # fmt: skip
+    items = [*handles, *_torque_patches(ds)]
+    style.figure_legend(fig, items, [item.get_label() for item in items], len(handles) + 1)
     style.finish_time_axis(axes, t)
     style.suptitle(fig, ds, "Panel tip displacement (mount frame)")
     return fig

@@ -162,8 +162,7 @@ def _figure_legend(fig: Figure, axes, ncols: int | None = None) -> None:
         for handle, label in zip(*ax.get_legend_handles_labels(), strict=True):
             seen.setdefault(label, handle)
     if seen:
-        fig.legend(list(seen.values()), list(seen), loc="outside lower center",
-                   ncols=ncols or min(len(seen), 6), fontsize=9)  # fmt: skip
+        style.figure_legend(fig, list(seen.values()), list(seen), ncols or min(len(seen), 6))
 
 
 def plot_slew_root_deformation(ds: xr.Dataset) -> Figure:

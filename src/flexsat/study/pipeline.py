@@ -43,6 +43,12 @@ __all__ = ["CAMPAIGNS", "PARTS", "Part", "StudyContext", "run_study"]
 CAMPAIGNS = ("sensitivity", "montecarlo-critical", "deployment-shock")
 """The thesis's three campaigns (chapter 5), in the order of the report."""
 
+QUICK_ANIMATED_MODES = 2
+"""Mode GIFs of the quick study: the lowest flexible modes that drive a hub DOF (the
+full study animates up to six)."""
+QUICK_ANIMATION_FRAMES = 60
+"""Frames of the quick study's slew animation (the full study's: 150)."""
+
 MANIFEST = "study.json"
 REPORT = "report.html"
 
@@ -129,7 +135,13 @@ def _configuration(ctx: StudyContext) -> dict:
 
 
 def _modal(ctx: StudyContext) -> dict:
-    _, summary = write_modal(ctx.plant, ctx.out / "modal")
+    animate = None
+    if ctx.quick:
+        from flexsat.analysis.modal import modal_analysis
+        from flexsat.plots.modal import default_animated_modes
+
+        animate = default_animated_modes(modal_analysis(ctx.plant))[:QUICK_ANIMATED_MODES]
+    _, summary = write_modal(ctx.plant, ctx.out / "modal", animate)
     files = _relative(ctx, summary["files"])
     return {"json": files[0], "figures": files[1:]}
 
@@ -192,7 +204,8 @@ def _animation(ctx: StudyContext) -> dict:
     from flexsat.simulate.result import Result
 
     result = Result.from_netcdf(ctx.out / ctx.results["slew"]["result"])
-    path = write_animation(result, ctx.out / "slew" / LAWS.default / "animation.gif")
+    frames = {"max_frames": QUICK_ANIMATION_FRAMES} if ctx.quick else {}
+    path = write_animation(result, ctx.out / "slew" / LAWS.default / "animation.gif", **frames)
     return {"figures": _relative(ctx, [path])}
 
 
