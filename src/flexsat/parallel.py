@@ -54,6 +54,7 @@ def forked_map(job: Callable, items: Iterable, workers: int | None = None) -> li
         Called once per item; a closure is fine (forked processes inherit it, only
         the items and the results are pickled).
     items : iterable
+        The job's arguments [-].
     workers : int, optional
         Processes; default :func:`figure_workers`, at most one per item.
 
