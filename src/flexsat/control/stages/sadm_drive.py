@@ -11,7 +11,7 @@ angle::
 held between control instants (zero-order hold). The commanded profile starts at the
 coordinate's initial angle beta_0 (the run's initial state): ``constant_rate``,
 beta_cmd = beta_0 + r t; ``to_target``, the rate-limited move to ``target_deg`` at
-|beta_dot_cmd| = r. Q enters eq. 2.50 as the generalized force on the joint
+abs(beta_dot_cmd) = r. Q enters eq. 2.50 as the generalized force on the joint
 coordinate, so the motor's reaction on the hub is the joint equations' own.
 ``docs/control.md``, "Solar-array drive (SADM)".
 

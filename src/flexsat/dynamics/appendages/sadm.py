@@ -45,7 +45,7 @@ def driven_plate(plate: AppendageConfig, stiffness: np.ndarray, damping: np.ndar
     Parameters
     ----------
     plate : AppendageConfig
-        The plate; its ``sadm_angle_deg`` becomes the drive's initial angle (|.| < 45 deg).
+        The plate; its ``sadm_angle_deg`` becomes the drive's initial angle (within ±45 deg).
     stiffness, damping : ndarray, shape (6,)
         Its tuned root-joint stiffness [N/m, N m/rad] and damping [N s/m, N m s/rad], in
         the order eta_x, eta_y, eta_z, eta_rx, eta_ry, eta_rz.
