@@ -3,11 +3,13 @@
 from __future__ import annotations
 
 import json
+import os
 import subprocess
 import sys
+from pathlib import Path
 
-from flexsat.config import preset_path
-from flexsat.study import PARTS
+from flexsat.config import nominal, preset_path
+from flexsat.study import PARTS, pipeline
 
 
 def test_quick_study_runs_every_part_but_the_campaigns(quick_study):
@@ -72,3 +74,54 @@ def test_a_failed_part_is_reported_and_the_rest_still_written(tmp_path):
     assert "Traceback (most recent call last)" in report  # the traceback is shown
     assert "Failed parts:" in report
     assert "eq. B.2" in report  # the sections of the parts that ran are there
+
+
+def test_every_part_reads_only_parts_of_its_own_lane():
+    # A part's inputs come from its own process: a need in the other lane would be
+    # missing in the forked lane (or read before it is written in this one).
+    lane = {part.name: part.lane for part in PARTS}
+    for part in PARTS:
+        assert part.lane in range(pipeline.LANES), part.name
+        assert all(lane[need] == part.lane for need in part.needs), part.name
+
+
+def _part(name: str, lane: int, run, needs: tuple[str, ...] = ()) -> pipeline.Part:
+    return pipeline.Part(name, name.title(), run, needs=needs, lane=lane)
+
+
+def _two_lanes(parts, monkeypatch) -> dict:
+    monkeypatch.setattr(pipeline, "PARTS", parts)
+    ctx = pipeline.StudyContext(nominal(), Path("."), quick=True, progress=False)
+    recorded: dict[str, dict] = {}
+    pipeline._run_parts(ctx, lambda part, entry: recorded.update({part.name: entry}), lanes=2)
+    return recorded
+
+
+def test_two_lanes_run_every_part_once_and_pass_outputs_along_a_lane(monkeypatch):
+    parts = (
+        _part("first", 0, lambda ctx: {"pid": os.getpid()}),
+        _part("second", 1, lambda ctx: {"pid": os.getpid()}),
+        _part("third", 1, lambda ctx: {"read": ctx.results["second"]["pid"]},
+              needs=("second",)),
+        _part("fourth", 0, lambda ctx: {"pid": os.getpid()}),
+    )  # fmt: skip
+    recorded = _two_lanes(parts, monkeypatch)
+    assert set(recorded) == {"first", "second", "third", "fourth"}
+    assert all(entry["status"] == "ok" for entry in recorded.values())
+    outputs = {name: entry["outputs"] for name, entry in recorded.items()}
+    assert outputs["first"]["pid"] == outputs["fourth"]["pid"] == os.getpid()
+    assert outputs["second"]["pid"] != os.getpid()  # lane 1 ran in the forked process
+    assert outputs["third"]["read"] == outputs["second"]["pid"]
+
+
+def test_a_lane_that_dies_leaves_its_unfinished_parts_failed(monkeypatch):
+    parts = (
+        _part("survivor", 0, lambda ctx: {}),
+        _part("done", 1, lambda ctx: {}),
+        _part("killer", 1, lambda ctx: os._exit(7)),
+        _part("orphan", 1, lambda ctx: {}),
+    )
+    recorded = _two_lanes(parts, monkeypatch)
+    status = {name: entry["status"] for name, entry in recorded.items()}
+    assert status == {"survivor": "ok", "done": "ok", "killer": "failed", "orphan": "failed"}
+    assert recorded["orphan"]["error"] == "the process running it stopped (exit code 7)"

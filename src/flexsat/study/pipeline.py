@@ -1,20 +1,27 @@
-"""The thesis study end to end: every part in turn, each timed, each allowed to fail.
+"""The thesis study end to end: every part timed, each allowed to fail.
 
-:func:`run_study` runs the parts of :data:`PARTS` in order (configuration, modal
-analysis, open-loop validation, the ASMC slew, the frequency-domain analysis, the
-controller comparison, the slew animation and, unless ``quick``, the three thesis
-campaigns), after compiling every kernel they need up front (its time is
-``compilation_s`` in the manifest; the parts' wall times exclude it), writes each part's
-outputs under its own folder, and keeps ``study.json``, the manifest, up to date
-after every part: status (ok, failed, skipped), wall time, the files written and,
-for a failed part, the error and its traceback. A failed part does not stop the
-others (a part whose input failed is marked failed with that reason). Finally it
-writes ``report.html`` from the manifest and the parts' JSON files.
+:func:`run_study` runs the parts of :data:`PARTS` (configuration, modal analysis,
+open-loop validation, the ASMC slew, the frequency-domain analysis, the controller
+comparison, the slew animation, the avionics, unless ``quick`` the three thesis
+campaigns, and the law comparison), after compiling every kernel they need up front
+(its time is ``compilation_s`` in the manifest; the parts' wall times exclude it),
+writes each part's outputs under its own folder, and keeps ``study.json``, the
+manifest, up to date after every part: status (ok, failed, skipped), wall time, the
+files written and, for a failed part, the error and its traceback. A failed part
+does not stop the others (a part whose input failed is marked failed with that
+reason). Finally it writes ``report.html`` from the manifest and the parts' JSON
+files.
+
+On two cores or more the parts run in two lanes side by side (:data:`LANES`): this
+process runs lane 0 (the campaigns among them, with their progress bars) and a
+forked process lane 1, each lane in the order of :data:`PARTS`; the manifest keeps
+that order whichever lane finishes first (docs/results.md, 'Two lanes').
 """
 
 from __future__ import annotations
 
 import datetime as dt
+import multiprocessing
 import time
 import traceback
 from collections.abc import Callable
@@ -27,7 +34,7 @@ from rich.markup import escape
 from flexsat import __version__
 from flexsat.config.models import SatelliteConfig
 from flexsat.control.laws import LAWS
-from flexsat.parallel import forked_map
+from flexsat.parallel import figure_workers, forked_map
 from flexsat.study.outputs import (
     derived_properties,
     fly_campaign,
@@ -38,7 +45,7 @@ from flexsat.study.outputs import (
     write_modal,
 )
 
-__all__ = ["CAMPAIGNS", "PARTS", "Part", "StudyContext", "run_study"]
+__all__ = ["CAMPAIGNS", "LANES", "PARTS", "Part", "StudyContext", "run_study"]
 
 CAMPAIGNS = ("sensitivity", "montecarlo-critical", "deployment-shock")
 """The thesis's three campaigns (chapter 5), in the order of the report."""
@@ -112,9 +119,12 @@ class Part:
     run : callable
         ``run(context) -> outputs``.
     needs : tuple of str
-        Parts whose outputs it reads (run first).
+        Parts whose outputs it reads (run first, in the same lane).
     full_only : bool
         Skipped with ``--quick``.
+    lane : int
+        The lane that runs it when the parts run side by side (:data:`LANES`): 0, this
+        process; 1, the forked one.
     """
 
     name: str
@@ -122,6 +132,7 @@ class Part:
     run: Callable[[StudyContext], dict]
     needs: tuple[str, ...] = ()
     full_only: bool = False  # skipped with --quick
+    lane: int = 0  # 0: this process; 1: the forked lane
 
 
 def _relative(ctx: StudyContext, paths) -> list[str]:
@@ -247,16 +258,23 @@ def _avionics(ctx: StudyContext) -> dict:
 PARTS = (
     Part("configuration", "Configuration", _configuration),
     Part("modal", "Modal analysis", _modal),
-    Part("openloop", "Open-loop validation", _openloop),
-    Part("slew", f"Nominal slew with {LAWS.get(LAWS.default).label}", _slew),
-    Part("frequency", "Frequency domain: plant, loop gain and margins", _frequency),
-    Part("comparison", "Controller comparison", _comparison, needs=("slew",)),
-    Part("animation", "Slew animation", _animation, needs=("slew",)),
+    Part("openloop", "Open-loop validation", _openloop, lane=1),
+    Part("slew", f"Nominal slew with {LAWS.get(LAWS.default).label}", _slew, lane=1),
+    Part("frequency", "Frequency domain: plant, loop gain and margins", _frequency, lane=1),
+    Part("comparison", "Controller comparison", _comparison, needs=("slew",), lane=1),
+    Part("animation", "Slew animation", _animation, needs=("slew",), lane=1),
     Part("avionics", "Avionics in the loop: what the thesis could not say", _avionics),
     Part("campaigns", "Robustness campaigns", _campaigns, full_only=True),
     Part("laws", "Law comparison over the campaigns", _laws),
 )
-"""The study's parts, in the order they run and appear in the report."""
+"""The study's parts, in the order they appear in the report (and run, lane by lane)."""
+
+LANES = 2
+"""Lanes the parts run in side by side when :func:`flexsat.parallel.figure_workers`
+allows two processes. Each part's ``lane`` splits the quick study's CPU time about
+evenly (measured: lane 0, configuration, modal, avionics and laws, 17 CPU-s; lane 1,
+the open loop, the slew and what reads it, and the frequency part, 17 CPU-s); the
+campaigns of the full study stay in this process, whose progress bars they show."""
 
 
 def run_study(
@@ -314,12 +332,16 @@ def run_study(
     }
     manifest["compilation_s"] = _compile(ctx, console)
     start = time.perf_counter()
-    for part in PARTS:
-        entry = _run_part(part, ctx)
-        manifest["parts"].append(entry)
+    done: dict[str, dict] = {}
+
+    def record(part: Part, entry: dict) -> None:
+        done[part.name] = entry
+        manifest["parts"] = [done[p.name] for p in PARTS if p.name in done]
         manifest["total_wall_time_s"] = time.perf_counter() - start
         write_json(out / MANIFEST, manifest)
         _announce(console, part, entry)
+
+    _run_parts(ctx, record, lanes=LANES if figure_workers() > 1 else 1)
     report = write_report(out)
     manifest["report"] = str(report)
     return manifest
@@ -358,25 +380,79 @@ def _compile(ctx: StudyContext, console: Console) -> float:
     return elapsed
 
 
+def _run_parts(ctx: StudyContext, record: Callable[[Part, dict], None], lanes: int) -> None:
+    """Run every part of :data:`PARTS` on ``lanes`` lanes; ``record(part, entry)`` each.
+
+    With two lanes, lane 1 runs in a forked process (it inherits the compiled
+    kernels and ``ctx``, and runs without progress bars) and sends each part's entry
+    back as it finishes; this process runs lane 0 and records lane 1's entries
+    between its own parts, then waits for the rest. A lane that dies leaves its
+    unfinished parts failed with its exit code.
+    """
+    if lanes < 2:
+        for part in PARTS:
+            record(part, _run_part(part, ctx))
+        return
+    forked = [part for part in PARTS if part.lane == 1]
+    context = multiprocessing.get_context("fork")
+    receive, send = context.Pipe(duplex=False)
+    lane = context.Process(target=_run_lane, args=(forked, ctx, send), name="flexsat-lane-1")
+    lane.start()
+    send.close()  # the lane holds the only writing end: its exit ends the reading
+    pending = {part.name: part for part in forked}
+
+    def collect(block: bool) -> None:
+        while pending and (block or receive.poll()):
+            try:
+                name, entry, results = receive.recv()
+            except EOFError:  # the lane stopped before sending every part
+                lane.join()
+                error = f"the process running it stopped (exit code {lane.exitcode})"
+                for part in list(pending.values()):
+                    record(part, _entry(part, "failed", error))
+                pending.clear()
+                return
+            if results is not None:  # a failed or skipped part has no outputs to read
+                ctx.results[name] = results
+            record(pending.pop(name), entry)
+
+    try:
+        for part in PARTS:
+            if part.lane != 1:
+                record(part, _run_part(part, ctx))
+                collect(block=False)
+        collect(block=True)
+    finally:
+        if lane.is_alive():  # interrupted: the lane goes with this process
+            lane.terminate()
+        lane.join()
+        receive.close()
+
+
+def _run_lane(parts: list[Part], ctx: StudyContext, send) -> None:
+    """Lane 1 in its forked process: run ``parts`` in order, send (name, entry, outputs)."""
+    ctx.progress = False  # two lanes' progress bars would interleave
+    for part in parts:
+        entry = _run_part(part, ctx)
+        send.send((part.name, entry, ctx.results.get(part.name)))
+    send.close()
+
+
+def _entry(part: Part, status: str = "ok", error: str | None = None) -> dict:
+    """A part's manifest entry before its run's outputs and time are known."""
+    return {"name": part.name, "title": part.title, "status": status, "wall_time_s": 0.0,
+            "outputs": {}, "error": error, "traceback": None}  # fmt: skip
+
+
 def _run_part(part: Part, ctx: StudyContext) -> dict:
-    entry = {
-        "name": part.name,
-        "title": part.title,
-        "status": "ok",
-        "wall_time_s": 0.0,
-        "outputs": {},
-        "error": None,
-        "traceback": None,
-    }
     if part.full_only and ctx.quick:
-        entry["status"] = "skipped"
-        entry["error"] = "skipped with --quick; run the study without it for this part"
-        return entry
+        return _entry(part, "skipped", "skipped with --quick; run the study without it for "
+                                       "this part")  # fmt: skip
     missing = [name for name in part.needs if name not in ctx.results]
     if missing:
-        entry["status"] = "failed"
-        entry["error"] = f"not run: it needs the {', '.join(missing)} part, which failed"
-        return entry
+        return _entry(part, "failed", f"not run: it needs the {', '.join(missing)} part, "
+                                      "which failed")  # fmt: skip
+    entry = _entry(part)
     start = time.perf_counter()
     try:
         entry["outputs"] = ctx.results[part.name] = part.run(ctx)
