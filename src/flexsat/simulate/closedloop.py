@@ -69,9 +69,11 @@ def design_inertia(config: SatelliteConfig | None = None) -> np.ndarray:
     Parameters
     ----------
     config : SatelliteConfig, optional
-        The user's nominal configuration; default the thesis's nominal satellite.
+        The user's nominal configuration; default the thesis's nominal satellite. A
+        drive's angle is frozen at its initial value (the plate's ``sadm_angle_deg``).
     """
-    return rigid_inertia(Plant.from_config(config or nominal()))
+    plant = Plant.from_config(config or nominal())
+    return _rigid_at_start(plant, SlewScenario())
 
 
 def slew_design_inertia(plant: Plant, scenario: SlewScenario) -> np.ndarray:
@@ -97,6 +99,12 @@ def slew_design_inertia(plant: Plant, scenario: SlewScenario) -> np.ndarray:
     """
     if scenario.design_inertia_kg_m2 is not None:
         return np.array(scenario.design_inertia_kg_m2, dtype=float)
+    return _rigid_at_start(plant, scenario)
+
+
+def _rigid_at_start(plant: Plant, scenario: SlewScenario) -> np.ndarray:
+    """J_tot of the rigidized ``plant``, its free coordinates (drives) where the slew
+    starts them, shape (3, 3) [kg m^2]."""
     return rigid_inertia(plant, design_coordinates(plant, initial_state(plant, scenario)[0]))
 
 
