@@ -43,14 +43,14 @@ def test_lag_is_the_exact_discretization_and_the_authority_holds(nominal_plant):
     Q, record, dt = np.zeros(n), np.zeros(2), 1e-3
     q_d = np.array([1.0, 0.0, 0.0, 0.0])
     for k in range(1, 301):
-        assert STEP(x, n, k * dt, dt, q_d, params, np.zeros(0), Q, record) == 0
+        assert STEP(x, n, k * dt, dt, q_d, np.eye(3), params, np.zeros(0), Q, record) == 0
         expected = -0.2 * (1.0 - np.exp(-2.0 * np.pi * 5.0 * k * dt))
         assert Q[j] == pytest.approx(expected, rel=1e-12)
     assert np.count_nonzero(Q) == 1  # only the actuated coordinate
     assert record[0] == pytest.approx(Q[j] * 0.02, rel=1e-15) and record[0] < 0.0  # dissipates
     x[n + j] = 5.0  # saturating: the output converges to the authority, never beyond
     for k in range(2000):
-        STEP(x, n, k * dt, dt, q_d, params, np.zeros(0), Q, record)
+        STEP(x, n, k * dt, dt, q_d, np.eye(3), params, np.zeros(0), Q, record)
         assert abs(Q[j]) <= 1.0
     assert Q[j] == pytest.approx(-1.0, rel=1e-12)
 
@@ -63,10 +63,10 @@ def test_engages_only_near_the_target(nominal_plant):
     x[n + j] = 0.01
     x[5] = np.radians(2.0)  # 2 deg of yaw from the reference: off
     Q, q_d = np.zeros(n), np.array([1.0, 0.0, 0.0, 0.0])
-    STEP(x, n, 0.0, 1e-3, q_d, params, np.zeros(0), Q, np.zeros(2))
+    STEP(x, n, 0.0, 1e-3, q_d, np.eye(3), params, np.zeros(0), Q, np.zeros(2))
     assert Q[j] == 0.0
     x[5] = np.radians(0.5)  # inside: on
-    STEP(x, n, 0.0, 1e-3, q_d, params, np.zeros(0), Q, np.zeros(2))
+    STEP(x, n, 0.0, 1e-3, q_d, np.eye(3), params, np.zeros(0), Q, np.zeros(2))
     assert Q[j] < 0.0
 
 

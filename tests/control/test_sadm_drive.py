@@ -46,8 +46,10 @@ def test_torque_is_the_pd_law_on_the_driven_coordinates_only(driven):
     drive = [driven.layout.dof_names().index(f"panel_{k}.{DRIVE_COORDINATE}") for k in (1, 2)]
     x = np.zeros(2 * n + 2)
     x[drive[0]], x[n + drive[0]] = 0.001, 0.0005  # ahead of the command, faster
-    Q, record = np.zeros(n), np.zeros(3)
-    assert STEP(x, n, 2.0, 1e-3, np.array([1.0, 0, 0, 0]), params, np.zeros(0), Q, record) == 0
+    Q, record, J = np.zeros(n), np.zeros(4), np.eye(3)
+    assert STEP(x, n, 2.0, 1e-3, np.array([1.0, 0, 0, 0]), J, params, np.zeros(10), Q,
+                record) == 0
+    assert np.array_equal(J, np.eye(3))  # design_model "initial": left as it is
     r = np.radians(0.06)
     expected = 4.0 * (2.0 * r - 0.001) + 1.0 * (r - 0.0005)
     assert Q[drive[0]] == pytest.approx(expected, rel=1e-14)  # 4.9e-3 N m, within the limit
@@ -64,6 +66,8 @@ def test_torque_is_the_pd_law_on_the_driven_coordinates_only(driven):
     ({"profile": "to_target"}, "target_deg: the to_target profile needs a target"),
     ({"max_torque_nm": 0.0}, "joint_actuator.max_torque_nm"),
     ({"coordinates": ["beta"]}, "joint_actuator.coordinates: unknown coordinate 'beta'"),
+    ({"design_model": "encoder"}, "joint_actuator.design_model: Input should be 'initial' or "
+     "'measured'"),
 ])  # fmt: skip
 def test_bad_settings_give_one_message_and_exit_code_2(fields, fragment, tmp_path, capsys):
     table = {**_DRIVE, **fields}

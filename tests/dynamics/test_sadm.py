@@ -29,13 +29,14 @@ OMEGA_N = 2.0 * np.pi * 0.1  # drive loop natural frequency [rad/s], below the 0
 @njit(cache=True)
 def _fly(x, dt, steps, record_every, n, params, Q, scratch, packed, log):
     """Drive step every RK4 step (control period = dt), no hub torque; x logged."""
-    record = np.zeros(3)
+    record = np.zeros(4)
     q_d = np.array([1.0, 0.0, 0.0, 0.0])
-    state = np.zeros(0)
+    state = np.zeros(10)
+    J_design = np.eye(3)  # the law's, not read here
     for s in range(steps):
         if s % record_every == 0:
             log[s // record_every, :] = x
-        sadm_drive_step(x, n, s * dt, dt, q_d, params, state, Q, record)
+        sadm_drive_step(x, n, s * dt, dt, q_d, J_design, params, state, Q, record)
         status = rk4_step(x, dt, (0.0, 0.0, 0.0), n, Q, scratch, packed)
         if status != 0:
             return status

@@ -108,7 +108,8 @@ class ModalAnalysis:
     stiffness_matrix : ndarray, shape (n_dof, n_dof)
         K, the joint stiffness matrix (eq. 3.2) [SI: N/m, N m/rad].
     frequencies_hz : ndarray, shape (n_dof,)
-        Natural frequencies, ascending; the six rigid-body modes are exactly 0 [Hz].
+        Natural frequencies, ascending; the rigid-body modes (the hub's six, plus one per
+        free joint such as a drive's angle) are exactly 0 [Hz].
     shapes : ndarray, shape (n_dof, n_dof)
         Mass-normalized mode shapes in columns (phi^T M phi = 1) [SI / sqrt(kg)].
     participation : ndarray, shape (n_dof, n_dof)
@@ -197,9 +198,15 @@ def effective_mass_table(plant: Plant) -> dict:
 _RESIDUAL_MAX = 1e-4
 
 
-def _check_conditioning(K, M0, eigenvalues, shapes) -> None:
+def _rigid_count(K: np.ndarray) -> int:
+    """The rigid-body modes: K_sys's zero rows, the hub's six and each free joint's (a
+    solar-array drive's angle: no stiffness, a mechanism)."""
+    return int(np.count_nonzero(~np.any(K != 0.0, axis=1)))
+
+
+def _check_conditioning(K, M0, eigenvalues, shapes, n_rigid: int = 6) -> None:
     """Refuse flexible modes that round-off has destroyed (reported as 0 Hz or wrong)."""
-    flexible = slice(6, None)
+    flexible = slice(n_rigid, None)
     lam, phi = eigenvalues[flexible], shapes[:, flexible]
     scale = np.abs(eigenvalues).max()
     residual = np.linalg.norm(K @ phi - (M0 @ phi) * lam, axis=0)
@@ -236,8 +243,9 @@ def modal_analysis(plant: Plant) -> ModalAnalysis:
     M0 = plant.mass_matrix()
     K = plant.stiffness_matrix()
     eigenvalues, shapes = eigh(K, M0)
-    _check_conditioning(K, M0, eigenvalues, shapes)
-    eigenvalues[:6] = 0.0  # K_sys has exactly six zero rows: the rigid-body modes
+    n_rigid = _rigid_count(K)  # six, plus one per free joint (a drive)
+    _check_conditioning(K, M0, eigenvalues, shapes, n_rigid)
+    eigenvalues[:n_rigid] = 0.0  # K_sys's zero rows: the rigid-body modes
     frequencies = np.sqrt(np.clip(eigenvalues, 0.0, None)) / (2.0 * np.pi)
     weighted = np.abs(shapes) * np.sqrt(np.diag(M0))[:, None]
     participation = weighted / weighted.max(axis=0, keepdims=True)
@@ -246,7 +254,7 @@ def modal_analysis(plant: Plant) -> ModalAnalysis:
     modes = []
     for k in range(plant.n_dof):
         phi = shapes[:, k]
-        rigid = k < 6
+        rigid = k < n_rigid
         order = np.argsort(-participation[:, k])
         modes.append(
             Mode(

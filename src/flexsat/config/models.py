@@ -33,6 +33,7 @@ __all__ = [
     "APPENDAGE_CONFIGS",
     "APPENDAGE_ENTRY_POINTS",
     "AppendageConfig",
+    "DriveConfig",
     "HubConfig",
     "SatelliteConfig",
     "TargetFrequencies",
@@ -163,6 +164,22 @@ class TargetFrequencies(_Frozen):
         )
 
 
+class DriveConfig(_Frozen):
+    """A solar-array drive (SADM) turning a plate about its SADM axis Y_M.
+
+    The plate becomes a two-segment chain, the rotor then the panel, its drive angle
+    alpha_sadm a generalized coordinate (``eta_ry_0``) starting at the plate's
+    ``sadm_angle_deg`` (``docs/model.md``, "Driven mount coordinate (SADM)"). A
+    ``[joint_actuator] kind = "sadm_drive"`` is its motor.
+    """
+
+    rotor_inertia_kg_m2: Annotated[
+        float, Strict(), AllowInfNan(False), Field(gt=0.0, le=1e12)
+    ] = Field(description="drive rotor inertia about the SADM axis as seen at the array (a "
+              "geared motor's N^2 J_motor) [kg m^2]")  # fmt: skip
+    rotor_mass_kg: Mass = Field(description="rotor mass, on the axis at the root [kg]")
+
+
 class AppendageConfig(_Frozen):
     """One flexible appendage: a rigid thin plate on a 6-DOF elastic root joint.
 
@@ -196,6 +213,10 @@ class AppendageConfig(_Frozen):
         description="joint DOFs held rigid in time simulation (reduced model; "
         "docs/campaigns.md, 'Reduced models')",
     )
+    drive: DriveConfig | None = Field(
+        None, description="put the plate on a solar-array drive: its SADM angle becomes a "
+        "coordinate; default: the angle is fixed"
+    )  # fmt: skip
 
     @model_validator(mode="after")
     def _one_mass(self) -> AppendageConfig:
@@ -205,7 +226,22 @@ class AppendageConfig(_Frozen):
             raise ValueError("give exactly one of surface_density_kg_m2 and mass_kg")
         if self.thickness_m > min(self.length_m, self.width_m):
             raise ValueError("thickness_m must not exceed length_m or width_m (thin plate)")
+        if self.drive is not None:
+            self._drivable()
         return self
+
+    def _drivable(self) -> None:
+        """Refuse a plate the drive's chain (``driven_plate``) cannot be built from."""
+        if self.locked_dofs:
+            raise ValueError(f"drive: a plate on a drive takes no locked_dofs (got "
+                             f"{self.locked_dofs})")  # fmt: skip
+        if abs(self.sadm_angle_deg) >= 45.0:
+            angle = self.sadm_angle_deg
+            raise ValueError(f"sadm_angle_deg: a plate on a drive starts its drive angle "
+                             f"within -45 < alpha < 45 deg (got {angle:g})")  # fmt: skip
+        if not 1e-4 <= self.mass <= 1e7:
+            raise ValueError(f"drive: a plate on a drive needs a panel mass within [1e-4, 1e7] "
+                             f"kg (got {self.mass:g})")  # fmt: skip
 
     @property
     def mass(self) -> float:

@@ -89,8 +89,16 @@ class Plant:
         """Pack a validated config and tune each appendage to its targets.
 
         The stiffness and damping follow eqs. 2.14-2.15 with J_eq taken from
-        diag M(0) of this very configuration (thesis section 2.2.3).
+        diag M(0) of this very configuration (thesis section 2.2.3). A plate on a drive
+        (its ``drive`` key) is built as its two-segment chain, the joints tuned as the
+        undriven plate's (:func:`~flexsat.dynamics.appendages.sadm.expand_drives`);
+        ``config`` of the result is then the satellite so written.
         """
+        from flexsat.dynamics.appendages.sadm import expand_drives
+
+        expanded = expand_drives(config)
+        if expanded is not config:
+            return cls.from_config(expanded)
         models = tuple(appendage_model(app.model) for app in config.appendages)
         untuned = cls(
             config=config,

@@ -17,7 +17,7 @@ from flexsat.control.stages.registry import no_derivative
 from flexsat.dynamics.attitude import identity_frame, inertial_view, is_identity, rebase
 from flexsat.dynamics.integrators import rk4_hold
 from flexsat.dynamics.plant import Plant
-from flexsat.dynamics.rigid import rigid_inertia
+from flexsat.dynamics.rigid import design_coordinates, rigid_inertia
 from flexsat.dynamics.status import STATUS_CONTROL_FAILED
 from flexsat.errors import ConfigError, SimulationError
 from flexsat.simulate.batch import fly, slew_timing
@@ -69,18 +69,21 @@ def design_inertia(config: SatelliteConfig | None = None) -> np.ndarray:
     Parameters
     ----------
     config : SatelliteConfig, optional
-        The user's nominal configuration; default the thesis's nominal satellite.
+        The user's nominal configuration; default the thesis's nominal satellite. A
+        drive's angle is frozen at its initial value (the plate's ``sadm_angle_deg``).
     """
-    return rigid_inertia(Plant.from_config(config or nominal()))
+    plant = Plant.from_config(config or nominal())
+    return _rigid_at_start(plant, SlewScenario())
 
 
 def slew_design_inertia(plant: Plant, scenario: SlewScenario) -> np.ndarray:
     """The design inertia a slew's controller uses [kg m^2], shape (3, 3).
 
     The scenario's ``design_inertia_kg_m2`` if given, else J_tot of the rigidized
-    ``plant`` configuration. Uncertainty studies perturb the truth plant only: they
-    give the nominal design model explicitly (campaigns write it into each case's
-    scenario from the base configuration).
+    ``plant`` configuration, a solar-array drive's angle frozen at its initial value
+    (:func:`~flexsat.dynamics.rigid.design_coordinates`). Uncertainty studies perturb
+    the truth plant only: they give the nominal design model explicitly (campaigns
+    write it into each case's scenario from the base configuration).
 
     Parameters
     ----------
@@ -96,7 +99,13 @@ def slew_design_inertia(plant: Plant, scenario: SlewScenario) -> np.ndarray:
     """
     if scenario.design_inertia_kg_m2 is not None:
         return np.array(scenario.design_inertia_kg_m2, dtype=float)
-    return rigid_inertia(plant)
+    return _rigid_at_start(plant, scenario)
+
+
+def _rigid_at_start(plant: Plant, scenario: SlewScenario) -> np.ndarray:
+    """J_tot of the rigidized ``plant``, its free coordinates (drives) where the slew
+    starts them, shape (3, 3) [kg m^2]."""
+    return rigid_inertia(plant, design_coordinates(plant, initial_state(plant, scenario)[0]))
 
 
 def run_slew(
@@ -379,7 +388,7 @@ def _loop_data(layout: LoopLayout, scenario: SlewScenario, J: np.ndarray,
     )  # fmt: skip
 
     return LoopData(
-        J_design=J,
+        J_design=J.copy(),  # a joint actuator may update it in place (sadm_drive, "measured")
         q_d=packed(target_quaternion(scenario.target_euler_deg)),  # the reference writes these
         omega_d=np.zeros(3),
         omega_dot_d=np.zeros(3),

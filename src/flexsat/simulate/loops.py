@@ -1,4 +1,4 @@
-"""Compiled closed loop: reference, sensing chain, law, actuation chain, joint actuator.
+"""Compiled closed loop: reference, sensing chain, joint actuator, law, actuation chain.
 
 Each control instant runs them in that order; the RK4 plant steps in between (numba).
 
@@ -107,7 +107,8 @@ class LoopData(NamedTuple):
     Attributes
     ----------
     J_design : ndarray, shape (3, 3)
-        The law's design inertia, hub frame B [kg m^2].
+        The law's design inertia, hub frame B [kg m^2]; the joint actuator may update
+        it in place before the law (its own copy: the run's initial one is kept).
     q_d : ndarray, shape (4,)
         Reference quaternion, scalar first [-].
     omega_d, omega_dot_d : ndarray, shape (3,)
@@ -283,8 +284,9 @@ def rk4_closed_loop(x, clock, stages, d, records, plant, frame):
     """Run ``clock.n_steps`` closed-loop steps from ``clock.t0``; ``x`` advanced in place.
 
     At each step k (time t0 + k dt): re-base the attitude if due, run the reference,
-    the sensing chain, the law,
-    the actuation chain and the joint actuator if k is a control instant, record if
+    the sensing chain, the joint actuator (its ``Q`` held like the torque; it may
+    update ``d.J_design`` for the law), the law and the actuation chain if k is a
+    control instant, record if
     k is a record instant, then take one RK4 step under the held torque and joint
     forces ``d.Q`` (coupled with the chain's continuous states if any). Chunk
     boundaries must be multiples of ``control_every`` and ``record_every``.
@@ -331,13 +333,15 @@ def rk4_closed_loop(x, clock, stages, d, records, plant, frame):
                 inertial_view(x, n, frame, view)
                 sensed = view
             status |= run_sensors(sensed, n, t, stages, d)
+            # before the law: it may update the design inertia the law reads now
+            status |= stages.joint_actuator[0](x, n, t, control_dt, d.q_d, d.J_design,
+                                               d.joint_params, d.joint_state, d.Q,
+                                               d.joint_record)  # fmt: skip
             status |= stages.law[0](
                 d.q_d, d.omega_d, d.omega_dot_d, d.q_meas, d.omega_meas, d.J_design,
                 d.law_gains, d.law_state, t, control_dt, d.tau_cmd, d.law_diag,
             )  # fmt: skip
             status |= run_actuators(x, n, t, control_dt, clock.continuous, stages, d)
-            status |= stages.joint_actuator[0](x, n, t, control_dt, d.q_d, d.joint_params,
-                                               d.joint_state, d.Q, d.joint_record)  # fmt: skip
             if status != 0:
                 return STATUS_CONTROL_FAILED, k, row - records.start
         if k % clock.record_every == 0:

@@ -76,8 +76,9 @@ class JointRateFeedbackConfig(JointActuatorConfig):
 
 
 @njit(JOINT_ACTUATOR_SIGNATURE, cache=True)
-def joint_rate_feedback_step(x, n_dof, t, dt, q_d, params, state, Q, record):
-    """Lagged, limited joint-rate feedback into Q (contract in ``stages.registry``)."""
+def joint_rate_feedback_step(x, n_dof, t, dt, q_d, J_design, params, state, Q, record):
+    """Lagged, limited joint-rate feedback into Q; J_design as it is (contract in
+    ``stages.registry``)."""
     k, limit = params[_GAIN], params[_LIMIT]
     a = exp(-2.0 * pi * params[_BANDWIDTH] * dt)
     active = True

@@ -28,8 +28,8 @@ class NoJointActuatorConfig(JointActuatorConfig):
 
 
 @njit(JOINT_ACTUATOR_SIGNATURE, cache=True)
-def no_joint_actuator_step(x, n_dof, t, dt, q_d, params, state, Q, record):
-    """Leaves Q[6:] at zero (contract in ``stages.registry``)."""
+def no_joint_actuator_step(x, n_dof, t, dt, q_d, J_design, params, state, Q, record):
+    """Leaves Q[6:] at zero and J_design as it is (contract in ``stages.registry``)."""
     return 0
 
 

@@ -37,17 +37,21 @@ writes the reference the law tracks: attitude ``q_d`` (4,), scalar first, rate
 the reference frame D (the law rotates them into B). The default ``step`` reference
 holds the target with zero rate: the thesis's step regulation.
 
-Joint-actuator step, ``@njit(JOINT_ACTUATOR_SIGNATURE, cache=True)``, run last at
-every control instant::
+Joint-actuator step, ``@njit(JOINT_ACTUATOR_SIGNATURE, cache=True)``, run after
+the sensing chain and before the law at every control instant::
 
-    status = step(x, n_dof, t, dt, q_d, params, state, Q, record)
+    status = step(x, n_dof, t, dt, q_d, J_design, params, state, Q, record)
 
 reads the plant state ``x`` and the reference ``q_d`` and writes the generalized
 forces it applies to appendage coordinates into ``Q[6:]`` (n_dof,) [N or N m per
 coordinate], held until the next instant; they enter the plant's equations as
 ``Q`` of eq. 2.50, so the reaction on the hub is the joint equations' own. It never
-writes ``Q[:6]`` (the hub's, overwritten by the integrator). Its parameter model
-derives :class:`JointActuatorConfig` and packs against the plant's state layout
+writes ``Q[:6]`` (the hub's, overwritten by the integrator). ``J_design`` (3, 3)
+[kg m^2], hub frame B, is the law's design inertia: a stage may update it in place
+(``sadm_drive`` with ``design_model = "measured"``: J_tot at the measured drive
+angles), and the law reads it at the same instant; it starts as the run's design
+inertia and keeps the last value written. Its parameter model derives
+:class:`JointActuatorConfig` and packs against the plant's state layout
 (coordinates by name). The default ``none`` applies nothing.
 
 For all: ``params`` are the stage's packed parameters (:meth:`StageConfig.packed`),
@@ -115,9 +119,10 @@ ACTUATOR_SIGNATURE = types.int64(_vec, types.float64, types.float64, _vec, _vec,
 REFERENCE_SIGNATURE = types.int64(types.float64, _vec, _vec, _vec, _vec, _vec, _vec)
 """t, params, state, q_d (out), omega_d (out), omega_dot_d (out), record (out)."""
 JOINT_ACTUATOR_SIGNATURE = types.int64(
-    _vec, types.int64, types.float64, types.float64, _vec, _vec, _vec, _vec, _vec
+    _vec, types.int64, types.float64, types.float64, _vec, types.float64[:, ::1], _vec, _vec,
+    _vec, _vec,
 )
-"""x, n_dof, t, dt, q_d, params, state, Q (out), record (out)."""
+"""x, n_dof, t, dt, q_d, J_design (in/out), params, state, Q (out), record (out)."""
 DERIVATIVE_SIGNATURE = types.int64(_vec, types.int64, types.float64, _vec, _vec, _vec, _vec)
 """x, n_dof, t, params, state, state_dot (out), wrench (in/out, added to)."""
 

@@ -209,8 +209,11 @@ class ChainModel(AppendageModel):
         return rotations, points
 
     def rigid_body(self, params: np.ndarray) -> RigidBody:
+        return self.rigid_body_at(params, np.zeros(self._coordinate_count(params)))
+
+    def rigid_body_at(self, params: np.ndarray, q_block: np.ndarray) -> RigidBody:
         n = self.segment_count(params)
-        rotations, points = self.segment_poses(params, np.zeros(self._coordinate_count(params)))
+        rotations, points = self.segment_poses(params, q_block)
         rows = [HEADER + SEG * k for k in range(n)]
         masses = np.array([params[g + G_MASS] for g in rows])
         coms = np.array([points[k] + rotations[k] @ params[g + G_COM : g + G_COM + 3]

@@ -244,6 +244,18 @@ class AppendageModel(ABC):
     def rigid_body(self, params: np.ndarray) -> RigidBody:
         """The appendage frozen undeformed (rigid design model, thesis appendix A.4)."""
 
+    def rigid_body_at(self, params: np.ndarray, q_block: np.ndarray) -> RigidBody:
+        """The appendage frozen at its coordinates ``q_block`` (count,) [m, rad].
+
+        What a design model that follows a moving mount (a solar-array drive's angle)
+        asks. Default: the undeformed body, only at ``q_block`` = 0 (ValueError
+        otherwise); a model whose rigid shape follows its coordinates (the chain)
+        overrides it.
+        """
+        if np.any(q_block):
+            raise ValueError(f"the {self.name!r} model freezes only undeformed (q = 0)")
+        return self.rigid_body(params)
+
     def tune(self, config: BaseModel, params: np.ndarray, inertia_diag: np.ndarray) -> np.ndarray:
         """The parameter row with stiffness and damping tuned (thesis section 2.2.3).
 

@@ -21,18 +21,22 @@ thesis plate as that two-segment chain:
 With the drive angle held, the panel's kinematics are the plate's exactly
 (R_BP = Rz(yaw) Ry(alpha_sadm) R_MP(rho), the root at the mount point). The drive
 axis is a ZYX joint angle: it must stay within +-90 deg of the mount frame (a
-status names the gimbal lock otherwise). docs/model.md, 'Driven mount coordinate
+status names the gimbal lock otherwise). A satellite TOML puts a plate on a drive
+with its ``drive`` key (:class:`~flexsat.config.models.DriveConfig`); the plant
+builds it through :func:`expand_drives`. docs/model.md, 'Driven mount coordinate
 (SADM)'.
 """
 
 from __future__ import annotations
 
 import numpy as np
+from pydantic import ValidationError
 
 from flexsat.config.models import AppendageConfig, SatelliteConfig
 from flexsat.dynamics.appendages.chain_config import DOF_NAMES, ChainConfig
+from flexsat.errors import ConfigError
 
-__all__ = ["DRIVE_COORDINATE", "driven_plate", "with_sadm"]
+__all__ = ["DRIVE_COORDINATE", "driven_plate", "expand_drives", "with_sadm"]
 
 DRIVE_COORDINATE = "eta_ry_0"
 """Name of the drive angle alpha_sadm in a driven plate's coordinates [rad]."""
@@ -91,10 +95,12 @@ def driven_plate(plate: AppendageConfig, stiffness: np.ndarray, damping: np.ndar
 
 def with_sadm(config: SatelliteConfig, rotor_inertia_kg_m2: float, rotor_mass_kg: float,
               names: tuple[str, ...] | None = None) -> SatelliteConfig:  # fmt: skip
-    """``config`` with its plates (all, or those named) on a SADM (:func:`driven_plate`).
+    """``config`` with its plates (all, or those named) on a SADM: their ``drive`` key set.
 
-    The joints keep the stiffness and damping the plant tunes them to (eqs. 2.14-2.15),
-    so the driven satellite is the same satellite with one more coordinate per plate.
+    The plant builds each such plate as :func:`driven_plate` (:func:`expand_drives`):
+    the joints keep the stiffness and damping the plant tunes them to (eqs.
+    2.14-2.15), so the driven satellite is the same satellite with one more
+    coordinate per plate.
 
     Parameters
     ----------
@@ -110,16 +116,70 @@ def with_sadm(config: SatelliteConfig, rotor_inertia_kg_m2: float, rotor_mass_kg
     Returns
     -------
     SatelliteConfig
-        The driven satellite: each chosen plate a two-segment chain [-].
+        The satellite, each chosen plate with ``drive = {rotor_inertia_kg_m2,
+        rotor_mass_kg}`` [-].
+
+    Raises
+    ------
+    pydantic.ValidationError
+        A plate that cannot go on a drive (its ``drive`` validation message).
+    """
+    drive = {"rotor_inertia_kg_m2": rotor_inertia_kg_m2, "rotor_mass_kg": rotor_mass_kg}
+    appendages = [
+        AppendageConfig.model_validate({**dict(app), "drive": drive})
+        if isinstance(app, AppendageConfig) and (names is None or app.name in names) else app
+        for app in config.appendages
+    ]  # fmt: skip
+    return config.model_copy(update={"appendages": appendages})
+
+
+def expand_drives(config: SatelliteConfig) -> SatelliteConfig:
+    """``config`` with each plate on a drive (its ``drive`` key) written as its chain.
+
+    The joints take the stiffness and damping the plant tunes the undriven plates to
+    (eqs. 2.14-2.15, on the satellite with every drive removed), then
+    :func:`driven_plate` builds each driven plate's two-segment chain.
+
+    Parameters
+    ----------
+    config : SatelliteConfig
+        The satellite.
+
+    Returns
+    -------
+    SatelliteConfig
+        ``config`` itself when no plate has a drive; else a copy whose driven plates
+        are chains [-].
+
+    Raises
+    ------
+    ConfigError
+        Naming the plate's ``drive`` when its chain is refused.
     """
     from flexsat.dynamics.plant import Plant
 
-    plant = Plant.from_config(config)
-    appendages = []
-    for app, model, params in zip(config.appendages, plant.models, plant.params, strict=True):
-        driven = isinstance(app, AppendageConfig) and (names is None or app.name in names)
-        if driven:
-            app = driven_plate(app, model.stiffness(params), model.damping(params),
-                               rotor_inertia_kg_m2, rotor_mass_kg)  # fmt: skip
-        appendages.append(app)
+    driven = [isinstance(app, AppendageConfig) and app.drive is not None
+              for app in config.appendages]  # fmt: skip
+    if not any(driven):
+        return config
+    fixed = [app.model_copy(update={"drive": None}) if d else app
+             for app, d in zip(config.appendages, driven, strict=True)]  # fmt: skip
+    plant = Plant.from_config(config.model_copy(update={"appendages": fixed}))
+    appendages = list(config.appendages)
+    for k, (app, model, params) in enumerate(zip(config.appendages, plant.models, plant.params,
+                                                 strict=True)):  # fmt: skip
+        if driven[k]:
+            appendages[k] = _chain(k, app, model.stiffness(params), model.damping(params))
     return config.model_copy(update={"appendages": appendages})
+
+
+def _chain(k: int, plate: AppendageConfig, stiffness: np.ndarray,
+           damping: np.ndarray) -> ChainConfig:  # fmt: skip
+    """:func:`driven_plate` of appendage ``k``, a refusal as a ConfigError naming its drive."""
+    try:
+        return driven_plate(plate, stiffness, damping, plate.drive.rotor_inertia_kg_m2,
+                            plate.drive.rotor_mass_kg)  # fmt: skip
+    except ValidationError as exc:
+        first = exc.errors()[0]
+        raise ConfigError(f"appendages[{k}].drive: {plate.name!r} cannot be built on a drive: "
+                          f"{first['msg'].removeprefix('Value error, ')}") from None  # fmt: skip
