@@ -10,8 +10,8 @@ drive (:func:`flexsat.dynamics.appendages.sadm.with_sadm`), the ideal loop with
 the drive holding its angle beside the drive turning at :data:`SADM_RATE_DEG_S`
 (``docs/control.md``, "Solar-array drive (SADM)"). Writes
 ``avionics/avionics.json`` and ``avionics/delay_boundary.png``. The runs of (a)
-and (b) are independent: they fly in forked processes side by side
-(:func:`flexsat.parallel.forked_map`).
+and (b) and the two of (c) are independent: they fly in forked processes side by
+side (:func:`flexsat.parallel.forked_map`).
 """
 
 from __future__ import annotations
@@ -99,38 +99,62 @@ def sadm_study(plant, duration_s: float | None = None) -> dict:
         peak tracking error ``peak_tracking_error_deg`` and the largest attitude
         difference from the holding run ``attitude_difference_deg``.
     """
+    driven, runs = _sadm_runs(plant)
+    return _sadm_summary(*(_sadm_run(driven, fields, duration_s) for fields in runs))
+
+
+def _sadm_runs(plant) -> tuple[Plant, list[dict]]:
+    """The driven satellite and the scenario fields of (c)'s runs, holding then turning."""
     from flexsat.dynamics.appendages.sadm import DRIVE_COORDINATE, with_sadm
 
     drive = SADM_DRIVE
-    config = with_sadm(plant.config, drive["rotor_inertia_kg_m2"], drive["rotor_mass_kg"])
-    driven = Plant.from_config(config)
+    driven = Plant.from_config(
+        with_sadm(plant.config, drive["rotor_inertia_kg_m2"], drive["rotor_mass_kg"]))
     plates = [a for a in plant.config.appendages if isinstance(a, AppendageConfig)]
     inertia = drive["rotor_inertia_kg_m2"] + max(a.centroidal_inertia()[1, 1] for a in plates)
     omega_n = 2.0 * np.pi * drive["frequency_hz"]
-    runs = {}
-    for key, rate in (("holding", 0.0), ("turning", SADM_RATE_DEG_S)):
+    runs = []
+    for rate in (0.0, SADM_RATE_DEG_S):
         joint = {"kind": "sadm_drive", "coordinates": [DRIVE_COORDINATE], "rate_deg_s": rate,
                  "stiffness_nm_rad": inertia * omega_n**2,
                  "damping_nms_rad": 2.0 * drive["damping_ratio"] * omega_n * inertia}  # fmt: skip
-        runs[key] = _run(driven, {"joint_actuator": joint}, duration_s)
-    metrics = {key: {k: slew_metrics(ds)[k] for k in _KEYS} for key, ds in runs.items()}
-    turning = runs["turning"]
-    angle = turning["q"].sel(dof=f"{plates[0].name}.{DRIVE_COORDINATE}").values[-1]
-    overlap = np.abs(np.sum(turning["quaternion"].values * runs["holding"]["quaternion"].values,
-                            axis=1))  # fmt: skip
+        runs.append({"joint_actuator": joint})
+    return driven, runs
+
+
+def _sadm_run(driven, fields: dict, duration_s: float | None) -> dict:
+    """One run of (c), reduced to what its summary reads (small enough to return from a
+    forked process): metrics, attitude history, final drive angle, drive peaks."""
+    from flexsat.dynamics.appendages.sadm import DRIVE_COORDINATE
+
+    ds = _run(driven, fields, duration_s)
+    metrics = slew_metrics(ds)
+    first = next(d for d in ds["dof"].values if d.endswith(f".{DRIVE_COORDINATE}"))  # plate 1's
+    return {
+        "metrics": {key: metrics[key] for key in _KEYS},
+        "quaternion": ds["quaternion"].values,
+        "array_angle_deg": float(np.degrees(ds["q"].sel(dof=first).values[-1])),
+        "peak_drive_torque_nm": float(ds["sadm_torque"].max()),
+        "peak_tracking_error_deg": float(np.degrees(ds["sadm_tracking_error"].max())),
+    }
+
+
+def _sadm_summary(holding: dict, turning: dict) -> dict:
+    """:func:`sadm_study`'s payload from its two runs (:func:`_sadm_run`)."""
+    overlap = np.abs(np.sum(turning["quaternion"] * holding["quaternion"], axis=1))
     difference = 2.0 * np.arccos(np.minimum(1.0, overlap))  # angle between the attitudes
     return {
-        "rate_deg_s": SADM_RATE_DEG_S, "drive": drive, **metrics,
-        "array_angle_deg": float(np.degrees(angle)),
-        "peak_drive_torque_nm": float(turning["sadm_torque"].max()),
-        "peak_tracking_error_deg": float(np.degrees(turning["sadm_tracking_error"].max())),
+        "rate_deg_s": SADM_RATE_DEG_S, "drive": SADM_DRIVE,
+        "holding": holding["metrics"], "turning": turning["metrics"],
+        **{key: turning[key] for key in ("array_angle_deg", "peak_drive_torque_nm",
+                                         "peak_tracking_error_deg")},
         "attitude_difference_deg": float(np.degrees(difference.max())),
     }  # fmt: skip
 
 
 def avionics_study(plant, out: str | Path, quick: bool = False,
                    duration_s: float | None = None) -> dict:  # fmt: skip
-    """Run (a) and (b) on ``plant``; write the JSON and the figure under ``out``.
+    """Run (a), (b) and (c) on ``plant``; write the JSON and the figure under ``out``.
 
     Parameters
     ----------
@@ -154,8 +178,19 @@ def avionics_study(plant, out: str | Path, quick: bool = False,
     out = Path(out)
     control_dt = SlewScenario().control_dt_s
     periods = [round(delay / control_dt) for delay in (QUICK_DELAYS_S if quick else DELAYS_S)]
-    runs = [{}, AVIONICS, *(delayed(n) for n in periods)]
-    ideal, avionics, *swept = forked_map(lambda fields: _metrics(plant, fields, duration_s), runs)
+    driven, drive_runs = _sadm_runs(plant)
+    # (on the driven satellite, fields): the items are pickled to the forks, the
+    # satellites are not (the forks inherit them)
+    runs = [(False, fields) for fields in ({}, AVIONICS, *(delayed(n) for n in periods))]
+    runs += [(True, fields) for fields in drive_runs]
+
+    def fly(run: tuple) -> dict:
+        on_drive, fields = run
+        if on_drive:
+            return _sadm_run(driven, fields, duration_s)
+        return _metrics(plant, fields, duration_s)
+
+    ideal, avionics, *swept, holding, turning = forked_map(fly, runs)
     side_by_side = {"ideal": ideal, "avionics": avionics}
     sweep = []
     for n, row in zip(periods, swept, strict=True):
@@ -174,7 +209,7 @@ def avionics_study(plant, out: str | Path, quick: bool = False,
         "r1_lost_at_delay_s": first("r1_pass", False),
         "r2_lost_at_delay_s": first("r2_pass", False),
         "unstable_at_delay_s": first("unstable", True),
-        "sadm": sadm_study(plant, duration_s),
+        "sadm": _sadm_summary(holding, turning),
         "quick": quick,
     }
     from flexsat.study.outputs import write_json
