@@ -21,7 +21,10 @@ accelerations c_k, then inward for the articulated inertias I^A_k and bias force
 p^A_k, handing the hub X_0^T I^a_0 X_0 and X_0^T p^a_0; pass 2 runs outward for
 q_ddot_k = D_k^-1 (u_k - U_k^T (X_k a_{k-1} + c_k)). Cost is linear in N. M(q) and
 h(q, q_dot) (analysis only, not in the integration loop) are the composite-rigid-body
-and recursive Newton-Euler algorithms and allocate one scratch row per chain.
+and recursive Newton-Euler algorithms and allocate one scratch row per chain. The
+root's wrench on the hub (tau_flex, :func:`joint_wrench`) is the Newton-Euler sum of
+the segments' inertial forces at the plant's q_ddot, so it holds the root joint's
+constraint reactions; one outward pass, nothing allocated.
 """
 
 from __future__ import annotations
