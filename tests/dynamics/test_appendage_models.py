@@ -46,6 +46,7 @@ from flexsat.dynamics.linalg3 import (
     add_block,
     cross,
     dot,
+    euler_rate_bias,
     euler_rate_matrix,
     load_seg,
     mm,
@@ -145,8 +146,21 @@ def _observe(q, qd, members, params, out):
 
 
 @njit(WRENCH_SIGNATURE, cache=True)
-def _joint_wrench(q, qd, Q, members, params, out):
-    return 0  # a rigid mount: no elastic or damping wrench
+def _joint_wrench(q, qd, qdd, Q, members, params, out):
+    # A rigid mount transmits the mass's whole inertial load: -m a at r, with its
+    # acceleration a = a_hub + alpha x r + w x (w x r) read from the plant's q_ddot.
+    S = euler_rate_matrix(q[3], q[4])
+    w = mv(S, load_seg(qd, 3))
+    alpha = add(mv(S, load_seg(qdd, 3)), euler_rate_bias(q[3], q[4], qd[3], qd[4], qd[5]))
+    a_hub = mtv(rot_zyx(q[3], q[4], q[5]), load_seg(qdd, 0))
+    for j in range(members.shape[0]):
+        m, r = params[j, 0], load_seg(params[j], 1)
+        f = scale(m, add(a_hub, add(cross(alpha, r), cross(w, cross(w, r)))))
+        t = cross(r, f)
+        for a in range(3):
+            out[a] -= f[a]
+            out[3 + a] -= t[a]
+    return 0
 
 
 @njit(TIPS_SIGNATURE, cache=True)
@@ -236,6 +250,29 @@ def test_omega_dot_is_the_combined_rigid_body(with_mass):
     # elimination: 1e-12 relative.
     np.testing.assert_allclose(qdd[3:6], alpha, rtol=1e-12, atol=1e-15)
     np.testing.assert_allclose(qdd[0:3], np.cross(alpha, -c), rtol=1e-12, atol=1e-15)
+
+
+def test_tau_flex_is_the_hubs_own_newton_euler(with_mass):
+    # The wrench the mass and the plates put on the hub is what moves the hub alone:
+    # m_h a_hub = f and J_h omega_dot + w x J_h w = tau_flex + tau at a deformed, spinning
+    # state. Both sides are the same 6 x 6 solve's round-off apart: 1e-12 of the largest
+    # term.
+    rng = np.random.default_rng(3)
+    q = rng.normal(scale=0.1, size=with_mass.n_dof)
+    qd = rng.normal(scale=0.1, size=with_mass.n_dof)
+    tau = np.array([0.3, -1.2, 2.0])  # [N m]
+    Q = with_mass.generalized_forces(q, tau)
+    qdd = with_mass.accelerations(q, qd, Q)
+    force, torque = with_mass.joint_wrench_on_hub(q, qd, Q)
+    S = np.array(euler_rate_matrix(q[3], q[4]))
+    w = S @ qd[3:6]
+    w_dot = S @ qdd[3:6] + np.array(euler_rate_bias(q[3], q[4], qd[3], qd[4], qd[5]))
+    J = with_mass.hub_J
+    euler = J @ w_dot + np.cross(w, J @ w) - tau
+    newton = with_mass.hub_mass * np.array(rot_zyx(q[3], q[4], q[5])).T @ qdd[0:3]
+    scale_ = max(np.abs(euler).max(), np.abs(newton).max())
+    np.testing.assert_allclose(torque, euler, rtol=0, atol=1e-12 * scale_)
+    np.testing.assert_allclose(force, newton, rtol=0, atol=1e-12 * scale_)
 
 
 def test_rigid_design_inertia_includes_the_mass(with_mass):

@@ -326,17 +326,23 @@ def bias_forces(q, qd, packed, h):
 
 
 @njit(cache=True, error_model="numpy")
-def hub_joint_wrench(q, qd, Q, packed, out):
+def hub_joint_wrench(q, qd, qdd, Q, packed, out):
     """Wrench the appendages' joints exert on the hub, written into ``out``.
 
-    Elastic + damping, plus any external generalized force on the joint coordinates.
+    The whole wrench each root joint transmits: elastic + damping, plus any external
+    generalized force on the joint coordinates, plus the constraint reaction of the
+    directions the joint does not free (contract ``WRENCH_SIGNATURE``).
 
     Parameters
     ----------
     q, qd : ndarray, shape (n_dof,)
         Generalized coordinates [m, rad] and their rates [m/s, rad/s].
+    qdd : ndarray, shape (n_dof,)
+        Generalized accelerations at (q, qd) [m/s^2, rad/s^2], as :func:`accelerations`
+        returns them (locked rows zero).
     Q : ndarray, shape (n_dof,)
-        External generalized forces [N, N m per coordinate].
+        Generalized forces on the appendage coordinates: joint actuations and the
+        constraint forces of locked coordinates [N, N m per coordinate].
     packed : PackedPlant
         The plant's packed arrays and kernels.
     out : ndarray, shape (6,)
@@ -350,7 +356,8 @@ def hub_joint_wrench(q, qd, Q, packed, out):
     """
     out[:] = 0.0
     for g in range(len(packed.joint_wrench)):
-        status = packed.joint_wrench[g](q, qd, Q, packed.members[g], packed.params[g], out)
+        status = packed.joint_wrench[g](q, qd, qdd, Q, packed.members[g], packed.params[g],
+                                        out)
         if status != STATUS_OK:
             return status
     return STATUS_OK

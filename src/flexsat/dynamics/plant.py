@@ -80,7 +80,8 @@ class Plant:
         views = {
             "mass_matrix": ("mass_matrix",), "bias_forces": ("bias_forces",),
             "accelerations": ("pass1", "pass2", "mass_matrix"), "observe": ("observe",),
-            "joint_wrench": ("joint_wrench",), "tips": ("tips",),
+            "joint_wrench": ("pass1", "pass2", "mass_matrix", "joint_wrench"),
+            "tips": ("tips",),
         }  # fmt: skip
         object.__setattr__(self, "_views", {k: only(self.packed, *v) for k, v in views.items()})
 
@@ -351,15 +352,36 @@ class Plant:
     ) -> tuple[np.ndarray, np.ndarray]:
         """Force and torque tau_flex the joints exert on the hub (about its centre of mass).
 
+        The whole wrench each root joint transmits, as the records report it: its
+        elastic, damping and external generalized forces and the constraint reactions
+        of the directions it does not free (and of locked coordinates), which depend on
+        the accelerations q_ddot = M^-1 (Q - h - C q_dot - k_el) the forces ``Q`` give.
+
+        Parameters
+        ----------
+        q, qd : ndarray, shape (n_dof,)
+            Generalized coordinates [m, rad] and rates [m/s, rad/s].
+        Q : ndarray, shape (n_dof,), optional
+            External generalized forces, hub rows included (:meth:`generalized_forces`)
+            [N, N m per coordinate]; default none.
+
         Returns
         -------
         force_B, torque_B : ndarray, shape (3,)
             In hub frame B [N], [N m]; zero at rest and undeformed.
+
+        Raises
+        ------
+        SimulationError
+            At a ZYX Euler-angle singularity of the hub or of a joint.
         """
-        out = np.empty(6)
-        status = kernels.hub_joint_wrench(
-            self._state(q), self._state(qd), self._state(Q), self._views["joint_wrench"], out
-        )
+        q, qd, Q = self._state(q), self._state(qd), self._state(Q)
+        view = self._views["joint_wrench"]
+        qdd, out = np.empty(self.n_dof), np.empty(6)
+        status = kernels.accelerations(q, qd, Q, view, qdd)
+        if status == STATUS_OK:
+            joint = Q + view.reaction[1] if view.constrained else Q  # as the records do
+            status = kernels.hub_joint_wrench(q, qd, qdd, joint, view, out)
         if status != STATUS_OK:
             raise SimulationError(status_message(status))
         return out[:3].copy(), out[3:].copy()

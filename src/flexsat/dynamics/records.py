@@ -66,7 +66,7 @@ def derive_records(
     """
     m, n = q.shape
     Q = np.zeros(n)
-    no_external = np.zeros(n)  # tau_flex: elastic and damping wrench (and constraint forces)
+    no_external = np.zeros(n)  # no joint actuation; the engine's constraint forces if locked
     qdd = np.empty(n)
     wrench = np.empty(6)
     obs = np.empty(OBS_SIZE)
@@ -80,7 +80,7 @@ def derive_records(
         status = accelerations(qk, qdk, Q, packed, qdd)
         # a locked joint carries its constraint force (left by accelerations)
         joint = packed.reaction[1] if packed.constrained else no_external
-        status |= hub_joint_wrench(qk, qdk, joint, packed, wrench)
+        status |= hub_joint_wrench(qk, qdk, qdd, joint, packed, wrench)
         if status == STATUS_OK:
             bias = euler_rate_bias(qk[3], qk[4], qdk[3], qdk[4], qdk[5])
             w_dot = mv(S, load_seg(qdd, 3))

@@ -21,7 +21,10 @@ accelerations c_k, then inward for the articulated inertias I^A_k and bias force
 p^A_k, handing the hub X_0^T I^a_0 X_0 and X_0^T p^a_0; pass 2 runs outward for
 q_ddot_k = D_k^-1 (u_k - U_k^T (X_k a_{k-1} + c_k)). Cost is linear in N. M(q) and
 h(q, q_dot) (analysis only, not in the integration loop) are the composite-rigid-body
-and recursive Newton-Euler algorithms and allocate one scratch row per chain.
+and recursive Newton-Euler algorithms and allocate one scratch row per chain. The
+root's wrench on the hub (tau_flex, :func:`joint_wrench`) is the Newton-Euler sum of
+the segments' inertial forces at the plant's q_ddot, so it holds the root joint's
+constraint reactions; one outward pass, nothing allocated.
 """
 
 from __future__ import annotations
@@ -57,6 +60,7 @@ from flexsat.dynamics.linalg3 import (
     add,
     cross,
     dot,
+    euler_rate_bias,
     euler_rate_bias_cs,
     euler_rate_matrix,
     euler_rate_matrix_cs,
@@ -270,6 +274,31 @@ def _cos_sin(angle, free):
 
 
 @njit(cache=True, error_model="numpy")
+def _joint_values(x, o, p, g):
+    """The six DOF values (x, y, z), (rx, ry, rz) of the joint whose segment's columns
+    start at p[g], read from the plant vector ``x`` (q, q_dot or q_ddot); 0 where locked."""
+    c = o + int(p[g + G_OFF])
+    v0 = v1 = v2 = v3 = v4 = v5 = 0.0
+    for i in range(6):
+        if p[g + G_FREE + i] != 0.0:
+            v = x[c]
+            c += 1
+            if i == 0:
+                v0 = v
+            elif i == 1:
+                v1 = v
+            elif i == 2:
+                v2 = v
+            elif i == 3:
+                v3 = v
+            elif i == 4:
+                v4 = v
+            else:
+                v5 = v
+    return (v0, v1, v2), (v3, v4, v5)
+
+
+@njit(cache=True, error_model="numpy")
 def _joint_pose(q, qd, o, p, g, first):
     """Pose and relative motion of the joint whose segment's columns start at p[g].
 
@@ -277,25 +306,8 @@ def _joint_pose(q, qd, o, p, g, first):
     S(rho), the joint velocity v_J = S_k qd_k and its bias c_J = S_dot_k qd_k (both in
     segment coordinates), and a status.
     """
-    c = o + int(p[g + G_OFF])
-    x = y = z = rx = ry = rz = 0.0
-    dx = dy = dz = drx = dry = drz = 0.0
-    for i in range(6):
-        if p[g + G_FREE + i] != 0.0:
-            v, dv = q[c], qd[c]
-            c += 1
-            if i == 0:
-                x, dx = v, dv
-            elif i == 1:
-                y, dy = v, dv
-            elif i == 2:
-                z, dz = v, dv
-            elif i == 3:
-                rx, drx = v, dv
-            elif i == 4:
-                ry, dry = v, dv
-            else:
-                rz, drz = v, dv
+    t, (rx, ry, rz) = _joint_values(q, o, p, g)
+    (dx, dy, dz), (drx, dry, drz) = _joint_values(qd, o, p, g)
     free_x, free_z = p[g + G_FREE + 3], p[g + G_FREE + 5]
     c1, s1 = _cos_sin(rx, free_x)
     c2, s2 = _cos_sin(ry, p[g + G_FREE + 4])
@@ -305,7 +317,6 @@ def _joint_pose(q, qd, o, p, g, first):
         status = STATUS_JOINT_GIMBAL_LOCK
     R_JP = rot_zyx_cs(c1, s1, c2, s2, c3, s3)
     S_rho = euler_rate_matrix_cs(c1, s1, c2, s2)
-    t = (x, y, z)
     if first:  # J_0 is the mount frame M
         R_PJ = load_m33_at(p, H_R_BM)
         pos = add(load_seg(p, H_MOUNT), mv(R_PJ, t))
@@ -362,6 +373,36 @@ def _invert_spd(w, k, n):
             w[k + 6 * r + e] = 0.0
             for c in range(n):
                 w[k + 6 * r + c] -= f * w[k + 6 * e + c]
+
+
+@njit(cache=True, error_model="numpy")
+def _outward(q, qd, o, p, g, first, va, vl, aa, al):
+    """One outward step of the recursive Newton-Euler algorithm (eqs. C.1, C.6).
+
+    From the parent's spatial velocity (va, vl) and acceleration (aa, al) in its own
+    coordinates, the segment's: v_k = X_k v_{k-1} + S_k qd_k and
+    a_k = X_k a_{k-1} + c_J + v_k x_m S_k qd_k, the acceleration at q_ddot_k = 0 (the
+    caller adds S_k q_ddot_k). Returns R, pos, R_JP, S(rho) as :func:`_joint_pose`,
+    then va, vl, aa, al and the status.
+    """
+    R, pos, R_JP, S_rho, ja, jl, ca, cl, status = _joint_pose(q, qd, o, p, g, first)
+    xa, xl = _xm(R, pos, va, vl)
+    va, vl = add(xa, ja), add(xl, jl)
+    xa, xl = _xm(R, pos, aa, al)
+    ba, bl = _crm(va, vl, ja, jl)
+    aa, al = add(add(xa, ca), ba), add(add(xl, cl), bl)
+    return R, pos, R_JP, S_rho, va, vl, aa, al, status
+
+
+@njit(cache=True, error_model="numpy")
+def _body_force(p, g, va, vl, aa, al):
+    """The force f_k = I_k a_k + v_k x_f I_k v_k that moves segment k (eq. C.8), [n; f]
+    in its frame about its joint origin."""
+    m, c, J = p[g + G_MASS], load_seg(p, g + G_COM), load_m33_at(p, g + G_J)
+    fn, ff = _inertia_mul(m, c, J, aa, al)
+    hn, hf = _inertia_mul(m, c, J, va, vl)
+    gn, gf = _crf(va, vl, hn, hf)
+    return add(fn, gn), add(ff, gf)
 
 
 @njit(PASS1_SIGNATURE, cache=True, error_model="numpy")
@@ -649,21 +690,15 @@ def bias_forces(q, qd, members, params, hub, h):
         va, vl, aa, al = omega_B, _ZERO, s_bias, _ZERO
         for k in range(n_seg):
             g, b = HEADER + k * SEG, k * WSEG
-            R, pos, R_JP, S_rho, ja, jl, ca, cl, status = _joint_pose(q, qd, o, p, g, k == 0)
+            R, pos, R_JP, S_rho, va, vl, aa, al, status = _outward(
+                q, qd, o, p, g, k == 0, va, vl, aa, al
+            )
             _put_m33(w, b + W_R, R)
             _put3(w, b + W_POS, pos)
             _store_subspace(w, b, p, g, R_JP, S_rho)
-            xa, xl = _xm(R, pos, va, vl)
-            va, vl = add(xa, ja), add(xl, jl)
-            xa, xl = _xm(R, pos, aa, al)
-            ba, bl = _crm(va, vl, ja, jl)
-            aa, al = add(add(xa, ca), ba), add(add(xl, cl), bl)
-            m, c, J = p[g + G_MASS], load_seg(p, g + G_COM), load_m33_at(p, g + G_J)
-            fn, ff = _inertia_mul(m, c, J, aa, al)
-            hn, hf = _inertia_mul(m, c, J, va, vl)
-            gn, gf = _crf(va, vl, hn, hf)
-            _put3(w, b + W_PA, add(fn, gn))
-            _put3(w, b + W_PA + 3, add(ff, gf))
+            fn, ff = _body_force(p, g, va, vl, aa, al)
+            _put3(w, b + W_PA, fn)
+            _put3(w, b + W_PA + 3, ff)
         for k in range(n_seg - 1, -1, -1):
             g, b = HEADER + k * SEG, k * WSEG
             fn, ff = load_seg(w, b + W_PA), load_seg(w, b + W_PA + 3)
@@ -739,39 +774,39 @@ def observe(q, qd, members, params, out):
                     a += 1
 
 
-@njit(cache=True, error_model="numpy")
-def _inv3(m):
-    """Inverse of a 3 x 3 matrix by cofactors."""
-    c00 = m[1][1] * m[2][2] - m[1][2] * m[2][1]
-    c01 = m[1][2] * m[2][0] - m[1][0] * m[2][2]
-    c02 = m[1][0] * m[2][1] - m[1][1] * m[2][0]
-    det = m[0][0] * c00 + m[0][1] * c01 + m[0][2] * c02
-    s = 1.0 / det
-    return (
-        (s * c00, s * (m[0][2] * m[2][1] - m[0][1] * m[2][2]),
-         s * (m[0][1] * m[1][2] - m[0][2] * m[1][1])),
-        (s * c01, s * (m[0][0] * m[2][2] - m[0][2] * m[2][0]),
-         s * (m[0][2] * m[1][0] - m[0][0] * m[1][2])),
-        (s * c02, s * (m[0][1] * m[2][0] - m[0][0] * m[2][1]),
-         s * (m[0][0] * m[1][1] - m[0][1] * m[1][0])),
-    )  # fmt: skip
-
-
 @njit(WRENCH_SIGNATURE, cache=True, error_model="numpy")
-def joint_wrench(q, qd, Q, members, params, out):
-    """Add the wrench each chain's root joint exerts on the hub (tau_flex in out[3:6]).
+def joint_wrench(q, qd, qdd, Q, members, params, out):
+    """Add the wrench each chain's root joint transmits to the hub (tau_flex in out[3:6]).
 
-    The root's generalized forces tau (elastic, damping, external) are the wrench
-    [n; f] on segment 0 with S^T [n; f] = tau and no component the joint does not
-    free: f = sum_i tau_i R_JP^T e_i, n = S_r (S_r^T S_r)^-1 tau_r over the free
-    rotations (= S(rho)^-T tau_r on a full joint, the plate's N_P).
+    The hub moves the chain through its root joint, so the wrench [n_0; f_0] the joint
+    puts on segment 0 is what the chain needs to move as it does: the sum of the
+    segments' inertial forces (recursive Newton-Euler, eq. C.9)
+
+        f_0 = sum_k (0X_k)^T (I_k a_k + v_k x_f I_k v_k),
+        a_k = X_k a_{k-1} + S_k q_ddot_k + c_k,   a_{-1} = [omega_dot_B; a_hub],
+        omega_dot_B = S(Theta) Theta_ddot + S_dot(Theta) Theta_dot,
+        a_hub = R_NB^T r_ddot_N,
+
+    with (0X_k)^T the force transform from segment k's frame to segment 0's; the
+    segments carry no other applied load (a generalized force Q on a chain coordinate
+    is a joint actuation, internal to the chain but at the root, where it is in f_0
+    through the accelerations). On the hub acts -X_0^T f_0. Its components along the
+    root's motion subspace are the joint's generalized forces, S_0^T f_0 = Q_0 - K_0 q_0
+    - C_0 q_dot_0 (the joint's equation of motion); the other components are the
+    constraint reaction of the directions the joint does not free. On a full 6-DOF root
+    S_0 is invertible and f_0 = S_0^-T (Q_0 - K_0 q_0 - C_0 q_dot_0), the plate's
+    (F_M, N_P). The constraint forces of coordinates the engine locks are in q_ddot too,
+    so ``Q`` is not read. One outward pass, each segment's force moved straight to the
+    hub centre of mass: O(N), nothing allocated.
 
     Parameters
     ----------
     q, qd : ndarray, shape (n_dof,)
         Generalized coordinates [m, rad] and rates [m/s, rad/s] of the whole plant.
+    qdd : ndarray, shape (n_dof,)
+        Generalized accelerations of the whole plant at (q, qd) [m/s^2, rad/s^2].
     Q : ndarray, shape (n_dof,)
-        External generalized forces [N, N m per coordinate].
+        External generalized forces [N, N m per coordinate]; not read (above).
     members : ndarray, shape (k, 2), int64
         Per chain: appendage index and offset of its first coordinate in q [-].
     params : ndarray, shape (k, p)
@@ -783,50 +818,38 @@ def joint_wrench(q, qd, Q, members, params, out):
     Returns
     -------
     int
-        ``STATUS_OK``.
+        ``STATUS_OK`` or a joint gimbal-lock status.
     """
+    phi, theta = q[3], q[4]
+    omega_B = mv(euler_rate_matrix(phi, theta), load_seg(qd, 3))
+    alpha_B = add(mv(euler_rate_matrix(phi, theta), load_seg(qdd, 3)),
+                  euler_rate_bias(phi, theta, qd[3], qd[4], qd[5]))  # fmt: skip
+    a_hub_B = mtv(rot_zyx(phi, theta, q[5]), load_seg(qdd, 0))
     for j in range(members.shape[0]):
         o = members[j, 1]
         p = params[j]
-        g = HEADER
-        R, pos, R_JP, S_rho, ja, jl, ca, cl, status = _joint_pose(q, qd, o, p, g, True)
-        if status != STATUS_OK:
-            return status
-        col = o + int(p[g + G_OFF])
-        t0 = t1 = t2 = r0 = r1 = r2 = 0.0
-        a = 0
-        for i in range(6):
-            if p[g + G_FREE + i] != 0.0:
-                v = Q[col + a] - p[g + G_K + i] * q[col + a] - p[g + G_C + i] * qd[col + a]
-                a += 1
-                if i == 0:
-                    t0 = v
-                elif i == 1:
-                    t1 = v
-                elif i == 2:
-                    t2 = v
-                elif i == 3:
-                    r0 = v
-                elif i == 4:
-                    r1 = v
-                else:
-                    r2 = v
-        f = mtv(R_JP, (t0, t1, t2))
-        fx, fy, fz = p[g + G_FREE + 3], p[g + G_FREE + 4], p[g + G_FREE + 5]
-        s0 = scale(fx, (S_rho[0][0], S_rho[1][0], S_rho[2][0]))
-        s1 = scale(fy, (S_rho[0][1], S_rho[1][1], S_rho[2][1]))
-        s2 = scale(fz, (S_rho[0][2], S_rho[1][2], S_rho[2][2]))
-        G = (
-            (dot(s0, s0) + 1.0 - fx, dot(s0, s1), dot(s0, s2)),
-            (dot(s1, s0), dot(s1, s1) + 1.0 - fy, dot(s1, s2)),
-            (dot(s2, s0), dot(s2, s1), dot(s2, s2) + 1.0 - fz),
-        )
-        y = mv(_inv3(G), (r0, r1, r2))
-        n = add(add(scale(y[0], s0), scale(y[1], s1)), scale(y[2], s2))
-        hn, hf = _xft(R, pos, n, f)
+        va, vl, aa, al = omega_B, _ZERO, alpha_B, a_hub_B
+        R_BP = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
+        r_O = _ZERO
+        n_B, f_B = _ZERO, _ZERO
+        for k in range(int(p[H_N])):
+            g = HEADER + k * SEG
+            R, pos, R_JP, S_rho, va, vl, aa, al, status = _outward(
+                q, qd, o, p, g, k == 0, va, vl, aa, al
+            )
+            if status != STATUS_OK:
+                return status
+            t_dd, rho_dd = _joint_values(qdd, o, p, g)  # S_k q_ddot_k
+            aa, al = add(aa, mv(S_rho, rho_dd)), add(al, mtv(R_JP, t_dd))
+            fn, ff = _body_force(p, g, va, vl, aa, al)
+            r_O = add(r_O, mv(R_BP, pos))
+            R_BP = mm(R_BP, R)
+            f = mv(R_BP, ff)
+            f_B = add(f_B, f)
+            n_B = add(n_B, add(mv(R_BP, fn), cross(r_O, f)))
         for r in range(3):
-            out[r] -= hf[r]
-            out[3 + r] -= hn[r]
+            out[r] -= f_B[r]
+            out[3 + r] -= n_B[r]
     return STATUS_OK
 
 

@@ -110,10 +110,16 @@ BIAS_SIGNATURE = types.void(_v, _v, _i, _m, _v, _v)
 and ``hub[HUB_SBIAS]``."""
 OBSERVE_SIGNATURE = types.void(_v, _v, _i, _m, _v)
 """``observe(q, qd, members, params, out)``: add to the observables (``OBS_*`` slots)."""
-WRENCH_SIGNATURE = types.int64(_v, _v, _v, _i, _m, _v)
-"""``joint_wrench(q, qd, Q, members, params, out) -> status``: add the wrench of its
-joint's elastic, damping and external generalized forces on the hub, ``out`` (6,) =
-[force_B, torque_B about the hub centre of mass] (tau_flex)."""
+WRENCH_SIGNATURE = types.int64(_v, _v, _v, _v, _i, _m, _v)
+"""``joint_wrench(q, qd, qdd, Q, members, params, out) -> status``: add the wrench its
+root joint transmits to the hub, ``out`` (6,) = [force_B, torque_B about the hub centre
+of mass] (tau_flex): its elastic, damping and external generalized forces ``Q`` and,
+where the joint does not free a direction, its constraint reaction. ``qdd`` (n_dof,) is
+the whole plant's q_ddot at (q, qd) (hub rows included), for a model whose reaction
+depends on the accelerations; a model that needs none ignores it. The model reads
+its own rows of ``Q`` (n_dof,): the generalized forces on its coordinates (joint
+actuations, the constraint forces of coordinates the engine locks); a model whose
+wrench comes from ``qdd`` has their effect there already and ignores ``Q``."""
 TIPS_SIGNATURE = types.void(_v, _i, _m, _m)
 """``tips(q, members, params, out)``: write row ``members[j, 0]`` of ``out`` (n, 3): the
 tip displacement from the undeformed place, mount frame [m]."""

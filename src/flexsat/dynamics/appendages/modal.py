@@ -413,9 +413,10 @@ def observe(q, qd, members, params, out):
 
 
 @njit(WRENCH_SIGNATURE, cache=True, error_model="numpy")
-def joint_wrench(q, qd, Q, members, params, out):
+def joint_wrench(q, qd, qdd, Q, members, params, out):
     """Add the modes' elastic, damping and external forces transmitted to the hub:
-    sum_k l_k (omega_k^2 eta_k + 2 zeta_k omega_k eta_dot_k - Q_k) at the interface."""
+    sum_k l_k (omega_k^2 eta_k + 2 zeta_k omega_k eta_dot_k - Q_k) at the interface
+    (eq. M.7, the mode-displacement load; ``qdd`` is not read, docs/model.md)."""
     for j in range(members.shape[0]):
         o, p = members[j, 1], params[j]
         r = load_seg(p, P_MOUNT)

@@ -629,8 +629,13 @@ def observe(q, qd, members, params, out):
 
 
 @njit(WRENCH_SIGNATURE, cache=True, error_model="numpy")
-def joint_wrench(q, qd, Q, members, params, out):
-    """Add the wrench the plates' joints exert on the hub (tau_flex in out[3:6])."""
+def joint_wrench(q, qd, qdd, Q, members, params, out):
+    """Add the wrench the plates' joints exert on the hub (tau_flex in out[3:6]).
+
+    The joint frees all six DOFs and is massless, so the wrench is that of its
+    generalized forces Q - K q - C q_dot alone (``_joint_wrench``; the constraint forces
+    of locked DOFs arrive in ``Q``); ``qdd`` is not needed.
+    """
     for j in range(members.shape[0]):
         o = members[j, 1]
         p = params[j]
