@@ -15,6 +15,7 @@ the recorded omega_dot is that one, and the recorded ``joint_force`` is the repl
 from __future__ import annotations
 
 import numpy as np
+import pytest
 
 from flexsat.campaigns.definition import load_campaign, resolve_cases
 from flexsat.config import nominal
@@ -101,14 +102,19 @@ def test_a_driven_array_s_motor_torque_reacts_in_the_records():
     _check(plant, SlewScenario.model_validate({**_SHORT, "joint_actuator": drive}))
 
 
-def test_root_dampers_torques_react_in_the_records():
+@pytest.mark.parametrize("locked", [[], ["eta_x", "eta_y", "eta_z"]])
+def test_root_dampers_torques_react_in_the_records(locked):
     # Hybrid damping (tests/simulate/test_hybrid_damping.py) on the thesis plates'
     # root rotations, the first deployment-shock case (deformed panels, the dampers at
     # their 0.1 N m authority). Before the records took its Q, tau_flex missed the
     # dampers' torques: the Euler residual was 1.4e-2 of the peak and omega_dot off by
-    # 1.4e-2 (measured after: 3.8e-16 and 2.1e-16).
+    # 1.4e-2 (measured after: 3.8e-16 and 2.1e-16). With the root translations locked
+    # tau_flex adds the dampers' torques to the constraint forces.
     case = resolve_cases(load_campaign("deployment-shock"), nominal())[0]
-    plant = Plant.from_config(SatelliteConfig.model_validate(case.plant))
+    config = SatelliteConfig.model_validate(case.plant).model_dump(mode="json")
+    for appendage in config["appendages"]:
+        appendage["locked_dofs"] = locked
+    plant = Plant.from_config(SatelliteConfig.model_validate(config))
     damping = {"kind": "rate_feedback", "coordinates": ["eta_rx", "eta_ry", "eta_rz"],
                "gain": 10.0, "limit": 0.1, "bandwidth_hz": 20.0}  # fmt: skip
     scenario = {**case.scenario, **_SHORT, "joint_actuator": damping}
