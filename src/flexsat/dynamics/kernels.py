@@ -79,6 +79,7 @@ __all__ = [
     "accelerations",
     "bias_forces",
     "hub_joint_wrench",
+    "joint_forces",
     "mass_matrix",
     "observe",
     "tip_displacement",
@@ -323,6 +324,30 @@ def bias_forces(q, qd, packed, h):
         packed.bias_forces[g](q, qd, packed.members[g], packed.params[g], hub, h)
     h[0], h[1], h[2] = load_seg(hub, HUB_FORCE)
     h[3], h[4], h[5] = mtv(S, load_seg(hub, HUB_TORQUE))
+
+
+@njit(cache=True, error_model="numpy")
+def joint_forces(Q, packed, out):
+    """Generalized forces the joints carry at the state :func:`accelerations` last
+    evaluated, written into ``out``: the external ones ``Q`` plus the constraint forces
+    of the locked coordinates (``packed.reaction[1]``, if the plant has any).
+
+    Parameters
+    ----------
+    Q : ndarray, shape (n_dof,)
+        The external generalized forces that evaluation was given [N, N m per
+        coordinate].
+    packed : PackedPlant
+        The plant's packed arrays and kernels.
+    out : ndarray, shape (n_dof,)
+        Output: the joints' generalized forces, the ``Q`` argument of
+        :func:`hub_joint_wrench` [N, N m per coordinate].
+    """
+    out[:] = Q
+    if packed.constrained:
+        reaction = packed.reaction[1]
+        for i in range(out.shape[0]):
+            out[i] += reaction[i]
 
 
 @njit(cache=True, error_model="numpy")

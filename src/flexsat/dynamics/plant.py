@@ -377,10 +377,10 @@ class Plant:
         """
         q, qd, Q = self._state(q), self._state(qd), self._state(Q)
         view = self._views["joint_wrench"]
-        qdd, out = np.empty(self.n_dof), np.empty(6)
+        qdd, joint, out = np.empty(self.n_dof), np.empty(self.n_dof), np.empty(6)
         status = kernels.accelerations(q, qd, Q, view, qdd)
         if status == STATUS_OK:
-            joint = Q + view.reaction[1] if view.constrained else Q  # as the records do
+            kernels.joint_forces(Q, view, joint)  # as the records do
             status = kernels.hub_joint_wrench(q, qd, qdd, joint, view, out)
         if status != STATUS_OK:
             raise SimulationError(status_message(status))

@@ -19,6 +19,7 @@ from flexsat.dynamics.appendages.contract import (
 from flexsat.dynamics.kernels import (
     accelerations,
     hub_joint_wrench,
+    joint_forces,
     observe,
     tip_displacement,
 )
@@ -37,7 +38,7 @@ __all__ = ["derive_records"]
 
 @njit(cache=True)
 def derive_records(
-    q, qd, tau_B, packed,
+    q, qd, tau_B, joint_force, packed,
     omega, omega_dot, tau_flex, H, H_rigid, kinetic, elastic, tips,
 ):  # fmt: skip
     """Fill the derived arrays, row by row, from recorded states.
@@ -48,6 +49,10 @@ def derive_records(
         Recorded generalized coordinates [m, rad] and rates [m/s, rad/s].
     tau_B : ndarray, shape (m, 3)
         Applied body torque at each record [N m].
+    joint_force : ndarray, shape (m, n_dof)
+        Generalized forces of the joint actuators held from each record, on the
+        appendage coordinates (columns 6 and on; the hub's are not read) [N, N m per
+        coordinate]; zeros without joint actuators.
     packed : PackedPlant
         ``Plant.packed``.
     omega, omega_dot, tau_flex, H, H_rigid : ndarray, shape (m, 3)
@@ -61,12 +66,15 @@ def derive_records(
 
     Notes
     -----
-    A row whose state is singular (the last state of a failed run) gets NaN
-    accelerations and joint torque.
+    Each row's q_ddot is that of the plant under the applied torque and the joint
+    forces, and tau_flex the wrench of the joints carrying those forces plus, on a
+    locked plant, the locked coordinates' constraint forces
+    (:func:`~flexsat.dynamics.kernels.joint_forces`). A row whose state is singular
+    (the last state of a failed run) gets NaN accelerations and joint torque.
     """
     m, n = q.shape
     Q = np.zeros(n)
-    no_external = np.zeros(n)  # no joint actuation; the engine's constraint forces if locked
+    joint = np.empty(n)
     qdd = np.empty(n)
     wrench = np.empty(6)
     obs = np.empty(OBS_SIZE)
@@ -77,9 +85,9 @@ def derive_records(
         w = mv(S, load_seg(qdk, 3))
         omega[k, 0], omega[k, 1], omega[k, 2] = w
         Q[3], Q[4], Q[5] = mtv(S, load_seg(tau_B[k], 0))
+        Q[6:] = joint_force[k, 6:]
         status = accelerations(qk, qdk, Q, packed, qdd)
-        # a locked joint carries its constraint force (left by accelerations)
-        joint = packed.reaction[1] if packed.constrained else no_external
+        joint_forces(Q, packed, joint)
         status |= hub_joint_wrench(qk, qdk, qdd, joint, packed, wrench)
         if status == STATUS_OK:
             bias = euler_rate_bias(qk[3], qk[4], qdk[3], qdk[4], qdk[5])

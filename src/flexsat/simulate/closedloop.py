@@ -153,7 +153,8 @@ def run_slew(
         idle = LoopClock(0.0, scenario.dt_s, 0, False, scenario.control_every,
                          scenario.record_every, layout.continuous)  # fmt: skip
         rk4_closed_loop(run.x.copy(), idle, run.stages, run.data,
-                        LoopRecords(run.rec_t, run.rec_x, run.rec_ctrl, 0, run.rec_frame),
+                        LoopRecords(run.rec_t, run.rec_x, run.rec_ctrl, 0, run.rec_frame,
+                                    run.rec_Q),
                         plant.packed, identity_frame())  # fmt: skip
     start = time.perf_counter()
     with progress_bar(show, scenario.duration_s) as (bar, task):
@@ -202,6 +203,9 @@ class PreparedSlew(NamedTuple):
         Recorded control rows [SI units of each channel].
     rec_frame : ndarray, shape (m, 9)
         Recorded attitude references R_NF [-].
+    rec_Q : ndarray, shape (m, n_dof)
+        Recorded joint-actuator forces held from each record, hub columns zero
+        [N, N m per coordinate].
     """
 
     plant: Plant
@@ -217,6 +221,7 @@ class PreparedSlew(NamedTuple):
     rec_x: np.ndarray  # (m, x_size)
     rec_ctrl: np.ndarray  # (m, record_size)
     rec_frame: np.ndarray  # (m, 9)
+    rec_Q: np.ndarray  # (m, n_dof)
 
 
 def prepare_slew(plant: Plant, scenario: SlewScenario,
@@ -258,6 +263,7 @@ def prepare_slew(plant: Plant, scenario: SlewScenario,
         data, stages, np.full(n_records, np.nan),
         np.full((n_records, layout.plant.size), np.nan),
         np.full((n_records, layout.record_size), np.nan), np.full((n_records, 9), np.nan),
+        np.zeros((n_records, plant.n_dof)),  # a Python law's loop applies none
     )  # fmt: skip
 
 
@@ -285,12 +291,14 @@ def finish_slew(run: PreparedSlew, status: int, done: int, rows: int, wall: floa
     Result
     """
     plant, scenario, law, layout, J, x, frame, data = run[:8]
-    rec_t, rec_x, rec_ctrl, rec_frame = run.rec_t, run.rec_x, run.rec_ctrl, run.rec_frame
+    records = run.rec_t, run.rec_x, run.rec_ctrl, run.rec_frame, run.rec_Q
+    rec_t, rec_x, rec_ctrl, rec_frame, rec_Q = records
     t_fail = done * scenario.dt_s if status else -1.0
     if status:  # keep the last good state as the final record
         rec_t[rows], rec_x[rows], rec_ctrl[rows], rec_frame[rows] = t_fail, x, data.held, frame
+        rec_Q[rows, :6], rec_Q[rows, 6:] = 0.0, data.Q[6:]  # as the loop records them
         rows += 1
-    rec_t, rec_x, rec_ctrl, rec_frame = (a[:rows] for a in (rec_t, rec_x, rec_ctrl, rec_frame))
+    rec_t, rec_x, rec_ctrl, rec_frame, rec_Q = (a[:rows] for a in records)
     attrs = run_attributes(plant, scenario, "closed-loop", status, t_fail, wall, done)
     attrs["controller"] = law.name if compiled_law else "python"
     attrs["controller_label"] = law.label if compiled_law else "Python law"
@@ -310,7 +318,7 @@ def finish_slew(run: PreparedSlew, status: int, done: int, rows: int, wall: floa
     ds = build_dataset(
         plant, rec_t, rec_x[:, at.q], rec_x[:, at.qd], rec_x[:, at.work_in],
         rec_x[:, at.dissipated], rec_ctrl[:, layout.tau_cmd], rec_ctrl[:, layout.tau_applied],
-        attrs, frames=rec_frame,
+        attrs, frames=rec_frame, joint_force=rec_Q,
     )  # fmt: skip
     ta = ("time", "axis")
     for channel, columns in layout.channels():
@@ -425,8 +433,8 @@ def _compiled_loop(run: PreparedSlew, bar, task) -> tuple[int, int, int]:
     per_call = 1 if bar is not None else timing.n_steps + 1
     while True:
         status, done, rows = fly(run.x, timing, run.stages, run.data, run.rec_t, run.rec_x,
-                                 run.rec_ctrl, run.rec_frame, run.plant.packed, run.frame,
-                                 done, rows, per_call)  # fmt: skip
+                                 run.rec_ctrl, run.rec_frame, run.rec_Q, run.plant.packed,
+                                 run.frame, done, rows, per_call)  # fmt: skip
         if bar is not None:
             bar.update(task, completed=done * run.scenario.dt_s)
         if status != 0 or done == timing.n_steps:

@@ -121,9 +121,10 @@ class progress_bar:
 
 
 # Measured on the nominal satellite (18 DOF): about 830 B per record of an open-loop
-# dataset and 980 B of a slew's, i.e. 8 B x (5 per DOF + 40) at most; the records,
-# the dataset built from them and the NetCDF writer hold up to three copies.
-_BYTES_PER_RECORD_PER_DOF = 40.0
+# dataset and 1130 B of a slew's (its joint forces included), i.e. 8 B x (6 per DOF
+# + 40) at most; the records, the dataset built from them and the NetCDF writer hold
+# up to three copies.
+_BYTES_PER_RECORD_PER_DOF = 48.0
 _BYTES_PER_RECORD = 320.0
 _COPIES = 3.0
 _SECONDS_PER_STEP_PER_DOF = 0.25e-6  # 3.4-3.9 us per RK4 step at 18 DOF (docs/performance.md)

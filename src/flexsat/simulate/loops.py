@@ -191,6 +191,10 @@ class LoopRecords(NamedTuple):
         First row this call writes.
     frame : ndarray, shape (m, 9)
         Attitude reference R_NF of each recorded state, row-major [-].
+    Q : ndarray, shape (m, n_dof)
+        The joint actuator's generalized forces ``LoopData.Q`` held from each record
+        (the plant steps under them from the recorded state), zero on the hub
+        coordinates [N, N m per coordinate].
     """
 
     t: np.ndarray  # (m,) [s]
@@ -198,6 +202,7 @@ class LoopRecords(NamedTuple):
     ctrl: np.ndarray  # (m, record_size)
     start: int
     frame: np.ndarray  # (m, 9) attitude reference R_NF of each recorded state
+    Q: np.ndarray  # (m, n_dof) joint forces held from each record, hub columns zero
 
 
 @njit(cache=True)
@@ -349,6 +354,8 @@ def rk4_closed_loop(x, clock, stages, d, records, plant, frame):
             records.x[row, :] = x
             records.frame[row, :] = frame
             records.ctrl[row, :] = d.held
+            records.Q[row, :6] = 0.0  # d.Q[:6] holds the integrator's last hub forces
+            records.Q[row, 6:] = d.Q[6:]
             row += 1
         if k == clock.n_steps:
             break

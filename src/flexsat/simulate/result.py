@@ -242,6 +242,7 @@ def build_dataset(
     attrs: dict,
     energy0: float | None = None,
     frames: np.ndarray | None = None,
+    joint_force: np.ndarray | None = None,
 ) -> xr.Dataset:
     """Derive every recorded quantity from the recorded states.
 
@@ -267,6 +268,11 @@ def build_dataset(
         (:mod:`flexsat.dynamics.attitude`);
         the hub part of ``q`` and ``qd`` is relative to it. Default: the identity.
         The dataset holds every attitude, position and momentum relative to N.
+    joint_force : ndarray, shape (m, n_dof), optional
+        Generalized forces of the joint actuators held from each record, zero on the
+        hub coordinates [N, N m per coordinate] (a slew's joint actuator): the
+        accelerations and tau_flex are those of the plant under them, and the dataset
+        holds them as ``joint_force``. Default: none (no variable).
     """
     m, n = q.shape
     names = [a.name for a in plant.config.appendages]
@@ -279,11 +285,12 @@ def build_dataset(
     kinetic = np.empty(m)
     elastic = np.empty(m)
     tips = np.zeros((m, n_app, 3))
+    joints = np.zeros((m, n)) if joint_force is None else np.ascontiguousarray(joint_force)
     # A diverged run keeps its last finite state, whose derived values may overflow.
     with np.errstate(over="ignore", invalid="ignore"):
         derive_records(
             np.ascontiguousarray(q), np.ascontiguousarray(qd), np.ascontiguousarray(tau_applied),
-            plant.packed, omega, omega_dot, tau_flex, H, H_rigid, kinetic, elastic, tips,
+            joints, plant.packed, omega, omega_dot, tau_flex, H, H_rigid, kinetic, elastic, tips,
         )  # fmt: skip
     if frames is not None:  # relative to N: H_N = R_NF H_F (docs/model.md)
         q, qd = inertial_records(q, qd, omega, frames)
@@ -334,6 +341,12 @@ def build_dataset(
             "E(t) - E(0) - W_in(t) + W_diss(t): numerical error of the integration",
         ),
     }
+    if joint_force is not None:
+        data_vars["joint_force"] = var(
+            ("time", "dof"), joint_force, "SI (N, N m)",
+            "generalized forces of the joint actuators, held from each record (zero on "
+            "the hub coordinates)",
+        )  # fmt: skip
     coords = {
         "time": ("time", t, {"units": "s", "long_name": "time since the start of the run"}),
         "axis": list(AXES),
