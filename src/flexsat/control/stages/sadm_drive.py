@@ -29,7 +29,7 @@ before the law, the stage writes
 
 where J_j(a) is J_tot of the rigid design model (:func:`flexsat.dynamics.rigid.rigid_inertia`,
 about the hub centre of mass) with drive j at angle a and the others at their
-initial angle. J_tot is a sum over the frozen bodies of R J_c R^T + m (|r|^2 I - r r^T)
+initial angle. J_tot is a sum over the frozen bodies of R J_c R^T + m ((r . r) I - r r^T)
 about the hub centre of mass, a fixed point of B: a drive turning its bodies about
 a fixed axis by a makes R(a) = I + sin a [u]x + (1 - cos a) [u]x^2 and each centre of
 mass r(a) affine in (cos a, sin a), so each term, and J_j, is the trigonometric
@@ -240,7 +240,7 @@ def follow_design(x, params, n, J_design, state):
     Returns
     -------
     float
-        max |J_design - J_design,0| over the entries [kg m^2].
+        The largest entry of abs(J_design - J_design,0) [kg m^2].
     """
     if state[_FLAG] == 0.0:  # the run's design inertia, before any change
         for a in range(9):
