@@ -22,6 +22,7 @@ from numba import njit
 
 from flexsat.dynamics.appendages.contract import HUB_DISSIPATION
 from flexsat.dynamics.attitude import rebase
+from flexsat.dynamics.borrowed import borrowed
 from flexsat.dynamics.kernels import accelerations
 from flexsat.dynamics.linalg3 import euler_rate_matrix, mtv
 from flexsat.dynamics.status import STATUS_NOT_FINITE, STATUS_OK
@@ -136,6 +137,7 @@ def rk4_step(x, dt, torque_B, n, Q, scratch, packed):
     int
         ``STATUS_OK``, a kernel status or ``STATUS_NOT_FINITE``.
     """
+    x, Q, scratch, packed = borrowed(x), borrowed(Q), borrowed(scratch), borrowed(packed)
     size = x.shape[0]
     k1, k2, k3, k4, stage = scratch[0], scratch[1], scratch[2], scratch[3], scratch[4]
     status = augmented_derivative(x, torque_B, n, Q, k1, packed)
@@ -184,6 +186,7 @@ def rk4_hold(x, dt, n_steps, torque_B, packed, frame):
     done : int
         Steps completed without error.
     """
+    x, packed, frame = borrowed(x), borrowed(packed), borrowed(frame)
     n = packed.n_dof
     scratch = np.empty((5, x.shape[0]))
     Q = np.zeros(n)  # no joint actuators
@@ -238,6 +241,8 @@ def rk4_open_loop(
     steps_done : int
         Steps completed without error (x is the state after them).
     """
+    x, packed, frame = borrowed(x), borrowed(packed), borrowed(frame)
+    rec_t, rec_x, rec_tau, rec_frame = borrowed((rec_t, rec_x, rec_tau, rec_frame))
     n = packed.n_dof
     scratch = np.empty((5, x.shape[0]))
     Q = np.zeros(n)  # no joint actuators

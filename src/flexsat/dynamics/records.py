@@ -16,6 +16,7 @@ from flexsat.dynamics.appendages.contract import (
     OBS_MOMENTUM,
     OBS_SIZE,
 )
+from flexsat.dynamics.borrowed import borrowed
 from flexsat.dynamics.kernels import (
     accelerations,
     hub_joint_wrench,
@@ -72,6 +73,9 @@ def derive_records(
     (:func:`~flexsat.dynamics.kernels.joint_forces`). A row whose state is singular
     (the last state of a failed run) gets NaN accelerations and joint torque.
     """
+    q, qd, tau_B, joint_force, packed = borrowed((q, qd, tau_B, joint_force, packed))
+    omega, omega_dot, tau_flex, H = borrowed((omega, omega_dot, tau_flex, H))
+    H_rigid, kinetic, elastic, tips = borrowed((H_rigid, kinetic, elastic, tips))
     m, n = q.shape
     Q = np.zeros(n)
     joint = np.empty(n)

@@ -24,6 +24,7 @@ import numpy as np
 from numba import njit
 
 from flexsat.dynamics.attitude import inertial_view, is_identity, rebase
+from flexsat.dynamics.borrowed import borrowed
 from flexsat.dynamics.integrators import rk4_step
 from flexsat.dynamics.status import STATUS_CONTROL_FAILED, STATUS_OK
 from flexsat.simulate.coupled import LoopFlow, chain_wrench, rk4_coupled_step
@@ -205,7 +206,7 @@ class LoopRecords(NamedTuple):
     Q: np.ndarray  # (m, n_dof) joint forces held from each record, hub columns zero
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def run_sensors(x, n, t, stages, d):
     """The sensing chain at one control instant: each stage refines q_meas, omega_meas.
 
@@ -234,7 +235,7 @@ def run_sensors(x, n, t, stages, d):
     return status
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def run_actuators(x, n, t, control_dt, continuous, stages, d):
     """The actuation chain at one control instant, from ``tau_cmd`` to ``tau_applied``.
 
@@ -322,6 +323,8 @@ def rk4_closed_loop(x, clock, stages, d, records, plant, frame):
     records_written : int
         Rows written.
     """
+    # the caller owns them for the call: no reference counting inside the loop
+    x, d, records, plant, frame = borrowed((x, d, records, plant, frame))
     n = plant.n_dof
     scratch = np.empty((5, x.shape[0]))
     view = np.empty(x.shape[0])  # x relative to N, for the sensing chain, once switched
