@@ -3,12 +3,14 @@ saturation, far-limit wheels against the ideal actuator, refused configurations.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
 from flexsat.analysis.requirements import slew_metrics
-from flexsat.control.stages.wheels import WheelsConfig, wheel_axes
+from flexsat.control.stages.wheels import WheelsConfig, _smooth_sign, wheel_axes
 from flexsat.simulate import SlewScenario, run_slew
 
 
@@ -120,3 +122,15 @@ def test_a_python_controller_flies_the_wheels_like_the_compiled_loop(nominal_pla
     # Friction (1e-3 N m Coulomb + viscous) slows each wheel by ~1e-3 N m s in 1 s.
     np.testing.assert_allclose(ds["wheel_momentum_B"].values[0], [0.0, 0.0, h0], atol=1e-9)
     assert abs(ds["wheel_momentum_B"].values[-1, 2] - h0) < 5e-3
+
+
+def test_the_friction_sign_is_the_c_librarys_tanh_bit_for_bit() -> None:
+    """The shortcut for abs(z) >= 22 returns what tanh itself returns there (exactly
+    +-1), so the wheels' results do not depend on it: 400 001 arguments across the
+    switch, the infinities and NaN."""
+    z = np.concatenate([np.linspace(-60.0, 60.0, 400_001), [21.999999999, 22.0, -22.0,
+                        np.inf, -np.inf, 0.0, -0.0, 1e-300]])  # fmt: skip
+    fast = np.array([_smooth_sign(v) for v in z])
+    exact = np.array([math.tanh(v) for v in z])
+    assert np.array_equal(fast.view(np.int64), exact.view(np.int64))
+    assert math.isnan(_smooth_sign(math.nan))
