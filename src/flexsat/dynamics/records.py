@@ -73,15 +73,26 @@ def derive_records(
     (:func:`~flexsat.dynamics.kernels.joint_forces`). A row whose state is singular
     (the last state of a failed run) gets NaN accelerations and joint torque.
     """
+    n = q.shape[1]
+    _derive_rows(q, qd, tau_B, joint_force, packed, omega, omega_dot, tau_flex, H, H_rigid,
+                 kinetic, elastic, tips, np.zeros(n), np.empty(n), np.empty(n), np.empty(6),
+                 np.empty(OBS_SIZE))  # fmt: skip
+
+
+@njit(cache=True)
+def _derive_rows(
+    q, qd, tau_B, joint_force, packed,
+    omega, omega_dot, tau_flex, H, H_rigid, kinetic, elastic, tips,
+    Q, joint, qdd, wrench, obs,
+):  # fmt: skip
+    """:func:`derive_records` on work arrays its caller owns: Q, the joint forces and
+    q_ddot (n_dof,), the hub wrench (6,), the observation row (``OBS_SIZE``); all
+    borrowed (:mod:`flexsat.dynamics.borrowed`)."""
     q, qd, tau_B, joint_force, packed = borrowed((q, qd, tau_B, joint_force, packed))
     omega, omega_dot, tau_flex, H = borrowed((omega, omega_dot, tau_flex, H))
     H_rigid, kinetic, elastic, tips = borrowed((H_rigid, kinetic, elastic, tips))
-    m, n = q.shape
-    Q = np.zeros(n)
-    joint = np.empty(n)
-    qdd = np.empty(n)
-    wrench = np.empty(6)
-    obs = np.empty(OBS_SIZE)
+    Q, joint, qdd, wrench, obs = borrowed((Q, joint, qdd, wrench, obs))
+    m = q.shape[0]
     L = OBS_LOCKED_INERTIA
     for k in range(m):
         qk, qdk = q[k], qd[k]
