@@ -32,7 +32,7 @@ bias speed without torquing the hub; each u_cmd,i is clipped to the motor limit.
 
 from __future__ import annotations
 
-from math import tanh
+from math import copysign, exp, tanh
 from typing import Annotated, Literal
 
 import numpy as np
@@ -174,15 +174,22 @@ def _momentum(p, s, i):
 
 @njit(cache=True, inline="always")
 def _smooth_sign(z):
-    """tanh(z), returning +-1 at once for abs(z) >= 22, where the C library's tanh
-    returns exactly +-1 (1 - 2 / (exp(2 z) + 1) rounds to 1 from abs(z) > 19.1): the
-    same numbers, without the exponential a spinning wheel would pay at every RK4
-    stage."""
-    if z >= 22.0:
-        return 1.0
-    if z <= -22.0:
-        return -1.0
-    return tanh(z)
+    """tanh(z), the Coulomb sign smoothed, at half the C library's cost.
+
+    With e = exp(-2 abs(z)), tanh(z) = sign(z) (1 - e) / (1 + e): one exponential,
+    where the C library's tanh calls ``expm1`` behind a range reduction (9.2 against
+    4.8 ns per call, measured in ``docs/performance.md``). Below abs(z) = 0.55 the
+    subtraction 1 - e would cancel (e > 1/3), so the library's tanh runs there;
+    from abs(z) = 22 both are exactly +-1. Within 2 ulp of ``math.tanh`` everywhere
+    (``tests/control/test_wheels.py``).
+    """
+    a = abs(z)
+    if a < 0.55 or a != a:  # near zero, and NaN
+        return tanh(z)
+    if a >= 22.0:
+        return copysign(1.0, z)
+    e = exp(-2.0 * a)
+    return copysign((1.0 - e) / (1.0 + e), z)
 
 
 @njit(DERIVATIVE_SIGNATURE, cache=True, error_model="numpy")
