@@ -12,6 +12,7 @@ Needs ``perf`` (``linux-perf``) and permission to profile the own process
 (``kernel.perf_event_paranoid`` <= 2). Usage::
 
     python bench/profile_slew.py --case full --duration 120 --runs 4
+    python bench/profile_slew.py --case ideal --reduced --runs 30
 """
 
 from __future__ import annotations
@@ -30,6 +31,7 @@ from pathlib import Path
 from numba.core.registry import CPUDispatcher
 
 from flexsat import Plant, nominal
+from flexsat.campaigns.definition import Reduced
 from flexsat.simulate import SlewScenario, run_slew
 
 SENSORS = [{"kind": "gyro"}, {"kind": "star_tracker"}, {"kind": "mekf"}]
@@ -71,11 +73,21 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--duration", type=float, default=120.0, help="slew length [s]")
     parser.add_argument("--runs", type=int, default=4, help="slews recorded")
     parser.add_argument("--top", type=int, default=25, help="symbols printed")
+    parser.add_argument("--reduced", action="store_true",
+                        help="the campaigns' reduced model: root translations locked, "
+                             "10 ms step and control period")  # fmt: skip
     args = parser.parse_args(argv)
     if shutil.which("perf") is None:
         sys.exit("perf is not installed (Debian: linux-perf)")
-    plant = Plant.from_config(nominal())
-    scenario = SlewScenario.model_validate({"duration_s": args.duration, **CASES[args.case]})
+    config, fields = nominal(), {"duration_s": args.duration, **CASES[args.case]}
+    if args.reduced:
+        reduced = Reduced()
+        config = config.model_copy(update={"appendages": [
+            app.model_copy(update={"locked_dofs": reduced.locked_dofs})
+            for app in config.appendages]})  # fmt: skip
+        fields |= {"dt_s": reduced.dt_s, "control_dt_s": reduced.control_dt_s}
+    plant = Plant.from_config(config)
+    scenario = SlewScenario.model_validate(fields)
     run_slew(plant, scenario.model_copy(update={"duration_s": 0.1}))  # compile
     count = write_symbol_map(Path(f"/tmp/perf-{os.getpid()}.map"))
     data = Path(tempfile.mkdtemp()) / "perf.data"
@@ -93,7 +105,8 @@ def main(argv: list[str] | None = None) -> None:
         capture_output=True, text=True, check=False,
     )  # fmt: skip
     rows = [line for line in report.stdout.splitlines() if "%" in line and "[" in line]
-    print(f"{args.case}: {args.runs} slews of {args.duration:g} s, {count} compiled "
+    model = " (reduced)" if args.reduced else ""
+    print(f"{args.case}{model}: {args.runs} slews of {args.duration:g} s, {count} compiled "
           f"functions mapped; share of samples:")  # fmt: skip
     for line in rows[: args.top]:
         print(line[:120])
