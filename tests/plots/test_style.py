@@ -114,3 +114,24 @@ def test_save_figure_releases_the_figure(tmp_path):
     path = style.save_figure(fig, tmp_path / "sub" / "one.png", dpi=20)
     assert path.read_bytes().startswith(PNG_MAGIC)
     assert not fig.axes  # cleared once written
+
+
+def test_log_axes_keep_only_the_ticks_in_view_and_draw_the_same_image(tmp_path):
+    def draw():
+        fig, axes = style.figure(2, 1, size=(6.0, 5.0))  # two axes sharing a log x axis
+        f = np.geomspace(1e-3, 200.0, 300)
+        for ax in axes[:, 0]:
+            ax.loglog(f, 1.0 / (1.0 + f**2))
+            ax.grid(True, which="both")
+        return fig, axes
+
+    fig, axes = draw()
+    fig.savefig(tmp_path / "plain.png", dpi=40)
+    fig, axes = draw()
+    style._log_ticks_in_view(fig)
+    fig.savefig(tmp_path / "in_view.png", dpi=40)
+    assert (tmp_path / "in_view.png").read_bytes() == (tmp_path / "plain.png").read_bytes()
+    for axis in (axes[0, 0].xaxis, axes[1, 0].xaxis, axes[0, 0].yaxis):
+        lo, hi = sorted(axis.get_view_interval())
+        for ticks in (axis.get_majorticklocs(), axis.get_minorticklocs()):
+            assert ticks.size and np.all((ticks >= lo * (1 - 1e-6)) & (ticks <= hi * (1 + 1e-6)))

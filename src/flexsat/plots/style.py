@@ -27,6 +27,7 @@ import numpy as np
 import xarray as xr
 from matplotlib.axes import Axes
 from matplotlib.figure import Figure
+from matplotlib.ticker import LogLocator
 
 from flexsat.parallel import figure_workers, forked_map
 
@@ -296,9 +297,54 @@ def save_figure(fig: Figure, path: str | Path, *, dpi: int) -> Path:
     path.parent.mkdir(parents=True, exist_ok=True)
     # PNG at zlib level 1: a fraction of the default level's time for a slightly larger file
     extra = {"pil_kwargs": {"compress_level": 1}} if path.suffix.lower() == ".png" else {}
+    _log_ticks_in_view(fig)
     fig.savefig(path, dpi=dpi, **extra)
     _release(fig)
     return path
+
+
+class _InViewLogLocator(LogLocator):
+    """The ticks of a log axis's own locator that lie in the view, its edges included.
+
+    A log locator returns whole decades beyond both ends of the view, up to two
+    decades of minor ticks that are never drawn; matplotlib still builds a tick
+    (three lines, two texts) for each. Dropping them before drawing leaves every
+    drawn tick and the image unchanged.
+    """
+
+    def __init__(self, inner: LogLocator) -> None:
+        super().__init__()
+        self.inner = inner
+
+    def set_axis(self, axis) -> None:
+        super().set_axis(axis)
+        self.inner.set_axis(axis)
+
+    def tick_values(self, vmin: float, vmax: float) -> np.ndarray:
+        locs = np.asarray(self.inner.tick_values(vmin, vmax))
+        lo, hi = sorted((vmin, vmax))
+        # a relative slack keeps the ticks matplotlib draws at the edges of the view
+        return locs[(locs >= lo * (1.0 - 1e-6)) & (locs <= hi * (1.0 + 1e-6))]
+
+    def nonsingular(self, vmin: float, vmax: float) -> tuple:
+        return self.inner.nonsingular(vmin, vmax)
+
+    def view_limits(self, vmin: float, vmax: float) -> tuple:
+        return self.inner.view_limits(vmin, vmax)
+
+
+def _log_ticks_in_view(fig: Figure) -> None:
+    """Give every log axis of ``fig`` locators that return the ticks in view only."""
+    for ax in fig.axes:
+        for axis in (ax.xaxis, ax.yaxis):
+            if axis.get_scale() != "log":
+                continue
+            # shared axes share their locators: wrap each once
+            major, minor = axis.get_major_locator(), axis.get_minor_locator()
+            if type(major) is LogLocator:
+                axis.set_major_locator(_InViewLogLocator(major))
+            if type(minor) is LogLocator:
+                axis.set_minor_locator(_InViewLogLocator(minor))
 
 
 def _release(fig: Figure) -> None:
