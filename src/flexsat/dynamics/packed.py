@@ -202,12 +202,17 @@ _KERNELS: dict[tuple[int, str], FirstClassKernel] = {}
 
 
 def first_class(dispatcher, signature) -> FirstClassKernel:
-    """The :class:`FirstClassKernel` of a dispatcher compiled with ``signature`` (cached).
+    """The :class:`FirstClassKernel` of a dispatcher with ``signature`` (cached).
+
+    A kernel declared without its signature (``@njit(cache=True)``) is compiled with it
+    here, on the first plant that uses its model (or loaded from numba's disk cache):
+    importing flexsat then compiles no model a run does not use. A kernel declared
+    with its signature was compiled at import.
 
     Parameters
     ----------
     dispatcher : numba dispatcher
-        The kernel; it must have been compiled with ``signature`` (else TypeError).
+        The kernel.
     signature : numba signature
         Its contract signature.
 
@@ -215,13 +220,23 @@ def first_class(dispatcher, signature) -> FirstClassKernel:
     -------
     FirstClassKernel
         The same object for the same dispatcher and signature.
+
+    Raises
+    ------
+    TypeError
+        If the kernel was declared with other signatures only, or does not compile
+        with ``signature``.
     """
     key = (id(dispatcher), str(signature))
     if key not in _KERNELS:
+        name = getattr(dispatcher, "__name__", dispatcher)
         if signature.args not in dispatcher.signatures:
-            raise TypeError(
-                f"{getattr(dispatcher, '__name__', dispatcher)!r} must be compiled with "
-                f"@njit({signature}, cache=True)"
-            )
+            try:
+                dispatcher.compile(signature)
+            except Exception as error:  # numba's typing errors, or compilation disabled
+                first_line = str(error).strip().splitlines()[0] if str(error).strip() else ""
+                raise TypeError(f"{name!r} must compile with its contract signature "
+                                f"{signature} (declare it @njit(cache=True) or with that "
+                                f"signature): {first_line}") from None  # fmt: skip
         _KERNELS[key] = FirstClassKernel(dispatcher, signature)
     return _KERNELS[key]

@@ -35,7 +35,6 @@ import numpy as np
 from numba import njit
 
 from flexsat.dynamics.appendages.contract import (
-    BIAS_SIGNATURE,
     HUB_ACC,
     HUB_ALPHA,
     HUB_DISSIPATION,
@@ -44,17 +43,11 @@ from flexsat.dynamics.appendages.contract import (
     HUB_OMEGA,
     HUB_SBIAS,
     HUB_TORQUE,
-    MASS_SIGNATURE,
     OBS_DISSIPATION,
     OBS_ELASTIC,
     OBS_KINETIC,
     OBS_LOCKED_INERTIA,
     OBS_MOMENTUM,
-    OBSERVE_SIGNATURE,
-    PASS1_SIGNATURE,
-    PASS2_SIGNATURE,
-    TIPS_SIGNATURE,
-    WRENCH_SIGNATURE,
 )
 from flexsat.dynamics.linalg3 import (
     add,
@@ -405,7 +398,7 @@ def _body_force(p, g, va, vl, aa, al):
     return add(fn, gn), add(ff, gf)
 
 
-@njit(PASS1_SIGNATURE, cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy")  # compiled with PASS1_SIGNATURE on first use
 def pass1(q, qd, Q, members, params, work, hub, qdd):
     """Velocities outward, articulated inertias inward; the root's share to the hub.
 
@@ -521,7 +514,7 @@ def pass1(q, qd, Q, members, params, work, hub, qdd):
     return STATUS_OK
 
 
-@njit(PASS2_SIGNATURE, cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy")  # compiled with PASS2_SIGNATURE on first use
 def pass2(q, qd, members, params, work, hub, qdd):
     """Joint accelerations outward from the hub's: q_ddot_k = D^-1 (u - U^T a'_k).
 
@@ -585,7 +578,7 @@ def _subspace_pass(q, o, p, w):
         _store_subspace(w, b, p, g, R_JP, S_rho)
 
 
-@njit(MASS_SIGNATURE, cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy")  # compiled with MASS_SIGNATURE on first use
 def mass_matrix(q, members, params, M):
     """The chains' share of M(q) (eq. 2.39): composite-rigid-body algorithm.
 
@@ -661,7 +654,7 @@ def mass_matrix(q, members, params, M):
                         M[3 + e, a] += v
 
 
-@njit(BIAS_SIGNATURE, cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy")  # compiled with BIAS_SIGNATURE on first use
 def bias_forces(q, qd, members, params, hub, h):
     """The chains' share of h(q, q_dot) (eq. 2.43): recursive Newton-Euler at q_ddot = 0.
 
@@ -719,7 +712,7 @@ def bias_forces(q, qd, members, params, hub, h):
                     hub[HUB_TORQUE + r] += pn[r]
 
 
-@njit(OBSERVE_SIGNATURE, cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy")  # compiled with OBSERVE_SIGNATURE on first use
 def observe(q, qd, members, params, out):
     """Add the chains' kinetic energy, momentum, locked inertia, elastic energy, damper power.
 
@@ -774,7 +767,7 @@ def observe(q, qd, members, params, out):
                     a += 1
 
 
-@njit(WRENCH_SIGNATURE, cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy")  # compiled with WRENCH_SIGNATURE on first use
 def joint_wrench(q, qd, qdd, Q, members, params, out):
     """Add the wrench each chain's root joint transmits to the hub (tau_flex in out[3:6]).
 
@@ -853,7 +846,7 @@ def joint_wrench(q, qd, qdd, Q, members, params, out):
     return STATUS_OK
 
 
-@njit(TIPS_SIGNATURE, cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy")  # compiled with TIPS_SIGNATURE on first use
 def tips(q, members, params, out):
     """Displacement of each chain's free end from its undeformed place, mount frame [m].
 

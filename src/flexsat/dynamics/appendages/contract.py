@@ -17,9 +17,13 @@ form:
    the summed articulated inertias;
 3. ``pass2``: the member's coordinate accelerations given the hub's acceleration.
 
-Every kernel is ``@njit(<its signature below>, cache=True)``: numba then types a
-tuple of them by signature, so the engine's loops compile once and run any model,
-built-in or a user's own from their own file, at full speed.
+Every kernel is a numba function compiled with its signature below: numba then types
+a tuple of them by signature, so the engine's loops compile once and run any model,
+built-in or a user's own from their own file, at full speed. Declared
+``@njit(cache=True)``, a kernel is compiled with its signature when the first plant
+uses its model (:func:`flexsat.dynamics.packed.first_class`), so importing flexsat
+compiles no model a run does not use (the built-in models are declared so);
+declared ``@njit(<its signature>, cache=True)``, it is compiled at import.
 
 Arguments common to the kernels: ``q``, ``qd``, ``Q`` (n_dof,) generalized
 coordinates, rates and external forces of the whole plant; ``members`` (k, 2) int64,

@@ -50,7 +50,6 @@ from scipy.spatial.transform import Rotation
 from flexsat.config.modal_data import ModalData, load_modal_data
 from flexsat.config.models import Angle, Matrix3, Name, Point3
 from flexsat.dynamics.appendages.contract import (
-    BIAS_SIGNATURE,
     HUB_ACC,
     HUB_ALPHA,
     HUB_DISSIPATION,
@@ -59,17 +58,11 @@ from flexsat.dynamics.appendages.contract import (
     HUB_OMEGA,
     HUB_SBIAS,
     HUB_TORQUE,
-    MASS_SIGNATURE,
     OBS_DISSIPATION,
     OBS_ELASTIC,
     OBS_KINETIC,
     OBS_LOCKED_INERTIA,
     OBS_MOMENTUM,
-    OBSERVE_SIGNATURE,
-    PASS1_SIGNATURE,
-    PASS2_SIGNATURE,
-    TIPS_SIGNATURE,
-    WRENCH_SIGNATURE,
     AppendageKernels,
     AppendageModel,
     Coordinate,
@@ -254,7 +247,7 @@ def _inertia_about_hub(p, J, r, c1):
     return _madd(_madd(J, mm(R, C), -1.0), mm(C, R), -1.0)
 
 
-@njit(PASS1_SIGNATURE, cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy")  # compiled with PASS1_SIGNATURE on first use
 def pass1(q, qd, Q, members, params, work, hub, qdd):
     """Wrench on the hub at zero hub acceleration and the articulated inertia X^T M_I X.
 
@@ -302,7 +295,7 @@ def pass1(q, qd, Q, members, params, work, hub, qdd):
     return STATUS_OK
 
 
-@njit(PASS2_SIGNATURE, cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy")  # compiled with PASS2_SIGNATURE on first use
 def pass2(q, qd, members, params, work, hub, qdd):
     """eta_ddot_k = f_k - l_t,k . a_I - l_r,k . alpha, a_I the interface acceleration."""
     omega = load_seg(hub, HUB_OMEGA)
@@ -318,7 +311,7 @@ def pass2(q, qd, members, params, work, hub, qdd):
     return STATUS_OK
 
 
-@njit(MASS_SIGNATURE, cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy")  # compiled with MASS_SIGNATURE on first use
 def mass_matrix(q, members, params, M):
     """The modal appendages' share of M(q), from T with v = R_BN r_dot - [r]x S Theta_dot
     and omega = S Theta_dot (module notes)."""
@@ -348,7 +341,7 @@ def mass_matrix(q, members, params, M):
             M[o + k, o + k] += 1.0
 
 
-@njit(BIAS_SIGNATURE, cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy")  # compiled with BIAS_SIGNATURE on first use
 def bias_forces(q, qd, members, params, hub, h):
     """The modal appendages' share of h(q, q_dot): their inertia forces at q_ddot = 0
     (a_hub = 0, alpha = S_dot Theta_dot, eta_ddot = 0)."""
@@ -377,7 +370,7 @@ def bias_forces(q, qd, members, params, hub, h):
                         - _centrifugal(p, k, omega))
 
 
-@njit(OBSERVE_SIGNATURE, cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy")  # compiled with OBSERVE_SIGNATURE on first use
 def observe(q, qd, members, params, out):
     """Kinetic energy T, momentum about the inertial origin, locked inertia, U and 2 D."""
     R_NB = rot_zyx(q[3], q[4], q[5])
@@ -412,7 +405,7 @@ def observe(q, qd, members, params, out):
                 out[OBS_LOCKED_INERTIA + 3 * a + b] += J_O[a][b]
 
 
-@njit(WRENCH_SIGNATURE, cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy")  # compiled with WRENCH_SIGNATURE on first use
 def joint_wrench(q, qd, qdd, Q, members, params, out):
     """Add the modes' elastic, damping and external forces transmitted to the hub:
     sum_k l_k (omega_k^2 eta_k + 2 zeta_k omega_k eta_dot_k - Q_k) at the interface
@@ -433,7 +426,7 @@ def joint_wrench(q, qd, qdd, Q, members, params, out):
     return STATUS_OK
 
 
-@njit(TIPS_SIGNATURE, cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy")  # compiled with TIPS_SIGNATURE on first use
 def tips(q, members, params, out):
     """Tip displacement sum_k psi_tip,k eta_k, mount frame [m]."""
     for j in range(members.shape[0]):

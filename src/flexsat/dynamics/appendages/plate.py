@@ -36,7 +36,6 @@ from scipy.spatial.transform import Rotation
 
 from flexsat.config.models import AppendageConfig
 from flexsat.dynamics.appendages.contract import (
-    BIAS_SIGNATURE,
     HUB_ACC,
     HUB_ALPHA,
     HUB_DISSIPATION,
@@ -45,17 +44,11 @@ from flexsat.dynamics.appendages.contract import (
     HUB_OMEGA,
     HUB_SBIAS,
     HUB_TORQUE,
-    MASS_SIGNATURE,
     OBS_DISSIPATION,
     OBS_ELASTIC,
     OBS_KINETIC,
     OBS_LOCKED_INERTIA,
     OBS_MOMENTUM,
-    OBSERVE_SIGNATURE,
-    PASS1_SIGNATURE,
-    PASS2_SIGNATURE,
-    TIPS_SIGNATURE,
-    WRENCH_SIGNATURE,
     AppendageKernels,
     AppendageModel,
     Coordinate,
@@ -427,7 +420,7 @@ def _locked_pass2(o, w, hub, qdd):
         qdd[o + k] = s
 
 
-@njit(PASS1_SIGNATURE, cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy")  # compiled with PASS1_SIGNATURE on first use
 def pass1(q, qd, Q, members, params, work, hub, qdd):
     """Joint wrenches -> panel absolute accelerations and the reaction on the hub.
 
@@ -484,7 +477,7 @@ def pass1(q, qd, Q, members, params, work, hub, qdd):
     return STATUS_OK
 
 
-@njit(PASS2_SIGNATURE, cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy")  # compiled with PASS2_SIGNATURE on first use
 def pass2(q, qd, members, params, work, hub, qdd):
     """Relative accelerations of each joint from the absolute ones left by :func:`pass1`."""
     omega_B = load_seg(hub, HUB_OMEGA)
@@ -523,7 +516,7 @@ def pass2(q, qd, members, params, work, hub, qdd):
     return STATUS_OK
 
 
-@njit(MASS_SIGNATURE, cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy")  # compiled with MASS_SIGNATURE on first use
 def mass_matrix(q, members, params, M):
     """The plates' share of M(q) (eq. 2.39), from their velocity Jacobians::
 
@@ -557,7 +550,7 @@ def mass_matrix(q, members, params, M):
         add_block(M, o + 3, o + 3, mtm(S_rho, mm(J_p, S_rho)), 1.0)
 
 
-@njit(BIAS_SIGNATURE, cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy")  # compiled with BIAS_SIGNATURE on first use
 def bias_forces(q, qd, members, params, hub, h):
     """The plates' share of h(q, q_dot) (eq. 2.43): Kane's inertia forces at q_ddot = 0."""
     R_NB = rot_zyx(q[3], q[4], q[5])
@@ -592,7 +585,7 @@ def bias_forces(q, qd, members, params, hub, h):
         h[o + 3], h[o + 4], h[o + 5] = mtv(S_rho, add(cross(d, mtv(R_BP, f_B)), g_P))
 
 
-@njit(OBSERVE_SIGNATURE, cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy")  # compiled with OBSERVE_SIGNATURE on first use
 def observe(q, qd, members, params, out):
     """Add the plates' kinetic energy, momentum, locked inertia, elastic energy, damper power."""
     R_NB = rot_zyx(q[3], q[4], q[5])
@@ -628,7 +621,7 @@ def observe(q, qd, members, params, out):
             out[OBS_DISSIPATION] += p[P_C + k] * qd[o + k] ** 2  # eq. 2.36
 
 
-@njit(WRENCH_SIGNATURE, cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy")  # compiled with WRENCH_SIGNATURE on first use
 def joint_wrench(q, qd, qdd, Q, members, params, out):
     """Add the wrench the plates' joints exert on the hub (tau_flex in out[3:6]).
 
@@ -647,7 +640,7 @@ def joint_wrench(q, qd, qdd, Q, members, params, out):
     return STATUS_OK
 
 
-@njit(TIPS_SIGNATURE, cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy")  # compiled with TIPS_SIGNATURE on first use
 def tips(q, members, params, out):
     """Tip displacement eta + (R_MP - I) tip of each plate, mount frame [m]."""
     for j in range(members.shape[0]):
