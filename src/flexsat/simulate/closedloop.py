@@ -10,12 +10,20 @@ import numpy as np
 
 from flexsat.config import nominal
 from flexsat.config.models import SatelliteConfig
-from flexsat.control.laws import get_law
+from flexsat.control.laws import LAW_SIGNATURE, get_law
 from flexsat.control.quaternion import pointing_errors, target_quaternion
 from flexsat.control.stages import ACTUATORS, JOINT_ACTUATORS, REFERENCES, SENSORS
-from flexsat.control.stages.registry import no_derivative
+from flexsat.control.stages.registry import (
+    ACTUATOR_SIGNATURE,
+    DERIVATIVE_SIGNATURE,
+    JOINT_ACTUATOR_SIGNATURE,
+    REFERENCE_SIGNATURE,
+    SENSOR_SIGNATURE,
+    no_derivative,
+)
 from flexsat.dynamics.attitude import identity_frame, inertial_view, is_identity, rebase
 from flexsat.dynamics.integrators import rk4_hold
+from flexsat.dynamics.packed import first_class
 from flexsat.dynamics.plant import Plant
 from flexsat.dynamics.rigid import design_coordinates, rigid_inertia
 from flexsat.dynamics.status import STATUS_CONTROL_FAILED
@@ -251,11 +259,15 @@ def prepare_slew(plant: Plant, scenario: SlewScenario,
     q0, qd0 = initial_state(plant, scenario)
     n_records = scenario.n_steps // scenario.record_every + 2  # + the last good state
     data = _loop_data(layout, scenario, J, plant)
+    # each compiled with its role's signature on first use (flexsat.dynamics.packed)
     stages = LoopStages(
-        tuple(s.step for s in layout.sensors), (law.step,),
-        tuple(s.step for s in layout.actuators),
-        tuple(s.derivative or no_derivative for s in layout.actuators),
-        (layout.reference.step,), (layout.joint_actuator.step,),
+        tuple(first_class(s.step, SENSOR_SIGNATURE) for s in layout.sensors),
+        (first_class(law.step, LAW_SIGNATURE),),
+        tuple(first_class(s.step, ACTUATOR_SIGNATURE) for s in layout.actuators),
+        tuple(first_class(s.derivative or no_derivative, DERIVATIVE_SIGNATURE)
+              for s in layout.actuators),
+        (first_class(layout.reference.step, REFERENCE_SIGNATURE),),
+        (first_class(layout.joint_actuator.step, JOINT_ACTUATOR_SIGNATURE),),
     )  # fmt: skip
     return PreparedSlew(
         plant, scenario, law, layout, J, np.concatenate([q0, qd0, [0.0, 0.0]]),

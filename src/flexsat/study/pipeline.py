@@ -347,9 +347,12 @@ def run_study(
     return manifest
 
 
-COLD_S = 1.0
-"""A first compile job slower than this [s] means an empty disk cache: the rest are
-compiled by two forked processes side by side (:func:`_compile`)."""
+def _cache_was_empty(plant) -> bool:
+    """True if building ``plant`` compiled its appendage kernels instead of loading
+    them from numba's disk cache: the first run after an install (or an upgrade,
+    which drops every cached kernel together, :mod:`flexsat._compiled_cache`)."""
+    return any(sum(kernel.stats.cache_misses.values())
+               for model in plant.models for kernel in model.kernels)  # fmt: skip
 
 
 def _compile(ctx: StudyContext, console: Console) -> float:
@@ -359,11 +362,10 @@ def _compile(ctx: StudyContext, console: Console) -> float:
     law, the avionics chain, the delay stage, the hybrid damping and the solar-array
     drive; the parts' wall times then exclude compilation, which the manifest gives
     apart (``compilation_s``), and the forked processes the parts fly their runs in
-    inherit the compiled loops instead of each compiling them. The open loop and the
-    first law's slew (what every loop shares) compile here first; if that was slow
-    (:data:`COLD_S`: the disk cache is empty), two forked processes compile the
-    other loops side by side and write them to the disk cache, from which this
-    process then loads them. Returns its wall time [s].
+    inherit the compiled loops instead of each compiling them. When building the
+    plant compiled its kernels (:func:`_cache_was_empty`), two forked processes first
+    compile the runs into the disk cache side by side, the longest first, and this
+    process then loads them from it. Returns its wall time [s].
     """
     from flexsat.simulate import OpenLoopScenario, SlewScenario, run_openloop, run_slew
     from flexsat.study.avionics import AVIONICS, delayed, sadm_study
@@ -374,21 +376,26 @@ def _compile(ctx: StudyContext, console: Console) -> float:
     start = time.perf_counter()
     short = {"duration_s": 0.02, "record_dt_s": 0.01}
 
-    def fly(fields: dict | None) -> None:
-        if fields is None:  # the arrays on a drive
+    def fly(fields: dict | str | None) -> None:
+        if fields == "open loop":
+            run_openloop(ctx.plant, OpenLoopScenario.model_validate(short), progress=False)
+        elif fields is None:  # the arrays on a drive
             sadm_study(ctx.plant, duration_s=short["duration_s"])
         else:
             run_slew(ctx.plant, SlewScenario.model_validate({**short, **fields}),
                      progress=False)  # fmt: skip
 
-    loops = [{"controller": {"kind": kind}} for kind in ctx.laws]
-    loops += [AVIONICS, delayed(1), {"joint_actuator": HYBRID_DAMPING}, None]
+    laws = [{"controller": {"kind": kind}} for kind in ctx.laws]
+    # Each distinct loop first (measured on an empty cache: the open loop about 11 s,
+    # the first law's 8, the delay's 9, the drive's 9 with its chain kernels, the
+    # avionics chain's 6), then the runs that reuse one of them (the hybrid damping
+    # and the other laws share the first law's loop).
+    runs = ["open loop", laws[0], delayed(1), None, AVIONICS,
+            {"joint_actuator": HYBRID_DAMPING}, *laws[1:]]  # fmt: skip
     try:
-        run_openloop(ctx.plant, OpenLoopScenario.model_validate(short), progress=False)
-        fly(loops[0])
-        if time.perf_counter() - start > COLD_S:
-            forked_map(fly, loops[1:])  # each process compiles its share into the cache
-        for fields in loops[1:]:
+        if _cache_was_empty(ctx.plant):
+            forked_map(fly, runs)  # each process compiles its share into the cache
+        for fields in runs:
             fly(fields)
     except Exception:  # the part that needs it reports the problem
         pass

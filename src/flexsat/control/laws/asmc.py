@@ -31,7 +31,7 @@ from flexsat.control.laws._sliding import (
     sat,
     surface_attributes,
 )
-from flexsat.control.laws.registry import LAW_SIGNATURE, LawConfig, LawSpec
+from flexsat.control.laws.registry import LawConfig, LawSpec
 from flexsat.dynamics.linalg3 import cross, mv
 
 __all__ = ["ASMC", "ASMCConfig", "ASMCGains"]
@@ -128,7 +128,7 @@ def _jk(jk_min, limit, tau_gyro, tau_guide, s, phi):
     return jk_min + (avail - jk_min) * min(abs(s) / phi, 1.0)
 
 
-@njit(LAW_SIGNATURE, cache=True)
+@njit(cache=True)  # compiled with LAW_SIGNATURE on first use
 def asmc_step(q_d, omega_d, omega_dot_d, q, omega_B, J, gains, state, t, dt, tau_cmd, diag):
     """The ASMC command (law contract in :mod:`flexsat.control.laws.registry`).
 

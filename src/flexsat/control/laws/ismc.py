@@ -25,7 +25,7 @@ from pydantic import Field
 
 from flexsat.config.models import Positive
 from flexsat.control.laws._sliding import clip_and_store, errors, inertia3, sat, surface_attributes
-from flexsat.control.laws.registry import LAW_SIGNATURE, LawConfig, LawSpec
+from flexsat.control.laws.registry import LawConfig, LawSpec
 from flexsat.control.registry import Channel
 from flexsat.dynamics.linalg3 import cross, mv
 
@@ -81,7 +81,7 @@ class ISMCConfig(LawConfig):
         return surface_attributes(self.lambda_, self.lambda_, self.phi, self.jk_nm)
 
 
-@njit(LAW_SIGNATURE, cache=True)
+@njit(cache=True)  # compiled with LAW_SIGNATURE on first use
 def ismc_step(q_d, omega_d, omega_dot_d, q, omega_B, J, gains, state, t, dt, tau_cmd, diag):
     """The ISMC command (law contract in :mod:`flexsat.control.laws.registry`).
 

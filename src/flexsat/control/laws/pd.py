@@ -13,7 +13,7 @@ from pydantic import Field
 
 from flexsat.config.models import Positive
 from flexsat.control.laws._sliding import clip_and_store, errors, inertia3
-from flexsat.control.laws.registry import LAW_SIGNATURE, LawConfig, LawSpec
+from flexsat.control.laws.registry import LawConfig, LawSpec
 from flexsat.control.registry import Channel
 from flexsat.dynamics.linalg3 import cross, mv
 
@@ -66,7 +66,7 @@ class PDConfig(LawConfig):
         return np.hstack([np.asarray(J) * wn**2, np.asarray(J) * 2.0 * zeta * wn])
 
 
-@njit(LAW_SIGNATURE, cache=True)
+@njit(cache=True)  # compiled with LAW_SIGNATURE on first use
 def pd_step(q_d, omega_d, omega_dot_d, q, omega_B, J, gains, state, t, dt, tau_cmd, diag):
     """The PD command (law contract in :mod:`flexsat.control.laws.registry`); no state."""
     limit = gains[G.reduction_factor] * gains[G.t_max]

@@ -8,7 +8,9 @@ names a law.
 
 The compiled step
 -----------------
-Compiled with ``@njit(LAW_SIGNATURE, cache=True)`` and called by the compiled loop
+Compiled with :data:`LAW_SIGNATURE` (``@njit(LAW_SIGNATURE, cache=True)``, or
+``@njit(cache=True)`` to compile it when a slew first uses it, as the built-ins do)
+and called by the compiled loop
 through a numba first-class function (typed by this signature, so any function of
 it runs, including one defined in a user's own file)::
 

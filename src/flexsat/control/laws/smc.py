@@ -23,7 +23,7 @@ from flexsat.control.laws._sliding import (
     sat,
     surface_attributes,
 )
-from flexsat.control.laws.registry import LAW_SIGNATURE, LawConfig, LawSpec
+from flexsat.control.laws.registry import LawConfig, LawSpec
 from flexsat.dynamics.linalg3 import cross, mv
 
 __all__ = ["SMC", "SMCConfig", "SMCGains"]
@@ -77,7 +77,7 @@ class SMCConfig(LawConfig):
         return linear_sliding_feedback(J, self.lambda_, self.jk_nm, self.phi)
 
 
-@njit(LAW_SIGNATURE, cache=True)
+@njit(cache=True)  # compiled with LAW_SIGNATURE on first use
 def smc_step(q_d, omega_d, omega_dot_d, q, omega_B, J, gains, state, t, dt, tau_cmd, diag):
     """The SMC command (law contract in :mod:`flexsat.control.laws.registry`); no state."""
     limit = gains[G.reduction_factor] * gains[G.t_max]

@@ -36,7 +36,7 @@ from pydantic import Field, model_validator
 
 from flexsat.config.models import Positive
 from flexsat.control.laws._sliding import clip_and_store, errors, inertia3, surface_attributes
-from flexsat.control.laws.registry import LAW_SIGNATURE, LawConfig, LawSpec
+from flexsat.control.laws.registry import LawConfig, LawSpec
 from flexsat.control.registry import Channel
 from flexsat.dynamics.linalg3 import cross, mv
 
@@ -204,7 +204,7 @@ def _twist(k1, s):
     return -k1 * sqrt(abs(s)) * _sgn(s)
 
 
-@njit(LAW_SIGNATURE, cache=True)
+@njit(cache=True)  # compiled with LAW_SIGNATURE on first use
 def stsmc_step(q_d, omega_d, omega_dot_d, q, omega_B, J, gains, state, t, dt, tau_cmd, diag):
     """The STSMC command (law contract in :mod:`flexsat.control.laws.registry`).
 

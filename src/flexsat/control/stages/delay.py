@@ -14,7 +14,7 @@ from numba import njit
 from pydantic import Field
 
 from flexsat.control.registry import Channel
-from flexsat.control.stages.registry import ACTUATOR_SIGNATURE, StageConfig, StageSpec
+from flexsat.control.stages.registry import StageConfig, StageSpec
 
 __all__ = ["DELAY", "MAX_DELAY_PERIODS", "DelayConfig"]
 
@@ -42,7 +42,7 @@ class DelayConfig(StageConfig):
         return [float(self.periods)]
 
 
-@njit(ACTUATOR_SIGNATURE, cache=True)
+@njit(cache=True)  # compiled with ACTUATOR_SIGNATURE on first use
 def delay_step(tau_cmd, t, dt, params, state, tau_applied, record):
     """tau_applied(k) = tau_cmd(k - D); state: [instants seen, ring of D commands]."""
     periods = int(params[0])

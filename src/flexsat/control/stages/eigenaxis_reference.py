@@ -30,7 +30,7 @@ from flexsat.analysis.modal import modal_analysis
 from flexsat.config.models import Positive, _Frozen
 from flexsat.control.quaternion import quaternion_product, target_quaternion
 from flexsat.control.registry import Channel
-from flexsat.control.stages.registry import REFERENCE_SIGNATURE, PlantStageConfig, StageSpec
+from flexsat.control.stages.registry import PlantStageConfig, StageSpec
 from flexsat.control.stages.shapers import shaper_for_modes
 
 __all__ = ["EIGENAXIS_REFERENCE", "EigenaxisReferenceConfig", "ShaperConfig", "coupled_modes"]
@@ -195,7 +195,7 @@ def _profile(p, tau):
     return angle, 0.0, 0.0
 
 
-@njit(REFERENCE_SIGNATURE, cache=True)
+@njit(cache=True)  # compiled with REFERENCE_SIGNATURE on first use
 def eigenaxis_reference_step(t, params, state, q_d, omega_d, omega_dot_d, record):
     """The shaped eigenaxis reference at t (contract in ``stages.registry``)."""
     n = int(params[_N])

@@ -32,7 +32,7 @@ from flexsat.control.registry import Channel
 from flexsat.control.stages._sampling import control_periods
 from flexsat.control.stages._truth import true_body_rate
 from flexsat.control.stages.noise import normal
-from flexsat.control.stages.registry import SENSOR_SIGNATURE, StageConfig, StageSpec
+from flexsat.control.stages.registry import StageConfig, StageSpec
 
 __all__ = ["GYRO", "GyroConfig"]
 
@@ -87,7 +87,7 @@ class GyroConfig(StageConfig):
         ])  # fmt: skip
 
 
-@njit(SENSOR_SIGNATURE, cache=True)
+@njit(cache=True)  # compiled with SENSOR_SIGNATURE on first use
 def gyro_step(x, n_dof, t, params, state, q_meas, omega_meas, record):
     """A new sample every ``every`` control instants, held in between."""
     p, s = params, state

@@ -11,7 +11,7 @@ from typing import Literal
 from numba import njit
 
 from flexsat.control.quaternion import euler_zyx_to_quaternion
-from flexsat.control.stages.registry import SENSOR_SIGNATURE, StageConfig, StageSpec
+from flexsat.control.stages.registry import StageConfig, StageSpec
 from flexsat.dynamics.linalg3 import euler_rate_matrix, load_seg, mv
 
 __all__ = ["IDEAL_SENSOR", "IdealSensorConfig"]
@@ -29,7 +29,7 @@ class IdealSensorConfig(StageConfig):
     kind: Literal["ideal"] = "ideal"
 
 
-@njit(SENSOR_SIGNATURE, cache=True)
+@njit(cache=True)  # compiled with SENSOR_SIGNATURE on first use
 def ideal_sensor_step(x, n_dof, t, params, state, q_meas, omega_meas, record):
     """Exact attitude and rate (stage contract in :mod:`flexsat.control.stages.registry`)."""
     q_meas[0], q_meas[1], q_meas[2], q_meas[3] = euler_zyx_to_quaternion(x[3], x[4], x[5])

@@ -31,7 +31,6 @@ from flexsat.config.models import Positive
 from flexsat.control.quaternion import euler_zyx_to_quaternion, quaternion_error
 from flexsat.control.registry import Channel
 from flexsat.control.stages.registry import (
-    JOINT_ACTUATOR_SIGNATURE,
     JointActuatorConfig,
     StageSpec,
 )
@@ -75,7 +74,7 @@ class JointRateFeedbackConfig(JointActuatorConfig):
                         dtype=float)  # fmt: skip
 
 
-@njit(JOINT_ACTUATOR_SIGNATURE, cache=True)
+@njit(cache=True)  # compiled with JOINT_ACTUATOR_SIGNATURE on first use
 def joint_rate_feedback_step(x, n_dof, t, dt, q_d, J_design, params, state, Q, record):
     """Lagged, limited joint-rate feedback into Q; J_design as it is (contract in
     ``stages.registry``)."""

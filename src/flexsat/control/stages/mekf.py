@@ -36,7 +36,7 @@ from pydantic import Field
 
 from flexsat.control.registry import Channel
 from flexsat.control.stages._truth import true_attitude
-from flexsat.control.stages.registry import SENSOR_SIGNATURE, StageConfig, StageSpec
+from flexsat.control.stages.registry import StageConfig, StageSpec
 
 __all__ = ["MEKF", "MEKFConfig"]
 
@@ -135,7 +135,7 @@ def _inverse3(a00, a01, a02, a10, a11, a12, a20, a21, a22):
             c20 / det, c21 / det, c22 / det)  # fmt: skip
 
 
-@njit(SENSOR_SIGNATURE, cache=True)
+@njit(cache=True)  # compiled with SENSOR_SIGNATURE on first use
 def mekf_step(x, n_dof, t, params, state, q_meas, omega_meas, record):
     """Propagate with the gyro, update on a new star-tracker sample (module docstring)."""
     p, s = params, state

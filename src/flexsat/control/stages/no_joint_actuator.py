@@ -7,7 +7,6 @@ from typing import Literal
 from numba import njit
 
 from flexsat.control.stages.registry import (
-    JOINT_ACTUATOR_SIGNATURE,
     JointActuatorConfig,
     StageSpec,
 )
@@ -27,7 +26,7 @@ class NoJointActuatorConfig(JointActuatorConfig):
     kind: Literal["none"] = "none"
 
 
-@njit(JOINT_ACTUATOR_SIGNATURE, cache=True)
+@njit(cache=True)  # compiled with JOINT_ACTUATOR_SIGNATURE on first use
 def no_joint_actuator_step(x, n_dof, t, dt, q_d, J_design, params, state, Q, record):
     """Leaves Q[6:] at zero and J_design as it is (contract in ``stages.registry``)."""
     return 0

@@ -23,7 +23,7 @@ from numba import njit
 from pydantic import Field, model_validator
 
 from flexsat.config.models import Positive, _Frozen
-from flexsat.control.stages.registry import ACTUATOR_SIGNATURE, StageConfig, StageSpec
+from flexsat.control.stages.registry import StageConfig, StageSpec
 
 __all__ = ["MAX_SECTIONS", "NOTCH", "Notch", "NotchConfig", "notch_for_modes"]
 
@@ -137,7 +137,7 @@ def notch_for_modes(plant, modes: int = 1, depth_db: float = 20.0, damping: floa
     return NotchConfig(notches=notches, rolloff_hz=rolloff_hz)
 
 
-@njit(ACTUATOR_SIGNATURE, cache=True)
+@njit(cache=True)  # compiled with ACTUATOR_SIGNATURE on first use
 def notch_step(tau_cmd, t, dt, params, state, tau_applied, record):
     """Filter each axis through the sections (direct form II transposed)."""
     n = int(params[0])

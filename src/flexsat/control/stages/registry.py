@@ -6,7 +6,10 @@ slew scenario selects one sensor (``[sensor] kind = ...``) and one actuator
 (``[actuator] kind = ...``); the compiled loop calls their steps through numba
 first-class functions, so a stage defined in a user's own file runs at built-in
 speed. Both run at every control instant (every ``control_dt_s``); their outputs
-are held between instants (zero-order hold).
+are held between instants (zero-order hold). Each step below is compiled with its
+role's signature: at import when declared with it, else when a slew first uses it
+(:func:`flexsat.dynamics.packed.first_class`; the built-ins are declared
+``@njit(cache=True)``).
 
 Sensor step, ``@njit(SENSOR_SIGNATURE, cache=True)``::
 
@@ -127,7 +130,7 @@ DERIVATIVE_SIGNATURE = types.int64(_vec, types.int64, types.float64, _vec, _vec,
 """x, n_dof, t, params, state, state_dot (out), wrench (in/out, added to)."""
 
 
-@njit(DERIVATIVE_SIGNATURE, cache=True)
+@njit(cache=True)  # compiled with DERIVATIVE_SIGNATURE on first use
 def no_derivative(x, n_dof, t, params, state, state_dot, wrench):
     """The derivative of a stage without continuous states: nothing integrated.
 

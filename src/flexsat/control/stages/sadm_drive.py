@@ -56,7 +56,6 @@ from pydantic import Field, model_validator
 from flexsat.config.models import Positive
 from flexsat.control.registry import Channel
 from flexsat.control.stages.registry import (
-    JOINT_ACTUATOR_SIGNATURE,
     JointActuatorConfig,
     StageSpec,
 )
@@ -264,7 +263,7 @@ def follow_design(x, params, n, J_design, state):
     return change
 
 
-@njit(JOINT_ACTUATOR_SIGNATURE, cache=True)
+@njit(cache=True)  # compiled with JOINT_ACTUATOR_SIGNATURE on first use
 def sadm_drive_step(x, n_dof, t, dt, q_d, J_design, params, state, Q, record):
     """PD drive torque on each driven coordinate into Q and, with ``design_model =
     "measured"``, the design inertia at the measured angles into J_design (contract in

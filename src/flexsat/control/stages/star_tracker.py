@@ -23,7 +23,7 @@ from flexsat.control.registry import Channel
 from flexsat.control.stages._sampling import control_periods
 from flexsat.control.stages._truth import true_attitude
 from flexsat.control.stages.noise import normal
-from flexsat.control.stages.registry import SENSOR_SIGNATURE, StageConfig, StageSpec
+from flexsat.control.stages.registry import StageConfig, StageSpec
 
 __all__ = ["STAR_TRACKER", "StarTrackerConfig"]
 
@@ -65,7 +65,7 @@ class StarTrackerConfig(StageConfig):
         return np.array([every, self.seed, latency, *(np.array(self.noise_arcsec) * _ARCSEC)])
 
 
-@njit(SENSOR_SIGNATURE, cache=True)
+@njit(cache=True)  # compiled with SENSOR_SIGNATURE on first use
 def star_tracker_step(x, n_dof, t, params, state, q_meas, omega_meas, record):
     """Sample every ``every`` instants, deliver ``latency`` instants later, hold."""
     p, s = params, state

@@ -18,7 +18,7 @@ import numpy as np
 from numba import njit
 from pydantic import Field
 
-from flexsat.control.stages.registry import ACTUATOR_SIGNATURE, ActuatorStageConfig, StageSpec
+from flexsat.control.stages.registry import ActuatorStageConfig, StageSpec
 
 __all__ = ["PACKED", "STATIC_ACTUATOR", "ActuatorConfig"]
 
@@ -50,7 +50,7 @@ def _axis(tau_cmd, p, slosh, a):
     return min(p[_TMAX], max(-p[_TMAX], value))
 
 
-@njit(ACTUATOR_SIGNATURE, cache=True)
+@njit(cache=True)  # compiled with ACTUATOR_SIGNATURE on first use
 def static_actuator_step(tau_cmd, t, dt, params, state, tau_applied, record):
     """Applied torque, body frame [N m], per axis within T_max (module docstring)."""
     slosh = params[_RATIO] * sin(2.0 * pi * params[_HZ] * t)

@@ -12,7 +12,7 @@ import numpy as np
 from numba import njit
 
 from flexsat.control.quaternion import target_quaternion
-from flexsat.control.stages.registry import REFERENCE_SIGNATURE, PlantStageConfig, StageSpec
+from flexsat.control.stages.registry import PlantStageConfig, StageSpec
 
 __all__ = ["STEP_REFERENCE", "StepReferenceConfig"]
 
@@ -33,7 +33,7 @@ class StepReferenceConfig(PlantStageConfig):
         return target_quaternion(scenario.target_euler_deg)
 
 
-@njit(REFERENCE_SIGNATURE, cache=True)
+@njit(cache=True)  # compiled with REFERENCE_SIGNATURE on first use
 def step_reference_step(t, params, state, q_d, omega_d, omega_dot_d, record):
     """Target attitude, zero rate and acceleration (contract in ``stages.registry``)."""
     for i in range(4):

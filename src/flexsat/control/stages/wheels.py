@@ -43,8 +43,6 @@ from flexsat.config.models import Positive, Real
 from flexsat.control.registry import Channel
 from flexsat.control.stages._truth import true_body_rate
 from flexsat.control.stages.registry import (
-    ACTUATOR_SIGNATURE,
-    DERIVATIVE_SIGNATURE,
     ActuatorStageConfig,
     StageSpec,
 )
@@ -192,7 +190,7 @@ def _smooth_sign(z):
     return copysign((1.0 - e) / (1.0 + e), z)
 
 
-@njit(DERIVATIVE_SIGNATURE, cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy")  # compiled with DERIVATIVE_SIGNATURE on first use
 def wheels_derivative(x, n_dof, t, params, state, state_dot, wrench):
     """h_dot, u_dot, motor power, friction power; the wheels' wrench on the hub.
 
@@ -230,7 +228,7 @@ def wheels_derivative(x, n_dof, t, params, state, state_dot, wrench):
     return 0
 
 
-@njit(ACTUATOR_SIGNATURE, cache=True)
+@njit(cache=True)  # compiled with ACTUATOR_SIGNATURE on first use
 def wheels_step(tau_cmd, t, dt, params, state, tau_applied, record):
     """Allocate the body torque to the motors (module docstring); nothing held on the
     hub: the wheels act through their derivative."""
