@@ -30,6 +30,7 @@ import tempfile
 from collections.abc import Iterator
 from pathlib import Path
 
+import dask
 import numpy as np
 import pandas as pd
 import xarray as xr
@@ -228,7 +229,12 @@ class CampaignStore:
         os.close(fd)
         os.chmod(tmp, 0o666 & ~_UMASK)
         try:
-            ds.to_netcdf(tmp)
+            # With a Dask client active, xarray guards every variable's write with a
+            # cluster-wide lock: a round trip to the scheduler per access, about 120
+            # per history (measured). Only this process writes the store's files, so
+            # the local scheduler's thread lock is enough.
+            with dask.config.set(scheduler="synchronous"):
+                ds.to_netcdf(tmp)
             os.replace(tmp, path)
         except RuntimeError as exc:  # the HDF5 library's way of saying the write failed
             raise OSError(f"writing {path.name} failed ({exc})") from None
