@@ -242,3 +242,27 @@ def test_a_write_error_stops_the_run_at_once_with_one_message(tmp_path):
     assert "cannot write to the campaign store" in result.stderr
     assert "0 of 12 cases are stored" in result.stderr and "--resume" in result.stderr
     assert "Traceback" not in result.stderr
+
+
+def test_a_signal_while_the_cases_are_prepared_stops_the_campaign(tmp_path, monkeypatch):
+    # A process that starts with SIGINT ignored (a background job, a test runner's
+    # worker) and is signalled while its cases are prepared, which on a first run is
+    # the minute the kernels compile: the signal stops it, nothing runs, no store.
+    from flexsat.campaigns import runner
+
+    class Signalled(runner.CaseStream):
+        def __init__(self, *args, **kwargs):
+            os.kill(os.getpid(), signal.SIGINT)  # delivered before the next bytecode
+            super().__init__(*args, **kwargs)
+
+    monkeypatch.setattr(runner, "CaseStream", Signalled)
+    previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
+        with pytest.raises(runner.CampaignInterrupted, match="while preparing its cases") as caught:
+            run_campaign(_short("sensitivity", 0.2), nominal(), tmp_path / "s", workers=1,
+                         progress=False)  # fmt: skip
+        assert signal.getsignal(signal.SIGINT) == signal.SIG_IGN  # given back as it was
+    finally:
+        signal.signal(signal.SIGINT, previous)
+    assert caught.value.exit_code == 130
+    assert not (tmp_path / "s" / "cases").exists()

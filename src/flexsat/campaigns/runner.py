@@ -353,45 +353,47 @@ def run_campaign(
                               workers=workers, resume=resume)  # fmt: skip
     if runner not in RUNNERS:
         raise ConfigError(f"runner: {runner!r} is not one of {', '.join(RUNNERS)}")
-    cases = CaseStream(definition, satellite, n_random)  # checks what it can up front
     store = CampaignStore(out)
     if store.root.exists() and not store.root.is_dir():
         raise ConfigError(f"--out {store.root}: exists and is not a folder")
     start = time.perf_counter()
     failed = 0
-    with _backend(workers, scheduler, dask_local, runner) as execute, store.opened(
-        campaign_fingerprint(definition, satellite, cases), definition.name, resume
-    ):
-        todo = _Todo(cases, store)
-        columns = (TextColumn(f"campaign {definition.name}"), BarColumn(), MofNCompleteColumn(),
-                   TextColumn("failed {task.fields[failed]}"), TimeRemainingColumn())  # fmt: skip
-        interrupts = _Interrupts()
-        with Progress(*columns, disable=not progress, transient=True) as bar, interrupts:
-            task = bar.add_task("cases", total=len(cases), completed=0, failed=0)
-            try:
-                for row in execute(todo, len(cases)):
-                    history = row.pop(HISTORY_KEY, None)
-                    with interrupts.deferred():  # a signal never cuts a write in half
-                        if history is not None:  # before the case: a stored case has its history
-                            store.write_history(row["case_id"], history, status=row["status"])
-                        store.write_case(row)
-                    failed += row["status"] != "ok"
-                    bar.update(task, completed=todo.skipped + todo.ran_done(), failed=failed)
-            except _Interrupted as stop:
-                interrupted = CampaignInterrupted(
-                    f"campaign {definition.name} interrupted ({stop.name}): "
-                    f"{store.finished()} of {len(cases)} cases are stored in {store.root}; "
-                    "run the same command with --resume to finish it",
-                )
-                interrupted.exit_code = 128 + stop.signum  # the shell's convention
-                raise interrupted from None
-            except OSError as exc:
-                raise _write_error(store, cases, exc) from None
+    cases = None
+    # From the first step: a signal while the cases are prepared (which compiles the
+    # plant's kernels on a first run) stops the campaign too, even where the process
+    # started with SIGINT ignored (a background job, a test runner's worker).
+    with _Interrupts() as interrupts:
         try:
-            store.record_case_inputs(todo.digest.hexdigest())
-            parquet, csv = store.write_tables()
-        except OSError as exc:
-            raise _write_error(store, cases, exc) from None
+            cases = CaseStream(definition, satellite, n_random)  # checks what it can up front
+            with _backend(workers, scheduler, dask_local, runner) as execute, store.opened(
+                campaign_fingerprint(definition, satellite, cases), definition.name, resume
+            ):
+                todo = _Todo(cases, store)
+                columns = (TextColumn(f"campaign {definition.name}"), BarColumn(),
+                           MofNCompleteColumn(), TextColumn("failed {task.fields[failed]}"),
+                           TimeRemainingColumn())  # fmt: skip
+                with Progress(*columns, disable=not progress, transient=True) as bar:
+                    task = bar.add_task("cases", total=len(cases), completed=0, failed=0)
+                    try:
+                        for row in execute(todo, len(cases)):
+                            history = row.pop(HISTORY_KEY, None)
+                            with interrupts.deferred():  # a signal never cuts a write in half
+                                if history is not None:  # a stored case has its history
+                                    store.write_history(row["case_id"], history,
+                                                        status=row["status"])  # fmt: skip
+                                store.write_case(row)
+                            failed += row["status"] != "ok"
+                            bar.update(task, completed=todo.skipped + todo.ran_done(),
+                                       failed=failed)  # fmt: skip
+                    except OSError as exc:
+                        raise _write_error(store, cases, exc) from None
+                try:
+                    store.record_case_inputs(todo.digest.hexdigest())
+                    parquet, csv = store.write_tables()
+                except OSError as exc:
+                    raise _write_error(store, cases, exc) from None
+        except _Interrupted as stop:
+            raise _interrupted(definition, store, cases, stop) from None
     return {
         "campaign": definition.name,
         "cases": len(cases),
@@ -401,6 +403,21 @@ def run_campaign(
         "parquet": str(parquet),
         "csv": str(csv),
     }
+
+
+def _interrupted(definition: CampaignDefinition, store: CampaignStore,
+                 cases: CaseStream | None, stop: _Interrupted) -> CampaignInterrupted:
+    """The error of a campaign stopped by a signal: what is stored and how to resume."""
+    if cases is None:
+        where = "while preparing its cases, before any ran; run the same command to start it"
+    else:
+        where = (f"{store.finished()} of {len(cases)} cases are stored in {store.root}; "
+                 "run the same command with --resume to finish it")  # fmt: skip
+    interrupted = CampaignInterrupted(
+        f"campaign {definition.name} interrupted ({stop.name}): {where}"
+    )
+    interrupted.exit_code = 128 + stop.signum  # the shell's convention
+    return interrupted
 
 
 class _Todo:
@@ -457,7 +474,8 @@ class _Interrupts:
     """While active, SIGINT and SIGTERM raise :class:`_Interrupted` in the main thread.
 
     Inside :meth:`deferred` (the store's writes, whose libraries hold locks) a signal
-    is kept and raised at the end of the block instead.
+    is kept and raised at the end of the block instead. Once one signal is taken,
+    later ones are ignored: the stop under way ends cleanly.
     """
 
     def __init__(self) -> None:
@@ -466,9 +484,10 @@ class _Interrupts:
         self.previous: dict = {}
 
     def _handler(self, signum, frame) -> None:
-        if self.deferring:
-            self.pending = signum
+        if self.deferring or self.pending is not None:  # deferred, or already stopping
+            self.pending = signum if self.pending is None else self.pending
             return
+        self.pending = signum
         raise _Interrupted(signum)
 
     def __enter__(self) -> _Interrupts:
