@@ -228,13 +228,14 @@ def test_a_killed_worker_is_replaced_and_the_campaign_completes(tmp_path):
 
 
 def test_a_write_error_stops_the_run_at_once_with_one_message(tmp_path):
-    """Files above 8 kB cannot be written (as on a full disk): the first history fails."""
+    """Files above 8 kB cannot be written (as on a full disk): the first history (a
+    10 s slew's, about 20 kB) fails."""
 
     def small_files() -> None:
         resource.setrlimit(resource.RLIMIT_FSIZE, (8192, 8192))
 
     store = tmp_path / "store"
-    command = [*FLEXSAT, "campaign", "sensitivity", "--duration", "1", "--workers", "1",
+    command = [*FLEXSAT, "campaign", "sensitivity", "--duration", "10", "--workers", "1",
                "--out", str(store), "--json"]  # fmt: skip
     result = subprocess.run(command, capture_output=True, text=True, timeout=300,
                             preexec_fn=small_files)  # fmt: skip

@@ -1,4 +1,4 @@
-"""The campaign store's files under a Dask client: written with local locks."""
+"""The campaign store's case histories: read back exactly, written without a Dask lock."""
 
 from __future__ import annotations
 
@@ -14,11 +14,11 @@ distributed = pytest.importorskip("distributed")
 def test_a_history_written_beside_a_dask_client_takes_no_cluster_wide_lock(
     tmp_path, monkeypatch
 ) -> None:
-    """With a distributed client active, xarray would guard every variable's write
-    with a ``distributed.Lock`` (a round trip to the scheduler each: about 120 per
-    history, which made the client the bottleneck of a Dask campaign). The store
-    writes its own files alone, so none may be taken; the file must read back
-    exactly."""
+    """With a distributed client active, xarray's ``to_netcdf`` guards every
+    variable's write with a ``distributed.Lock`` (a round trip to the scheduler each:
+    about 120 per history, which made the client the bottleneck of a Dask campaign).
+    The store writes its own files alone, so none may be taken; the file must read
+    back exactly."""
     taken = []
     acquire = distributed.Lock.acquire
 
@@ -38,3 +38,25 @@ def test_a_history_written_beside_a_dask_client_takes_no_cluster_wide_lock(
         np.testing.assert_array_equal(ds["pointing_error_deg"].values, time**2)
         np.testing.assert_array_equal(ds["tau_cmd"].values[:, 2], 2 * time)
         assert ds["tau_cmd"].attrs["units"] == "N m"
+
+
+def test_a_history_reads_back_exactly_with_its_units_and_descriptions(tmp_path) -> None:
+    # The NetCDF-3 file through xarray: values bit for bit (float64 both ways), a NaN
+    # gap read as missing, text attributes (non-ASCII included) as written.
+    time = np.linspace(0.0, 2.0, 21)
+    rate = np.sin(time)
+    rate[5] = np.nan
+    data = {"time": time.tolist(), "rate_error_deg_s": rate, "jk": np.outer(time, [1, 2, 3]),
+            "channels": {"jk": {"units": "N m", "description": "robust gain λ·J"}}}  # fmt: skip
+    path = CampaignStore(tmp_path).write_history("random-00007", data, status="failed")
+    with xr.open_dataset(path) as ds:
+        np.testing.assert_array_equal(ds["time"].values, time)
+        np.testing.assert_array_equal(ds["rate_error_deg_s"].values, rate)  # NaN where NaN
+        np.testing.assert_array_equal(ds["jk"].values, np.outer(time, [1, 2, 3]))
+        assert ds["jk"].dims == ("time", "axis") and list(ds["axis"].values) == ["x", "y", "z"]
+        assert ds["jk"].attrs == {"units": "N m", "description": "robust gain λ·J"}
+        assert ds["rate_error_deg_s"].attrs["units"] == "deg/s"
+        assert ds["time"].attrs["units"] == "s"
+        assert (ds.attrs["case_id"], ds.attrs["status"]) == ("random-00007", "failed")
+        assert "pointing_error_deg" not in ds  # what the case lacks is left out
+    assert sorted(p.name for p in path.parent.iterdir()) == ["random-00007.nc"]  # no partial

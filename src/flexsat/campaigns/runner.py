@@ -159,12 +159,12 @@ HISTORY_DT_S = 0.1
 
 
 def case_history(ds, dt: float = HISTORY_DT_S) -> dict:
-    """Time history of a slew decimated to every ``dt`` seconds, as plain lists.
+    """Time history of a slew decimated to every ``dt`` seconds, as float arrays.
 
     Keys are those of :data:`HISTORY_UNITS` and the law's declared diagnostics
     (``attrs["law_diagnostics"]``: ``lambda_act`` and ``jk`` for the ASMC, the
     twisting integral for the STSMC...), whose units and descriptions go under
-    ``channels``; per-axis variables are lists of [x, y, z] per sample,
+    ``channels``; per-axis variables are (samples, 3) arrays,
     ``tip_displacement_max`` the largest tip-displacement magnitude over the
     appendages [m]. Variables a dataset lacks are left out. A partial (failed) run
     gives the history up to where it stopped.
@@ -179,23 +179,24 @@ def case_history(ds, dt: float = HISTORY_DT_S) -> dict:
     Returns
     -------
     dict
-        Lists by variable name, plus ``channels``.
+        Arrays by variable name (own copies, C-contiguous float64: cheap to send
+        between processes), plus ``channels``.
     """
     import numpy as np
 
     t = np.asarray(ds["time"].values, dtype=float)
     if t.size == 0:
-        return {"time": []}
+        return {"time": t}
     grid = np.arange(t[0], t[-1] + 0.5 * dt, dt)
     index = np.unique(np.clip(np.searchsorted(t, grid - 1e-9 * dt), 0, t.size - 1))
-    history = {"time": t[index].tolist()}
+    history = {"time": t[index]}
     for name in ("pointing_error_deg", "rate_error_deg_s", "tau_cmd", "total_energy"):
         if name in ds:
-            history[name] = np.asarray(ds[name].values, dtype=float)[index].tolist()
+            history[name] = np.asarray(ds[name].values, dtype=float)[index]
     channels = {}
     for name in ds.attrs.get("law_diagnostics", ()):
         if name in ds:
-            history[name] = np.asarray(ds[name].values, dtype=float)[index].tolist()
+            history[name] = np.asarray(ds[name].values, dtype=float)[index]
             channels[name] = {key: ds[name].attrs.get(key, "") for key in ("units", "description")}
     if channels:
         history["channels"] = channels
@@ -203,7 +204,7 @@ def case_history(ds, dt: float = HISTORY_DT_S) -> dict:
         tips = np.asarray(ds["tip_displacement"].values, dtype=float)[index]
         magnitude = np.linalg.norm(tips, axis=-1)  # (time, appendage)
         if magnitude.ndim == 2 and magnitude.shape[1]:
-            history["tip_displacement_max"] = magnitude.max(axis=1).tolist()
+            history["tip_displacement_max"] = magnitude.max(axis=1)
     return history
 
 
