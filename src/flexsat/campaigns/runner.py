@@ -554,28 +554,44 @@ def _backend(workers, scheduler, dask_local, runner="pool"):
     yield execute
 
 
+QUIET_DASK = {
+    "distributed.worker.profile.enabled": False,  # the dashboard's sampler, every 10 ms
+    "distributed.admin.tick.interval": "1s",  # the event loops' block detector, 20 ms
+    "distributed.admin.system-monitor.interval": "5s",  # dashboard metrics, 500 ms
+    "distributed.scheduler.work-stealing": False,  # a window of tasks per thread: balanced
+}
+"""Dask settings of a campaign's cluster and client. Dask's defaults feed its
+dashboard, which a campaign does not start: an idle LocalCluster of 2 workers took
+3.5 CPU-s per 30 s on its own (12 % of a core), 1.0 CPU-s with these
+(docs/performance.md, 'Dask: a quiet cluster')."""
+
+
 @contextlib.contextmanager
 def _dask_client(scheduler, dask_local):
+    import dask
     from dask.distributed import Client, LocalCluster
 
-    cluster = None
-    if scheduler is None:
-        cluster = LocalCluster(
-            n_workers=dask_local, threads_per_worker=1, processes=True,
-            host="127.0.0.1", dashboard_address=None,
-        )  # fmt: skip
-    try:
-        client = Client(cluster if cluster is not None else scheduler, timeout="10s")
-    except (OSError, TimeoutError, ValueError) as exc:
-        if cluster is not None:
-            cluster.close()
-        raise ConfigError(f"cannot connect to the Dask scheduler {scheduler}: {exc}") from None
-    try:
-        yield client
-    finally:
-        client.close()
-        if cluster is not None:
-            cluster.close()
+    with dask.config.set(QUIET_DASK):  # the workers of a LocalCluster inherit them
+        cluster = None
+        if scheduler is None:
+            cluster = LocalCluster(
+                n_workers=dask_local, threads_per_worker=1, processes=True,
+                host="127.0.0.1", dashboard_address=None,
+            )  # fmt: skip
+        try:
+            client = Client(cluster if cluster is not None else scheduler, timeout="10s")
+        except (OSError, TimeoutError, ValueError) as exc:
+            if cluster is not None:
+                cluster.close()
+            raise ConfigError(
+                f"cannot connect to the Dask scheduler {scheduler}: {exc}"
+            ) from None
+        try:
+            yield client
+        finally:
+            client.close()
+            if cluster is not None:
+                cluster.close()
 
 
 DASK_BATCH = 8
