@@ -162,3 +162,20 @@ def test_seeded_kills_of_parent_and_workers_lose_and_recompute_nothing(tmp_path,
 
 
 assert TIMING  # the columns _table drops: wall times, which differ between runs
+
+
+def test_a_local_dask_cluster_runs_without_the_dashboard_feeds():
+    # The settings reach the worker processes of the LocalCluster (their profiler
+    # sampling every thread every 10 ms was most of an idle cluster's CPU).
+    import dask
+
+    from flexsat.campaigns.runner import QUIET_DASK, _dask_client
+
+    def settings() -> dict:
+        return {key: dask.config.get(key) for key in QUIET_DASK}
+
+    with _dask_client(None, 1) as client:
+        (worker,) = client.run(settings).values()
+        assert worker == QUIET_DASK
+        assert settings() == QUIET_DASK  # the client's (and scheduler's) process too
+    assert dask.config.get("distributed.worker.profile.enabled") is True  # restored
