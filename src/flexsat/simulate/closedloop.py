@@ -333,23 +333,25 @@ def finish_slew(run: PreparedSlew, status: int, done: int, rows: int, wall: floa
         attrs, frames=rec_frame, joint_force=rec_Q,
     )  # fmt: skip
     ta = ("time", "axis")
+    added = {}  # one assign: each ``ds[name] =`` would re-merge the whole dataset
     for channel, columns in layout.channels():
         values = rec_ctrl[:, columns] if channel.per_axis else rec_ctrl[:, columns.start]
         attributes = {"units": channel.units, "long_name": channel.description}
-        ds[channel.name] = (ta if channel.per_axis else "time", values, attributes)
+        added[channel.name] = (ta if channel.per_axis else "time", values, attributes)
     # of the true attitude, whatever the sensor measured
     pointing = pointing_errors(target, np.ascontiguousarray(ds["q"].values[:, at.attitude]))
-    ds["pointing_error_deg"] = (
+    added["pointing_error_deg"] = (
         "time", np.degrees(pointing),
         {"units": "deg", "long_name": "2 asin |q_v,e| of the true attitude from the "
          "target: absolute pointing error"},
     )  # fmt: skip
     with np.errstate(over="ignore", invalid="ignore"):  # a diverged run's last state
         rate_error = np.degrees(np.linalg.norm(ds["omega"].values, axis=1))
-    ds["rate_error_deg_s"] = (
+    added["rate_error_deg_s"] = (
         "time", rate_error,
         {"units": "deg/s", "long_name": "|omega - omega_d|: residual rate (jitter)"},
     )  # fmt: skip
+    ds = ds.assign(added)
     return Result(ds)
 
 
