@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import os
 import subprocess
 import sys
 
@@ -186,3 +187,28 @@ def test_slew_target_option():
     assert final == pytest.approx([10.0, 0.0, -20.0], abs=0.05)
     bad = run("slew", "--target-euler-deg", "10,0")
     assert bad.returncode == 2 and "three comma-separated numbers" in bad.stderr
+
+
+_ANNOUNCE = (
+    "import sys; from pathlib import Path; from flexsat.dynamics import kernels; "
+    "from flexsat.cli.main import _announce_compilation; "
+    "cache = Path(kernels.accelerations._cache._cache_path); "
+    "cache.mkdir(parents=True, exist_ok=True); "
+    "sys.argv[1:] and (cache / 'kernels.accelerations-1.py311.nbi').touch(); "
+    "_announce_compilation(); print(cache)"
+)
+
+
+def _announce(env: dict, *extra: str) -> subprocess.CompletedProcess:
+    command = [sys.executable, "-c", _ANNOUNCE, *extra]
+    return subprocess.run(command, env=env, capture_output=True, text=True, check=True)
+
+
+def test_the_first_run_notice_looks_where_numba_caches(tmp_path):
+    # With NUMBA_CACHE_DIR set (or read-only sources), numba caches elsewhere than
+    # beside the sources: an empty cache there is announced, a filled one is not.
+    env = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path / "numba")}
+    empty, filled = _announce(env), _announce(env, "filled")
+    assert empty.stdout.strip().startswith(str(tmp_path / "numba"))
+    assert "compiling the dynamics kernels" in empty.stderr
+    assert "compiling" not in filled.stderr

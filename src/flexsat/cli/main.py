@@ -73,10 +73,14 @@ def _version(value: bool) -> None:
 
 
 def _announce_compilation() -> None:
-    """Say so on stderr when the compiled kernels are not cached yet (first run)."""
+    """Say so on stderr when the compiled kernels are not cached yet (first run).
+
+    The folder is the one numba's own cache locator chose: beside the sources,
+    ``NUMBA_CACHE_DIR``, or a per-user folder when the sources are read-only.
+    """
     from flexsat.dynamics import kernels
 
-    cache = Path(kernels.__file__).parent / "__pycache__"
+    cache = Path(kernels.accelerations._cache._cache_path)  # numba has no public getter
     if not any(cache.glob("kernels.*.nbi")):
         _errors.print("compiling the dynamics kernels (first run only, cached on disk)...")
 
