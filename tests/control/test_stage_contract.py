@@ -13,12 +13,14 @@ import numpy as np
 import pytest
 from numba import njit
 from pydantic import Field, ValidationError
+from scipy.integrate import trapezoid
 
 from flexsat.control import Channel, StageConfig, StageSpec, register_stage
 from flexsat.control.quaternion import euler_zyx_to_quaternion, target_quaternion
 from flexsat.control.stages import (
     ACTUATOR_SIGNATURE,
     ACTUATORS,
+    DERIVATIVE_SIGNATURE,
     SENSOR_SIGNATURE,
     SENSORS,
     ActuatorStageConfig,
@@ -26,6 +28,7 @@ from flexsat.control.stages import (
 )
 from flexsat.dynamics.linalg3 import euler_rate_matrix, load_seg, mv
 from flexsat.simulate import SlewScenario, run_slew
+from flexsat.simulate.closedloop import prepare_slew
 
 BIAS_DEG = 0.2  # attitude bias of the sensor about body x
 
@@ -73,6 +76,32 @@ class PlainActuatorConfig(StageConfig):
     kind: Literal["plain"] = "plain"  # no limits: an actuation stage only
 
 
+class RateIntegralConfig(StageConfig):
+    kind: Literal["rate_integral"] = "rate_integral"
+
+    def integrated_size(self) -> int:
+        return 3  # the integral; the instant counter after it is discrete
+
+
+@njit(ACTUATOR_SIGNATURE, cache=True)
+def rate_integral_step(tau_cmd, t, dt, params, state, tau_applied, record):
+    """Passes the torque on; records the integral of omega and counts the instants."""
+    state[3] += 1.0
+    for a in range(3):
+        tau_applied[a] = tau_cmd[a]
+        record[a] = state[a]
+    record[3] = state[3]
+    return 0
+
+
+@njit(DERIVATIVE_SIGNATURE, cache=True)
+def rate_integral_derivative(x, n_dof, t, omega, params, state, state_dot, wrench):
+    """d/dt of the integral is the body rate the loop hands over; no torque on the hub."""
+    for a in range(3):
+        state_dot[a] = omega[a]
+    return 0
+
+
 BIASED = StageSpec(role="sensor", name="biased", config=BiasedSensorConfig,
                    step=biased_sensor_step)  # fmt: skip
 SCALING = StageSpec(
@@ -80,14 +109,23 @@ SCALING = StageSpec(
     records=(Channel("actuator_scale", "1", "applied / commanded torque"),),
 )  # fmt: skip
 
+RATE_INTEGRAL = StageSpec(
+    role="actuator", name="rate_integral", config=RateIntegralConfig, step=rate_integral_step,
+    derivative=rate_integral_derivative, state_size=4,
+    records=(Channel("rate_integral", "rad", "integral of omega, hub frame B", per_axis=True),
+             Channel("instants", "1", "control instants seen")),
+)  # fmt: skip
+
 
 @pytest.fixture(scope="module")
 def stages():
     register_stage(BIASED)  # the one line a user writes, per stage
     register_stage(SCALING)
+    register_stage(RATE_INTEGRAL)
     yield
     SENSORS.unregister(BIASED.name)
     ACTUATORS.unregister(SCALING.name)
+    ACTUATORS.unregister(RATE_INTEGRAL.name)
 
 
 def test_sensor_bias_moves_the_true_attitude_by_the_bias(stages, nominal_plant):
@@ -131,6 +169,27 @@ def test_actuator_stage_replaces_the_static_one(stages, nominal_plant):
     from flexsat.plots.slew import plot_disturbances
 
     plot_disturbances(ds)  # says there is no static disturbance model to draw
+
+
+def test_a_continuous_stage_integrates_the_body_rate_the_loop_hands_it(stages, nominal_plant):
+    # A stage's derivative receives omega = S(Theta) Theta_dot at every RK4 stage: its
+    # integral over the first 2 s of the thesis slew is the integral of the recorded
+    # body rate. Records every step (1 ms): the trapezoidal rule's error, dt^2 / 12 T
+    # max|omega''| ~ 1e-6 / 12 * 2 * 0.05 ~ 1e-8 rad, against an integral of ~1e-3 rad:
+    # 1e-4 relative bounds it with margin, while a wrong rate (a frame, a sign, a lag
+    # of one step: ~|omega| dt = 1e-6 rad) would not pass.
+    scenario = SlewScenario.model_validate({
+        "duration_s": 2.0, "record_dt_s": 0.001,
+        "actuator_stages": [{"kind": "rate_integral"}],
+    })  # fmt: skip
+    # only the integral rides in the coupled RK4 step, not the discrete counter
+    assert prepare_slew(nominal_plant, scenario).data.flow.state.shape == (3,)
+    ds = run_slew(nominal_plant, scenario).dataset
+    expected = trapezoid(ds["omega"].values, ds["time"].values, axis=0)
+    got = ds["rate_integral"].values[-1]
+    assert np.abs(got).max() > 1e-4  # the slew has started turning
+    np.testing.assert_allclose(got, expected, rtol=1e-4, atol=1e-10)
+    assert ds["instants"].values[-1] == scenario.n_steps + 1  # held, never integrated
 
 
 @pytest.mark.parametrize(

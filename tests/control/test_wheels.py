@@ -12,6 +12,7 @@ from scipy.spatial.transform import Rotation
 from flexsat.analysis.requirements import slew_metrics
 from flexsat.control.stages.wheels import WheelsConfig, _smooth_sign, wheel_axes
 from flexsat.simulate import SlewScenario, run_slew
+from flexsat.simulate.closedloop import prepare_slew
 
 
 @pytest.fixture(scope="module")
@@ -103,6 +104,16 @@ def test_presets_are_unit_axes_with_equal_capability():
     # At the 54.7356 deg half-angle A A^T = (4/3) I: the same torque on every axis.
     np.testing.assert_allclose(pyramid.T @ pyramid, 4.0 / 3.0 * np.eye(3), atol=1e-5)
     np.testing.assert_array_equal(wheel_axes("orthogonal3"), np.eye(3))
+
+
+@pytest.mark.parametrize(("preset", "wheels"), [("pyramid4", 4), ("orthogonal3", 3)])
+def test_the_coupled_step_carries_the_integrated_entries_only(nominal_plant, preset, wheels):
+    # h, u and the held u_cmd of each wheel, motor work, friction loss: 3 N + 2 of the
+    # stage's 20 entries (sized for six wheels) ride in the RK4 stages.
+    scenario = SlewScenario.model_validate({"actuator": {"kind": "wheels", "preset": preset}})
+    flow = prepare_slew(nominal_plant, scenario).data.flow
+    assert flow.state.shape == flow.eval.shape == flow.k[0].shape == (3 * wheels + 2,)
+    assert WheelsConfig(preset=preset).integrated_size() == 3 * wheels + 2
 
 
 def test_axes_that_do_not_span_3d_are_refused():

@@ -23,14 +23,15 @@ from numba import njit
 from flexsat.dynamics.appendages.contract import HUB_DISSIPATION
 from flexsat.dynamics.attitude import rebase
 from flexsat.dynamics.borrowed import borrowed
-from flexsat.dynamics.kernels import accelerations
-from flexsat.dynamics.linalg3 import euler_rate_matrix, mtv
+from flexsat.dynamics.kernels import accelerations_cs, hub_cs
+from flexsat.dynamics.linalg3 import euler_rate_matrix_cs, mtv
 from flexsat.dynamics.status import STATUS_NOT_FINITE, STATUS_OK
 
 __all__ = [
     "STATUS_NOT_FINITE",
     "applied_torque",
     "augmented_derivative",
+    "augmented_derivative_cs",
     "rk4_hold",
     "rk4_open_loop",
     "rk4_step",
@@ -95,12 +96,32 @@ def augmented_derivative(x, torque_B, n, Q, dx, packed):
     int
         ``STATUS_OK`` or a kernel status.
     """
+    return augmented_derivative_cs(hub_cs(x), x, torque_B, n, Q, dx, packed)
+
+
+@njit(cache=True, inline="always")
+def augmented_derivative_cs(cs, x, torque_B, n, Q, dx, packed):
+    """:func:`augmented_derivative` given the cosines and sines of the hub angles.
+
+    Parameters
+    ----------
+    cs : tuple of 6 float
+        :func:`~flexsat.dynamics.kernels.hub_cs` of ``x`` [-].
+    x, torque_B, n, Q, dx, packed
+        As for :func:`augmented_derivative`.
+
+    Returns
+    -------
+    int
+        ``STATUS_OK`` or a kernel status.
+    """
     q = x[:n]
     qd = x[n : 2 * n]
     Q[0], Q[1], Q[2] = 0.0, 0.0, 0.0
-    Q[3], Q[4], Q[5] = mtv(euler_rate_matrix(q[3], q[4]), torque_B)  # Q_Theta = S^T tau
+    S = euler_rate_matrix_cs(cs[0], cs[1], cs[2], cs[3])
+    Q[3], Q[4], Q[5] = mtv(S, torque_B)  # Q_Theta = S^T tau
     dx[:n] = qd
-    status = accelerations(q, qd, Q, packed, dx[n : 2 * n])
+    status = accelerations_cs(cs, q, qd, Q, packed, dx[n : 2 * n])
     power_in = 0.0
     for j in range(3, n):
         power_in += Q[j] * qd[j]

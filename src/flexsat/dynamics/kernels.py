@@ -30,7 +30,7 @@ about 10 % faster (docs/performance.md).
 
 from __future__ import annotations
 
-from math import cos
+from math import cos, sin
 
 from numba import njit
 
@@ -55,14 +55,17 @@ from flexsat.dynamics.linalg3 import (
     cross,
     dot,
     euler_rate_bias,
+    euler_rate_bias_cs,
     euler_rate_matrix,
-    euler_rate_matrix_inv,
+    euler_rate_matrix_cs,
+    euler_rate_matrix_inv_cs,
     load_seg,
     mm,
     mtm,
     mtv,
     mv,
     rot_zyx,
+    rot_zyx_cs,
     scale,
     sub,
 )
@@ -77,7 +80,9 @@ __all__ = [
     "STATUS_JOINT_GIMBAL_LOCK",
     "STATUS_OK",
     "accelerations",
+    "accelerations_cs",
     "bias_forces",
+    "hub_cs",
     "hub_joint_wrench",
     "joint_forces",
     "mass_matrix",
@@ -124,6 +129,24 @@ def _solve_hub(packed, force_B, torque_B):
     return (A[0, 6], A[1, 6], A[2, 6]), (A[3, 6], A[4, 6], A[5, 6])
 
 
+@njit(cache=True, error_model="numpy", inline="always")
+def hub_cs(q):
+    """Cosines and sines of the hub's ZYX Euler angles, for the ``_cs`` kernels.
+
+    Parameters
+    ----------
+    q : ndarray, shape (n_dof,) or longer
+        Generalized coordinates (or the augmented state, which starts with them);
+        the angles (phi, theta, psi) are q[3:6] [rad].
+
+    Returns
+    -------
+    tuple of 6 float
+        (cos phi, sin phi, cos theta, sin theta, cos psi, sin psi) [-].
+    """
+    return cos(q[3]), sin(q[3]), cos(q[4]), sin(q[4]), cos(q[5]), sin(q[5])
+
+
 @njit(cache=True, error_model="numpy")
 def accelerations(q, qd, Q, packed, qdd):
     """Solve M(q) q_ddot = Q - h(q, q_dot) - C q_dot - k_el(q) for q_ddot (eq. 2.50).
@@ -147,12 +170,34 @@ def accelerations(q, qd, Q, packed, qdd):
         ``STATUS_OK`` or a gimbal-lock status (``qdd`` is then undefined). As a side
         result ``packed.hub[HUB_DISSIPATION]`` holds the damper power q_dot^T C q_dot.
     """
-    phi, theta, psi = q[3], q[4], q[5]
-    if abs(cos(theta)) < _MIN_COS:
+    return accelerations_cs(hub_cs(q), q, qd, Q, packed, qdd)
+
+
+@njit(cache=True, error_model="numpy")
+def accelerations_cs(cs, q, qd, Q, packed, qdd):
+    """:func:`accelerations` given the cosines and sines of the hub angles, ``hub_cs(q)``.
+
+    A caller that needs them too (the body rate S(Theta) Theta_dot of the coupled
+    actuation stages, :mod:`flexsat.simulate.coupled`) computes them once for both.
+
+    Parameters
+    ----------
+    cs : tuple of 6 float
+        :func:`hub_cs` of ``q`` [-].
+    q, qd, Q, packed, qdd
+        As for :func:`accelerations`.
+
+    Returns
+    -------
+    int
+        As for :func:`accelerations`.
+    """
+    c1, s1, c2, s2, c3, s3 = cs
+    if abs(c2) < _MIN_COS:
         return STATUS_HUB_GIMBAL_LOCK
-    R_NB = rot_zyx(phi, theta, psi)
-    S_inv = euler_rate_matrix_inv(phi, theta)
-    omega_B = mv(euler_rate_matrix(phi, theta), load_seg(qd, 3))
+    R_NB = rot_zyx_cs(c1, s1, c2, s2, c3, s3)
+    S_inv = euler_rate_matrix_inv_cs(c1, s1, c2, s2)
+    omega_B = mv(euler_rate_matrix_cs(c1, s1, c2, s2), load_seg(qd, 3))
     hub = packed.hub
     _put(hub, HUB_OMEGA, omega_B)
     _put(hub, HUB_FORCE, mtv(R_NB, load_seg(Q, 0)))  # Q_r is an inertial force
@@ -183,7 +228,7 @@ def accelerations(q, qd, Q, packed, qdd):
     _put(hub, HUB_ACC, a_hub_B)
     _put(hub, HUB_ALPHA, omega_dot_B)
     qdd[0], qdd[1], qdd[2] = mv(R_NB, a_hub_B)
-    s_bias = euler_rate_bias(phi, theta, qd[3], qd[4], qd[5])
+    s_bias = euler_rate_bias_cs(c1, s1, c2, s2, qd[3], qd[4], qd[5])
     qdd[3], qdd[4], qdd[5] = mv(S_inv, sub(omega_dot_B, s_bias))
 
     # Pass 2: each appendage's coordinate accelerations given the hub's.

@@ -28,6 +28,7 @@ __all__ = [
     "euler_rate_matrix",
     "euler_rate_matrix_cs",
     "euler_rate_matrix_inv",
+    "euler_rate_matrix_inv_cs",
     "load_m33",
     "load_m33_at",
     "load_seg",
@@ -342,8 +343,23 @@ def euler_rate_matrix_inv(phi, theta):
     tuple of 3 rows of 3 float
         S^-1: ZYX Euler-angle rates = S^-1 @ body rate [-].
     """
-    c1, s1 = cos(phi), sin(phi)
-    c2, s2 = cos(theta), sin(theta)
+    return euler_rate_matrix_inv_cs(cos(phi), sin(phi), cos(theta), sin(theta))
+
+
+@njit(cache=True, error_model="numpy")
+def euler_rate_matrix_inv_cs(c1, s1, c2, s2):
+    """:func:`euler_rate_matrix_inv` from the cosines and sines of (phi, theta).
+
+    Parameters
+    ----------
+    c1, s1, c2, s2 : float
+        Cosines and sines of roll and pitch [-].
+
+    Returns
+    -------
+    tuple of 3 rows of 3 float
+        S^-1 [-].
+    """
     t2 = s2 / c2
     return ((1.0, s1 * t2, c1 * t2), (0.0, c1, -s1), (0.0, s1 / c2, c1 / c2))
 

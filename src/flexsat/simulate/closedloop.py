@@ -393,20 +393,28 @@ def _loop_data(layout: LoopLayout, scenario: SlewScenario, J: np.ndarray,
     def packed(values) -> np.ndarray:
         return np.ascontiguousarray(values, dtype=float)
 
+    # The coupled RK4 step carries each stage's integrated entries (the block ends with
+    # the last stage that integrates any, ActuatorStageConfig.integrated_size).
     block = layout.continuous_state
+    if layout.continuous:
+        last = max(i for i, s in enumerate(layout.actuators) if s.derivative is not None)
+        size = chain[n_sensors + last].integrated_size()
+        if size is not None:
+            block = slice(block.start, layout.actuator_states[last].start + size)
     m = block.stop - block.start
     evaluation, rate = np.zeros(m), np.zeros(m)
 
     def local(array: np.ndarray, pieces: tuple[slice, ...]) -> tuple:
-        """Each stage's piece of a flow array (empty for a stage outside the block)."""
-        within = [block.start <= p.start and p.stop <= block.stop for p in pieces]
-        return tuple(array[p.start - block.start : p.stop - block.start] if ok else array[:0]
-                     for p, ok in zip(pieces, within, strict=True))  # fmt: skip
+        """Each stage's part of a flow array (empty for a stage outside the block)."""
+        return tuple(array[max(p.start, block.start) - block.start :
+                           min(p.stop, block.stop) - block.start]
+                     if p.start < block.stop and block.start < p.stop else array[:0]
+                     for p in pieces)  # fmt: skip
 
     flow = LoopFlow(
         state=state[block], eval=evaluation, eval_views=local(evaluation, layout.actuator_states),
         dot=rate, dot_views=local(rate, layout.actuator_states), k=np.zeros((4, m)),
-        wrench=np.zeros(3), held=np.zeros(3),
+        wrench=np.zeros(3), held=np.zeros(3), omega=np.zeros(3),
     )  # fmt: skip
 
     return LoopData(

@@ -26,6 +26,7 @@ from numba import njit
 from flexsat.dynamics.attitude import inertial_view, is_identity, rebase
 from flexsat.dynamics.borrowed import borrowed
 from flexsat.dynamics.integrators import rk4_step
+from flexsat.dynamics.kernels import hub_cs
 from flexsat.dynamics.status import STATUS_CONTROL_FAILED, STATUS_OK
 from flexsat.simulate.coupled import LoopFlow, chain_wrench, rk4_coupled_step
 
@@ -279,7 +280,7 @@ def run_actuators(x, n, t, control_dt, continuous, stages, d):
         flow = d.flow
         flow.held[:] = d.tau_applied
         flow.eval[:] = flow.state
-        status |= chain_wrench(x, n, t, stages.derivative, d.actuator_params, flow)
+        status |= chain_wrench(x, n, t, hub_cs(x), stages.derivative, d.actuator_params, flow)
         for a in range(3):
             d.tau_applied[a] += flow.wrench[a]
     return status

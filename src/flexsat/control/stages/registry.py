@@ -70,15 +70,18 @@ delay). Only the final ``[actuator]`` carries the limits (``ActuatorStageConfig`
 Continuous states, optional ``derivative`` of an actuator stage,
 ``@njit(DERIVATIVE_SIGNATURE, cache=True)``::
 
-    status = derivative(x, n_dof, t, params, state, state_dot, wrench)
+    status = derivative(x, n_dof, t, omega, params, state, state_dot, wrench)
 
-is evaluated at every RK4 stage of every plant step, with the plant state ``x``
-and the stage's ``state`` at that RK4 stage: it writes ``state_dot`` (state_size,)
-for the entries it integrates (the loop zeroes it first: entries left at zero are
-held, i.e. discrete) and adds the torque the stage exerts on the hub to
-``wrench`` (3,) [N m], hub frame B (on top of the held ``tau_applied``). The
-stage's discrete ``step`` still runs at every control instant and sees the
-integrated entries in ``state``.
+is evaluated at every RK4 stage of every plant step, with the plant state ``x``,
+the hub's body rate ``omega`` (3,) = S(Theta) Theta_dot at that state [rad/s], hub
+frame B (computed once per RK4 stage with the plant's own trigonometry), and the
+stage's ``state`` at that RK4 stage: its first ``integrated_size()`` entries (of
+its config, :meth:`StageConfig.integrated_size`; default all ``state_size``). It writes
+``state_dot`` (as long) for the entries it integrates (the loop zeroes it first:
+entries left at zero are held, i.e. discrete) and adds the torque the stage exerts
+on the hub to ``wrench`` (3,) [N m], hub frame B (on top of the held
+``tau_applied``). The stage's discrete ``step`` still runs at every control instant
+and sees the integrated entries in ``state``.
 """
 
 from __future__ import annotations
@@ -126,12 +129,13 @@ JOINT_ACTUATOR_SIGNATURE = types.int64(
     _vec, _vec,
 )
 """x, n_dof, t, dt, q_d, J_design (in/out), params, state, Q (out), record (out)."""
-DERIVATIVE_SIGNATURE = types.int64(_vec, types.int64, types.float64, _vec, _vec, _vec, _vec)
-"""x, n_dof, t, params, state, state_dot (out), wrench (in/out, added to)."""
+DERIVATIVE_SIGNATURE = types.int64(_vec, types.int64, types.float64, _vec, _vec, _vec, _vec, _vec)
+"""x, n_dof, t, omega (body rate, hub frame B), params, state, state_dot (out), wrench
+(in/out, added to)."""
 
 
 @njit(cache=True)  # compiled with DERIVATIVE_SIGNATURE on first use
-def no_derivative(x, n_dof, t, params, state, state_dot, wrench):
+def no_derivative(x, n_dof, t, omega, params, state, state_dot, wrench):
     """The derivative of a stage without continuous states: nothing integrated.
 
     Parameters
@@ -142,6 +146,8 @@ def no_derivative(x, n_dof, t, params, state, state_dot, wrench):
         Number of generalized coordinates.
     t : float
         Time [s].
+    omega : ndarray, shape (3,)
+        Hub body rate, hub frame B [rad/s].
     params, state : ndarray
         The stage's packed parameters and state [per stage].
     state_dot : ndarray
@@ -173,6 +179,16 @@ class StageConfig(_Frozen):
     def check(self, scenario: Any) -> None:
         """Refuse a setting inconsistent with the rest of ``scenario`` (ValueError whose
         message starts with the field's name); default: nothing to check."""
+
+    def integrated_size(self) -> int | None:
+        """How many leading entries of the state an actuation stage's ``derivative``
+        integrates (module docstring, 'Continuous states').
+
+        The coupled RK4 step carries only those (its cost grows with them); the rest
+        are discrete, held between control instants and seen by ``step`` only. None
+        (the default): all ``state_size`` entries.
+        """
+        return None
 
 
 class ActuatorStageConfig(StageConfig):

@@ -41,7 +41,6 @@ from pydantic import Field, model_validator
 
 from flexsat.config.models import Positive, Real
 from flexsat.control.registry import Channel
-from flexsat.control.stages._truth import true_body_rate
 from flexsat.control.stages.registry import (
     ActuatorStageConfig,
     StageSpec,
@@ -60,9 +59,10 @@ _NULL = _PINV + 3 * MAX_WHEELS  # I - A^+ A, row-major (MAX_WHEELS, MAX_WHEELS)
 _INV_IS = _NULL + MAX_WHEELS * MAX_WHEELS
 _INV_TAU, _INV_WC, _HMAX, _H0 = _INV_IS + 1, _INV_IS + 2, _INV_IS + 3, _INV_IS + 4
 _SIZE = _INV_IS + 5
-# state: h (N), motor torque u (N), command u_cmd (N), motor work, friction loss
-_H, _U, _UCMD = 0, MAX_WHEELS, 2 * MAX_WHEELS
-_WM, _WF = 3 * MAX_WHEELS, 3 * MAX_WHEELS + 1
+# state, packed for the N wheels of the cluster (the coupled RK4 step carries its first
+# 3 N + 2 entries, WheelsConfig.integrated_size): h_i - I_s Omega_0 at i, motor torque
+# u_i at N + i, command u_cmd,i at 2 N + i (held: zero rate), motor work at 3 N,
+# friction loss at 3 N + 1
 _RPM = 2.0 * np.pi / 60.0  # [rad/s per rpm]
 _SATURATED = 0.999  # |h_i| / (I_s Omega_max) reported as saturated
 
@@ -140,6 +140,11 @@ class WheelsConfig(ActuatorStageConfig):
             raise ValueError("axes: every spin axis needs a non-zero length")
         return axes / norms[:, None]
 
+    def integrated_size(self) -> int:
+        """h, u and u_cmd of each wheel (u_cmd held: the motor's response reads it), the
+        motor work and the friction loss: 3 N + 2."""
+        return 3 * self.spin_axes().shape[0] + 2
+
     def check(self, scenario) -> None:
         if self.motor_time_constant_s < scenario.dt_s:
             raise ValueError(f"motor_time_constant_s must be at least dt_s ({scenario.dt_s} s) "
@@ -167,7 +172,7 @@ class WheelsConfig(ActuatorStageConfig):
 @njit(cache=True, inline="always")
 def _momentum(p, s, i):
     """h_i: the state holds its change from I_s Omega_0."""
-    return p[_IS] * p[_W0] + s[_H + i]
+    return p[_IS] * p[_W0] + s[i]
 
 
 @njit(cache=True, inline="always")
@@ -191,7 +196,7 @@ def _smooth_sign(z):
 
 
 @njit(cache=True, error_model="numpy")  # compiled with DERIVATIVE_SIGNATURE on first use
-def wheels_derivative(x, n_dof, t, params, state, state_dot, wrench):
+def wheels_derivative(x, n_dof, t, omega, params, state, state_dot, wrench):
     """h_dot, u_dot, motor power, friction power; the wheels' wrench on the hub.
 
     Evaluated at every RK4 stage: it multiplies by the packed reciprocals instead of
@@ -200,27 +205,29 @@ def wheels_derivative(x, n_dof, t, params, state, state_dot, wrench):
     """
     p, s = params, state
     n = int(p[_N])
-    w = true_body_rate(x, n_dof)
-    hx, hy, hz = 0.0, 0.0, 0.0
+    w = (omega[0], omega[1], omega[2])  # S(Theta) Theta_dot (eq. 2.28), read once
+    hx, hy, hz, work, loss = 0.0, 0.0, 0.0, 0.0, 0.0
     for i in range(n):
         ax, ay, az = p[_A + i], p[_A + MAX_WHEELS + i], p[_A + 2 * MAX_WHEELS + i]
-        h = p[_H0] + s[_H + i]  # the state holds the change from I_s Omega_0
+        h = p[_H0] + s[i]  # the state holds the change from I_s Omega_0
         speed = h * p[_INV_IS] - (ax * w[0] + ay * w[1] + az * w[2])  # Omega_i
-        u = s[_U + i]
+        u = s[n + i]
         if abs(h) >= p[_HMAX] and u * h > 0.0:
             u = 0.0  # the drive cuts the torque that would pass the momentum limit
         friction = p[_CV] * speed + p[_CC] * _smooth_sign(speed * p[_INV_WC])
         h_dot = u - friction
-        state_dot[_H + i] = h_dot
-        state_dot[_U + i] = (s[_UCMD + i] - s[_U + i]) * p[_INV_TAU]
-        state_dot[_WM] += u * speed
-        state_dot[_WF] += friction * speed
+        state_dot[i] = h_dot
+        state_dot[n + i] = (s[2 * n + i] - s[n + i]) * p[_INV_TAU]
+        work += u * speed
+        loss += friction * speed
         wrench[0] -= ax * h_dot
         wrench[1] -= ay * h_dot
         wrench[2] -= az * h_dot
         hx += ax * h
         hy += ay * h
         hz += az * h
+    state_dot[3 * n] = work
+    state_dot[3 * n + 1] = loss
     # - omega x sum a_i h_i
     wrench[0] -= w[1] * hz - w[2] * hy
     wrench[1] -= w[2] * hx - w[0] * hz
@@ -243,7 +250,7 @@ def wheels_step(tau_cmd, t, dt, params, state, tau_applied, record):
         if p[_KNULL] != 0.0:  # null-space momentum management, off by default
             for j in range(n):
                 u -= p[_KNULL] * p[_NULL + MAX_WHEELS * i + j] * (_momentum(p, s, j) - bias)
-        s[_UCMD + i] = min(p[_UMAX], max(-p[_UMAX], u))
+        s[2 * n + i] = min(p[_UMAX], max(-p[_UMAX], u))
         h = _momentum(p, s, i)
         hx += p[_A + i] * h
         hy += p[_A + MAX_WHEELS + i] * h
@@ -256,8 +263,8 @@ def wheels_step(tau_cmd, t, dt, params, state, tau_applied, record):
     tau_applied[0], tau_applied[1], tau_applied[2] = 0.0, 0.0, 0.0
     record[0], record[1], record[2] = hx, hy, hz
     record[3] = energy
-    record[4] = s[_WM]
-    record[5] = s[_WF]
+    record[4] = s[3 * n]
+    record[5] = s[3 * n + 1]
     record[6] = ratio
     record[7] = saturated
     return 0
