@@ -205,33 +205,37 @@ def wheels_derivative(x, n_dof, t, omega, params, state, state_dot, wrench):
     """
     p, s = params, state
     n = int(p[_N])
-    w = (omega[0], omega[1], omega[2])  # S(Theta) Theta_dot (eq. 2.28), read once
+    # read once: the stores below could alias every array for the compiler
+    w0, w1, w2 = omega[0], omega[1], omega[2]  # S(Theta) Theta_dot (eq. 2.28)
+    h0, inv_is, h_max, inv_tau = p[_H0], p[_INV_IS], p[_HMAX], p[_INV_TAU]
+    c_v, c_c, inv_wc = p[_CV], p[_CC], p[_INV_WC]
+    tx, ty, tz = wrench[0], wrench[1], wrench[2]
     hx, hy, hz, work, loss = 0.0, 0.0, 0.0, 0.0, 0.0
     for i in range(n):
         ax, ay, az = p[_A + i], p[_A + MAX_WHEELS + i], p[_A + 2 * MAX_WHEELS + i]
-        h = p[_H0] + s[i]  # the state holds the change from I_s Omega_0
-        speed = h * p[_INV_IS] - (ax * w[0] + ay * w[1] + az * w[2])  # Omega_i
+        h = h0 + s[i]  # the state holds the change from I_s Omega_0
+        speed = h * inv_is - (ax * w0 + ay * w1 + az * w2)  # Omega_i
         u = s[n + i]
-        if abs(h) >= p[_HMAX] and u * h > 0.0:
+        if abs(h) >= h_max and u * h > 0.0:
             u = 0.0  # the drive cuts the torque that would pass the momentum limit
-        friction = p[_CV] * speed + p[_CC] * _smooth_sign(speed * p[_INV_WC])
+        friction = c_v * speed + c_c * _smooth_sign(speed * inv_wc)
         h_dot = u - friction
         state_dot[i] = h_dot
-        state_dot[n + i] = (s[2 * n + i] - s[n + i]) * p[_INV_TAU]
+        state_dot[n + i] = (s[2 * n + i] - s[n + i]) * inv_tau
         work += u * speed
         loss += friction * speed
-        wrench[0] -= ax * h_dot
-        wrench[1] -= ay * h_dot
-        wrench[2] -= az * h_dot
+        tx -= ax * h_dot
+        ty -= ay * h_dot
+        tz -= az * h_dot
         hx += ax * h
         hy += ay * h
         hz += az * h
     state_dot[3 * n] = work
     state_dot[3 * n + 1] = loss
     # - omega x sum a_i h_i
-    wrench[0] -= w[1] * hz - w[2] * hy
-    wrench[1] -= w[2] * hx - w[0] * hz
-    wrench[2] -= w[0] * hy - w[1] * hx
+    wrench[0] = tx - (w1 * hz - w2 * hy)
+    wrench[1] = ty - (w2 * hx - w0 * hz)
+    wrench[2] = tz - (w0 * hy - w1 * hx)
     return 0
 
 
@@ -242,7 +246,7 @@ def wheels_step(tau_cmd, t, dt, params, state, tau_applied, record):
     p, s = params, state
     n = int(p[_N])
     bias = p[_IS] * p[_WBIAS]
-    hx, hy, hz, energy, ratio, saturated = 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
+    hx, hy, hz, h2, h_abs, saturated = 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
     for i in range(n):
         u = 0.0
         for a in range(3):
@@ -255,17 +259,16 @@ def wheels_step(tau_cmd, t, dt, params, state, tau_applied, record):
         hx += p[_A + i] * h
         hy += p[_A + MAX_WHEELS + i] * h
         hz += p[_A + 2 * MAX_WHEELS + i] * h
-        energy += 0.5 * h * h / p[_IS]
-        r = abs(h / p[_IS]) / p[_WMAX]
-        ratio = max(ratio, r)
-        if r >= _SATURATED:
+        h2 += h * h
+        h_abs = max(h_abs, abs(h))
+        if abs(h) >= _SATURATED * p[_HMAX]:
             saturated += 2.0**i
     tau_applied[0], tau_applied[1], tau_applied[2] = 0.0, 0.0, 0.0
     record[0], record[1], record[2] = hx, hy, hz
-    record[3] = energy
+    record[3] = 0.5 * h2 / p[_IS]  # the divisions once, not per wheel
     record[4] = s[3 * n]
     record[5] = s[3 * n + 1]
-    record[6] = ratio
+    record[6] = h_abs / p[_IS] / p[_WMAX]  # the max of each wheel's ratio, bit for bit
     record[7] = saturated
     return 0
 
