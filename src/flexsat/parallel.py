@@ -2,6 +2,8 @@
 
 - :func:`figure_workers`: how many processes (``FLEXSAT_FIGURE_WORKERS``, else up to 2).
 - :func:`forked_map`: ``[job(item) for item in items]`` by forked processes.
+- :func:`frozen_heap`: what a fork is started inside of, so the children's garbage
+  collections leave the parent's objects (and their memory pages) alone.
 
 Forked processes start in milliseconds with the parent's memory, including every
 numba kernel the parent already compiled or loaded from its disk cache, so a
@@ -11,11 +13,13 @@ numba, so the command line can import it at start-up.
 
 from __future__ import annotations
 
+import gc
 import multiprocessing
 import os
-from collections.abc import Callable, Iterable
+from collections.abc import Callable, Iterable, Iterator
+from contextlib import contextmanager
 
-__all__ = ["figure_workers", "forked_map"]
+__all__ = ["figure_workers", "forked_map", "frozen_heap"]
 
 
 def figure_workers() -> int:
@@ -36,6 +40,25 @@ def figure_workers() -> int:
     if given is not None and given.strip().isdigit():
         return max(1, int(given))
     return max(1, min(2, os.cpu_count() or 1))
+
+
+@contextmanager
+def frozen_heap() -> Iterator[None]:
+    """Start forked processes inside this: the objects that exist are frozen meanwhile.
+
+    A forked process shares the parent's memory pages until it writes to one; a
+    garbage collection in it writes to every object it examines (its ``gc`` header),
+    so each collection copies most of the parent's pages, one page fault at a time.
+    :func:`gc.freeze` moves the existing objects out of the collector's reach: the
+    children never examine them, and the parent is unfrozen (collects them again) as
+    soon as the block ends. Measured on the quick study (2 cores, about 20 forks of a
+    process holding the compiled kernels): about 1 s less system time.
+    """
+    gc.freeze()
+    try:
+        yield
+    finally:
+        gc.unfreeze()
 
 
 _JOB: Callable | None = None  # the job of the running map, inherited by the forks
@@ -70,7 +93,9 @@ def forked_map(job: Callable, items: Iterable, workers: int | None = None) -> li
         return [job(item) for item in items]
     _JOB = job
     try:
-        with multiprocessing.get_context("fork").Pool(workers) as pool:
+        with frozen_heap():  # the pool's processes are started here
+            pool = multiprocessing.get_context("fork").Pool(workers)
+        with pool:
             return pool.map(_run_job, items, chunksize=1)
     finally:
         _JOB = None

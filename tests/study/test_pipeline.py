@@ -125,3 +125,46 @@ def test_a_lane_that_dies_leaves_its_unfinished_parts_failed(monkeypatch):
     status = {name: entry["status"] for name, entry in recorded.items()}
     assert status == {"survivor": "ok", "done": "ok", "killer": "failed", "orphan": "failed"}
     assert recorded["orphan"]["error"] == "the process running it stopped (exit code 7)"
+
+
+def test_each_lane_loads_the_loops_only_its_parts_fly():
+    ctx = pipeline.StudyContext(nominal(), Path("."), quick=True, progress=False)
+    runs = pipeline._compile_runs(ctx)
+    shared, per_lane = pipeline._split_runs(runs, lanes=2)
+    lane = {part.name: part.lane for part in PARTS}
+    for fields, parts in runs:
+        lanes = {lane[name] for name in parts}
+        if len(lanes) == 1:  # flown by one lane's parts: loaded there, not before the fork
+            assert fields in per_lane[lanes.pop()] and fields not in shared
+        else:
+            assert fields in shared
+    assert "open loop" in per_lane[1]  # the open-loop part's lane
+    assert None in per_lane[0]  # the solar-array drive: the avionics part's lane
+    assert {"controller": {"kind": ctx.laws[0]}} in shared  # the slew's and law comparison's
+    one = pipeline._split_runs(runs, lanes=1)
+    assert one == ([fields for fields, _ in runs], {})
+
+
+def test_the_lanes_fly_their_own_short_runs_before_their_parts(monkeypatch):
+    # Lane 1 flies its share in the forked process, lane 0 here; the longer lane's time
+    # comes back (it is compilation, not the parts' wall time).
+    import time
+
+    flown = []
+
+    def fly(ctx, fields):
+        time.sleep(fields)
+        flown.append((os.getpid(), fields))
+
+    monkeypatch.setattr(pipeline, "_fly_short", fly)
+    parts = (_part("first", 0, lambda ctx: {"flown": list(flown)}),
+             _part("second", 1, lambda ctx: {"flown": list(flown)}))  # fmt: skip
+    monkeypatch.setattr(pipeline, "PARTS", parts)
+    ctx = pipeline.StudyContext(nominal(), Path("."), quick=True, progress=False)
+    recorded: dict[str, dict] = {}
+    prepared = pipeline._run_parts(ctx, lambda part, entry: recorded.update({part.name: entry}),
+                                   lanes=2, prepare={0: [0.01], 1: [0.3]})  # fmt: skip
+    assert 0.3 <= prepared < 5.0
+    assert recorded["first"]["outputs"]["flown"] == [(os.getpid(), 0.01)]
+    (pid, seconds), = recorded["second"]["outputs"]["flown"]
+    assert pid != os.getpid() and seconds == 0.3

@@ -1,4 +1,11 @@
-"""Analysis of plants and results: modes, open-loop metrics, spectra, requirement verdicts."""
+"""Analysis of plants and results: modes, open-loop metrics, spectra, requirement verdicts.
+
+The open-loop metrics and the spectra (:mod:`scipy.signal`, about 0.8 s to import) are
+imported on first use: the closed-loop stages import this package for its modal
+analysis, and a study's runs and figures other than the open loop's never need them.
+"""
+
+import importlib
 
 from flexsat.analysis.modal import (
     ModalAnalysis,
@@ -6,7 +13,6 @@ from flexsat.analysis.modal import (
     dof_names,
     modal_analysis,
 )
-from flexsat.analysis.openloop import openloop_metrics
 from flexsat.analysis.requirements import (
     Requirements,
     absolute_performance_error,
@@ -16,14 +22,13 @@ from flexsat.analysis.requirements import (
     settling_time,
     slew_metrics,
 )
-from flexsat.analysis.spectral import dominant_frequency
-from flexsat.analysis.spectrogram import (
-    DEFAULT_OVERLAP,
-    DEFAULT_WINDOW_S,
-    HUB_ROTATION_DOF,
-    coupled_frequencies,
-    spectrogram,
-)
+
+_LAZY = {
+    "openloop_metrics": "openloop",
+    "dominant_frequency": "spectral",
+    **dict.fromkeys(("DEFAULT_OVERLAP", "DEFAULT_WINDOW_S", "HUB_ROTATION_DOF",
+                     "coupled_frequencies", "spectrogram"), "spectrogram"),
+}  # fmt: skip
 
 __all__ = [
     "DEFAULT_OVERLAP",
@@ -45,3 +50,16 @@ __all__ = [
     "slew_metrics",
     "spectrogram",
 ]
+
+
+def __getattr__(name: str):
+    """The open-loop and spectral names, imported on first use (PEP 562)."""
+    if name in _LAZY:
+        value = getattr(importlib.import_module(f"{__name__}.{_LAZY[name]}"), name)
+        globals()[name] = value
+        return value
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+def __dir__() -> list[str]:
+    return sorted({*globals(), *__all__})

@@ -34,6 +34,7 @@ from numba import njit
 from scipy.spatial.transform import Rotation
 
 from flexsat.dynamics.linalg3 import (
+    copy_into,
     euler_rate_matrix,
     euler_rate_matrix_inv,
     load_m33_at,
@@ -171,7 +172,7 @@ def inertial_view(x, n_dof, frame, view):
     view : ndarray, shape (2 n_dof + 2,)
         Output: x with its hub part relative to N [SI, as x].
     """
-    view[:] = x
+    copy_into(view, x)
     R_NF = load_m33_at(frame, 0)
     omega_B = mv(euler_rate_matrix(x[3], x[4]), load_seg(x, n_dof + 3))
     phi, theta, psi = euler_zyx(mm(R_NF, rot_zyx(x[3], x[4], x[5])))

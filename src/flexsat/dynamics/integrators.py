@@ -24,7 +24,7 @@ from flexsat.dynamics.appendages.contract import HUB_DISSIPATION
 from flexsat.dynamics.attitude import rebase
 from flexsat.dynamics.borrowed import borrowed
 from flexsat.dynamics.kernels import accelerations_cs, hub_cs
-from flexsat.dynamics.linalg3 import euler_rate_matrix_cs, mtv
+from flexsat.dynamics.linalg3 import copy_into, euler_rate_matrix_cs, mtv
 from flexsat.dynamics.status import STATUS_NOT_FINITE, STATUS_OK
 
 __all__ = [
@@ -120,7 +120,7 @@ def augmented_derivative_cs(cs, x, torque_B, n, Q, dx, packed):
     Q[0], Q[1], Q[2] = 0.0, 0.0, 0.0
     S = euler_rate_matrix_cs(cs[0], cs[1], cs[2], cs[3])
     Q[3], Q[4], Q[5] = mtv(S, torque_B)  # Q_Theta = S^T tau
-    dx[:n] = qd
+    copy_into(dx[:n], qd)
     status = accelerations_cs(cs, q, qd, Q, packed, dx[n : 2 * n])
     power_in = 0.0
     for j in range(3, n):
@@ -177,7 +177,7 @@ def rk4_step(x, dt, torque_B, n, Q, scratch, packed):
         stage[j] = x[j] + dt / 6.0 * (k1[j] + 2.0 * k2[j] + 2.0 * k3[j] + k4[j])
         if not np.isfinite(stage[j]):
             return STATUS_NOT_FINITE
-    x[:] = stage
+    copy_into(x, stage)
     return STATUS_OK
 
 
@@ -278,8 +278,8 @@ def rk4_open_loop(
         if (k + 1) % record_every == 0:
             t_next = t0 + (k + 1) * dt
             rec_t[row] = t_next
-            rec_x[row, :] = x
-            rec_frame[row, :] = frame
+            copy_into(rec_x[row], x)
+            copy_into(rec_frame[row], frame)
             tau = applied_torque(t_next, seg_start, seg_end, seg_torque, disturbance)
             rec_tau[row, 0], rec_tau[row, 1], rec_tau[row, 2] = tau
             row += 1

@@ -52,6 +52,7 @@ from flexsat.dynamics.appendages.contract import (
 from flexsat.dynamics.linalg3 import (
     add,
     add_block,
+    copy_into,
     cross,
     dot,
     euler_rate_bias,
@@ -273,7 +274,7 @@ def _hold_locked(q, packed, qdd):
     M, A, free, unconstrained = packed.mass, packed.reduced, packed.free, packed.reaction[0]
     mass_matrix(q, packed, M)
     n, m = qdd.shape[0], free.shape[0]
-    unconstrained[:] = qdd
+    copy_into(unconstrained, qdd)
     for r in range(m):
         i = free[r]
         s = 0.0
@@ -388,7 +389,7 @@ def joint_forces(Q, packed, out):
         Output: the joints' generalized forces, the ``Q`` argument of
         :func:`hub_joint_wrench` [N, N m per coordinate].
     """
-    out[:] = Q
+    copy_into(out, Q)
     if packed.constrained:
         reaction = packed.reaction[1]
         for i in range(out.shape[0]):

@@ -21,6 +21,7 @@ from numba import njit
 __all__ = [
     "add",
     "add_block",
+    "copy_into",
     "cross",
     "dot",
     "euler_rate_bias",
@@ -45,6 +46,26 @@ __all__ = [
     "sub",
     "transpose",
 ]
+
+
+@njit(cache=True, error_model="numpy")
+def copy_into(dst, src):
+    """``dst[:] = src`` for 1-D arrays of one length, element by element.
+
+    The same bits as the slice assignment, which the compiled kernels avoid: for
+    every array assigned into a slice, numba (0.61 and later) compiles a formatted
+    error message for a shape mismatch (integer and string formatting), about 5 s of
+    compilation per process on a first run, again for each error model.
+
+    Parameters
+    ----------
+    dst : ndarray, shape (n,)
+        Output: a copy of ``src`` [any].
+    src : ndarray, shape (n,)
+        The values [any].
+    """
+    for i in range(src.shape[0]):
+        dst[i] = src[i]
 
 
 @njit(cache=True, error_model="numpy")

@@ -25,6 +25,7 @@ from flexsat.dynamics.kernels import (
     tip_displacement,
 )
 from flexsat.dynamics.linalg3 import (
+    copy_into,
     euler_rate_bias,
     euler_rate_matrix,
     load_seg,
@@ -100,7 +101,7 @@ def _derive_rows(
         w = mv(S, load_seg(qdk, 3))
         omega[k, 0], omega[k, 1], omega[k, 2] = w
         Q[3], Q[4], Q[5] = mtv(S, load_seg(tau_B[k], 0))
-        Q[6:] = joint_force[k, 6:]
+        copy_into(Q[6:], joint_force[k, 6:])
         status = accelerations(qk, qdk, Q, packed, qdd)
         joint_forces(Q, packed, joint)
         status |= hub_joint_wrench(qk, qdk, qdd, joint, packed, wrench)

@@ -27,6 +27,7 @@ from flexsat.dynamics.attitude import inertial_view, is_identity, rebase
 from flexsat.dynamics.borrowed import borrowed
 from flexsat.dynamics.integrators import rk4_step
 from flexsat.dynamics.kernels import hub_cs
+from flexsat.dynamics.linalg3 import copy_into
 from flexsat.dynamics.status import STATUS_CONTROL_FAILED, STATUS_OK
 from flexsat.simulate.coupled import LoopFlow, chain_wrench, rk4_coupled_step
 
@@ -271,15 +272,15 @@ def run_actuators(x, n, t, control_dt, continuous, stages, d):
         d.actuator_record[0],
     )  # fmt: skip
     for i in range(1, len(stages.actuator)):
-        d.tau_between[:] = d.tau_applied
+        copy_into(d.tau_between, d.tau_applied)
         status |= stages.actuator[i](
             d.tau_between, t, control_dt, d.actuator_params[i], d.actuator_state[i],
             d.tau_applied, d.actuator_record[i],
         )  # fmt: skip
     if continuous:
         flow = d.flow
-        flow.held[:] = d.tau_applied
-        flow.eval[:] = flow.state
+        copy_into(flow.held, d.tau_applied)
+        copy_into(flow.eval, flow.state)
         status |= chain_wrench(x, n, t, hub_cs(x), stages.derivative, d.actuator_params, flow)
         for a in range(3):
             d.tau_applied[a] += flow.wrench[a]
@@ -355,11 +356,11 @@ def rk4_closed_loop(x, clock, stages, d, records, plant, frame):
                 return STATUS_CONTROL_FAILED, k, row - records.start
         if k % clock.record_every == 0:
             records.t[row] = t
-            records.x[row, :] = x
-            records.frame[row, :] = frame
-            records.ctrl[row, :] = d.held
+            copy_into(records.x[row], x)
+            copy_into(records.frame[row], frame)
+            copy_into(records.ctrl[row], d.held)
             records.Q[row, :6] = 0.0  # d.Q[:6] holds the integrator's last hub forces
-            records.Q[row, 6:] = d.Q[6:]
+            copy_into(records.Q[row, 6:], d.Q[6:])
             row += 1
         if k == clock.n_steps:
             break

@@ -34,7 +34,7 @@ from rich.markup import escape
 from flexsat import __version__
 from flexsat.config.models import SatelliteConfig
 from flexsat.control.laws import LAWS
-from flexsat.parallel import figure_workers, forked_map
+from flexsat.parallel import figure_workers, forked_map, frozen_heap
 from flexsat.study.outputs import (
     derived_properties,
     fly_campaign,
@@ -330,7 +330,8 @@ def run_study(
         "quick": quick,
         "parts": [],
     }
-    manifest["compilation_s"] = _compile(ctx, console)
+    lanes = LANES if figure_workers() > 1 else 1
+    manifest["compilation_s"], per_lane = _compile(ctx, console, lanes)
     start = time.perf_counter()
     done: dict[str, dict] = {}
 
@@ -341,7 +342,11 @@ def run_study(
         write_json(out / MANIFEST, manifest)
         _announce(console, part, entry)
 
-    _run_parts(ctx, record, lanes=LANES if figure_workers() > 1 else 1)
+    # each lane's own kernels, loaded before its first part: compilation, not the parts'
+    prepared = _run_parts(ctx, record, lanes, per_lane)
+    manifest["compilation_s"] += prepared
+    manifest["total_wall_time_s"] = time.perf_counter() - start - prepared
+    write_json(out / MANIFEST, manifest)
     report = write_report(out)
     manifest["report"] = str(report)
     return manifest
@@ -355,76 +360,154 @@ def _cache_was_empty(plant) -> bool:
                for model in plant.models for kernel in model.kernels)  # fmt: skip
 
 
-def _compile(ctx: StudyContext, console: Console) -> float:
-    """Compile (or load from the disk cache) every kernel the study runs, up front.
+def _compile_runs(ctx: StudyContext) -> list[tuple[dict | str | None, frozenset[str]]]:
+    """The short runs that compile every loop the parts fly, each with the parts that
+    fly that loop (their lanes decide which process loads it, :func:`_compile`).
 
-    A 20 ms open-loop run and a 20 ms slew per compiled loop the parts fly: one per
-    law, the avionics chain, the delay stage, the hybrid damping and the solar-array
-    drive; the parts' wall times then exclude compilation, which the manifest gives
-    apart (``compilation_s``), and the forked processes the parts fly their runs in
-    inherit the compiled loops instead of each compiling them. When building the
-    plant compiled its kernels (:func:`_cache_was_empty`), two forked processes first
-    compile the runs into the disk cache side by side, the longest first, and this
-    process then loads them from it. Returns its wall time [s].
+    Each distinct loop first (measured on an empty cache: the open loop about 11 s,
+    the first law's 8, the delay's 9, the drive's 9 with its chain kernels, the
+    avionics chain's 6), then the runs that reuse one of them (the hybrid damping and
+    the other laws share the first law's loop). A run is the fields of a
+    :class:`flexsat.simulate.SlewScenario`, ``"open loop"``, or None: the solar arrays
+    on a drive (:func:`flexsat.study.avionics.sadm_study`).
     """
-    from flexsat.simulate import OpenLoopScenario, SlewScenario, run_openloop, run_slew
-    from flexsat.study.avionics import AVIONICS, delayed, sadm_study
+    from flexsat.study.avionics import AVIONICS, delayed
     from flexsat.study.laws import HYBRID_DAMPING
 
+    laws = [{"controller": {"kind": kind}} for kind in ctx.laws]
+    every_law = frozenset({"slew", "comparison", "laws"})
+    return [("open loop", frozenset({"openloop"})), (laws[0], every_law),
+            (delayed(1), frozenset({"avionics"})), (None, frozenset({"avionics"})),
+            (AVIONICS, frozenset({"avionics"})),
+            ({"joint_actuator": HYBRID_DAMPING}, frozenset({"laws"})),
+            *((law, every_law) for law in laws[1:])]  # fmt: skip
+
+
+def _fly_short(ctx: StudyContext, fields: dict | str | None) -> None:
+    """Fly one run of :func:`_compile_runs` for 20 ms (it compiles or loads its loop)."""
+    from flexsat.simulate import OpenLoopScenario, SlewScenario, run_openloop, run_slew
+    from flexsat.study.avionics import sadm_study
+
+    short = {"duration_s": 0.02, "record_dt_s": 0.01}
+    if fields == "open loop":
+        run_openloop(ctx.plant, OpenLoopScenario.model_validate(short), progress=False)
+    elif fields is None:  # the arrays on a drive
+        sadm_study(ctx.plant, duration_s=short["duration_s"])
+    else:
+        run_slew(ctx.plant, SlewScenario.model_validate({**short, **fields}),
+                 progress=False)  # fmt: skip
+
+
+def _fly_each(ctx: StudyContext, runs: list) -> float:
+    """Fly ``runs`` (of :func:`_compile_runs`) one after the other; return the wall time
+    [s]. A run that fails is left for the part that needs it to report."""
+    start = time.perf_counter()
+    try:
+        for fields in runs:
+            _fly_short(ctx, fields)
+    except Exception:  # the part that needs it reports the problem
+        pass
+    return time.perf_counter() - start
+
+
+def _compile(ctx: StudyContext, console: Console, lanes: int = 1) -> tuple[float, dict]:
+    """Compile (or load from the disk cache) every kernel the study runs, up front.
+
+    A 20 ms open-loop run and a 20 ms slew per compiled loop the parts fly
+    (:func:`_compile_runs`): one per law, the avionics chain, the delay stage, the
+    hybrid damping and the solar-array drive; the parts' wall times then exclude
+    compilation, which the manifest gives apart (``compilation_s``), and the forked
+    processes the parts fly their runs in inherit the compiled loops instead of each
+    compiling them. When building the plant compiled its kernels
+    (:func:`_cache_was_empty`), two forked processes first compile the runs into the
+    disk cache side by side, the longest first, and this process then loads them
+    from it.
+
+    With two lanes, this process loads only the loops that parts of both lanes fly;
+    a loop that only one lane's parts fly is loaded by that lane before its first
+    part (:func:`_run_parts`), both lanes side by side.
+
+    Parameters
+    ----------
+    ctx : StudyContext
+        The study.
+    console : Console
+        Where the step is announced.
+    lanes : int
+        Lanes the parts will run in (1 or 2).
+
+    Returns
+    -------
+    seconds : float
+        Wall time of this step [s].
+    per_lane : dict
+        Lane -> the runs left for it to fly (empty with one lane).
+    """
     console.print("compiling the simulation kernels (the first run only; later runs load "
                   "them from the disk cache)...", highlight=False)  # fmt: skip
     start = time.perf_counter()
-    short = {"duration_s": 0.02, "record_dt_s": 0.01}
-
-    def fly(fields: dict | str | None) -> None:
-        if fields == "open loop":
-            run_openloop(ctx.plant, OpenLoopScenario.model_validate(short), progress=False)
-        elif fields is None:  # the arrays on a drive
-            sadm_study(ctx.plant, duration_s=short["duration_s"])
-        else:
-            run_slew(ctx.plant, SlewScenario.model_validate({**short, **fields}),
-                     progress=False)  # fmt: skip
-
-    laws = [{"controller": {"kind": kind}} for kind in ctx.laws]
-    # Each distinct loop first (measured on an empty cache: the open loop about 11 s,
-    # the first law's 8, the delay's 9, the drive's 9 with its chain kernels, the
-    # avionics chain's 6), then the runs that reuse one of them (the hybrid damping
-    # and the other laws share the first law's loop).
-    runs = ["open loop", laws[0], delayed(1), None, AVIONICS,
-            {"joint_actuator": HYBRID_DAMPING}, *laws[1:]]  # fmt: skip
+    shared, per_lane = [], {}
     try:
-        if _cache_was_empty(ctx.plant):
-            forked_map(fly, runs)  # each process compiles its share into the cache
-        for fields in runs:
-            fly(fields)
+        runs = _compile_runs(ctx)
+        shared, per_lane = _split_runs(runs, lanes)
+        if _cache_was_empty(ctx.plant):  # each process compiles its share into the cache
+            forked_map(lambda fields: _fly_short(ctx, fields), [fields for fields, _ in runs])
     except Exception:  # the part that needs it reports the problem
         pass
+    _fly_each(ctx, shared)
     elapsed = time.perf_counter() - start
     console.print(f"compiled in {elapsed:.1f} s; the wall times below exclude it",
                   highlight=False)  # fmt: skip
-    return elapsed
+    return elapsed, per_lane
 
 
-def _run_parts(ctx: StudyContext, record: Callable[[Part, dict], None], lanes: int) -> None:
+def _split_runs(runs: list, lanes: int) -> tuple[list, dict[int, list]]:
+    """Split :func:`_compile_runs` into those this process flies before the lanes start
+    (loops the parts of both lanes fly) and, per lane, those only its parts fly.
+
+    Returns ``(shared, {lane: runs})``; with one lane every run is shared.
+    """
+    if lanes < 2:
+        return [fields for fields, _ in runs], {}
+    lane_of = {part.name: part.lane for part in PARTS}
+    shared, per_lane = [], {lane: [] for lane in range(lanes)}
+    for fields, parts in runs:
+        used = {lane_of[name] for name in parts}
+        (per_lane[used.pop()] if len(used) == 1 else shared).append(fields)
+    return shared, per_lane
+
+
+def _run_parts(
+    ctx: StudyContext,
+    record: Callable[[Part, dict], None],
+    lanes: int,
+    prepare: dict | None = None,
+) -> float:
     """Run every part of :data:`PARTS` on ``lanes`` lanes; ``record(part, entry)`` each.
 
     With two lanes, lane 1 runs in a forked process (it inherits the compiled
     kernels and ``ctx``, and runs without progress bars) and sends each part's entry
     back as it finishes; this process runs lane 0 and records lane 1's entries
     between its own parts, then waits for the rest. A lane that dies leaves its
-    unfinished parts failed with its exit code.
+    unfinished parts failed with its exit code. ``prepare`` maps a lane to the short
+    runs it flies before its first part (:func:`_compile`); returns the longer
+    lane's time for them [s] (0 without any).
     """
+    prepare = prepare or {}
     if lanes < 2:
         for part in PARTS:
             record(part, _run_part(part, ctx))
-        return
+        return 0.0
     forked = [part for part in PARTS if part.lane == 1]
     context = multiprocessing.get_context("fork")
     receive, send = context.Pipe(duplex=False)
-    lane = context.Process(target=_run_lane, args=(forked, ctx, send), name="flexsat-lane-1")
-    lane.start()
+    lane = context.Process(target=_run_lane, args=(forked, ctx, send, prepare.get(1, [])),
+                           name="flexsat-lane-1")  # fmt: skip
+    with frozen_heap():
+        lane.start()
     send.close()  # the lane holds the only writing end: its exit ends the reading
     pending = {part.name: part for part in forked}
+    prepared = [_fly_each(ctx, prepare.get(0, []))]
 
     def collect(block: bool) -> None:
         while pending and (block or receive.poll()):
@@ -437,6 +520,9 @@ def _run_parts(ctx: StudyContext, record: Callable[[Part, dict], None], lanes: i
                     record(part, _entry(part, "failed", error))
                 pending.clear()
                 return
+            if name is None:  # the lane's short runs, before its parts: their time
+                prepared.append(entry)
+                continue
             if results is not None:  # a failed or skipped part has no outputs to read
                 ctx.results[name] = results
             record(pending.pop(name), entry)
@@ -452,11 +538,15 @@ def _run_parts(ctx: StudyContext, record: Callable[[Part, dict], None], lanes: i
             lane.terminate()
         lane.join()
         receive.close()
+    return max(prepared)
 
 
-def _run_lane(parts: list[Part], ctx: StudyContext, send) -> None:
-    """Lane 1 in its forked process: run ``parts`` in order, send (name, entry, outputs)."""
+def _run_lane(parts: list[Part], ctx: StudyContext, send, runs: list = ()) -> None:
+    """Lane 1 in its forked process: fly ``runs`` (its share of :func:`_compile`) and send
+    (None, their time [s], None), then run ``parts`` in order, send (name, entry,
+    outputs) each."""
     ctx.progress = False  # two lanes' progress bars would interleave
+    send.send((None, _fly_each(ctx, list(runs)), None))
     for part in parts:
         entry = _run_part(part, ctx)
         send.send((part.name, entry, ctx.results.get(part.name)))

@@ -15,6 +15,7 @@ from pydantic import Field
 
 from flexsat.control.registry import Channel
 from flexsat.control.stages.registry import StageConfig, StageSpec
+from flexsat.dynamics.linalg3 import copy_into
 
 __all__ = ["DELAY", "MAX_DELAY_PERIODS", "DelayConfig"]
 
@@ -47,7 +48,7 @@ def delay_step(tau_cmd, t, dt, params, state, tau_applied, record):
     """tau_applied(k) = tau_cmd(k - D); state: [instants seen, ring of D commands]."""
     periods = int(params[0])
     if periods == 0:
-        tau_applied[:] = tau_cmd
+        copy_into(tau_applied, tau_cmd)
         return 0
     k = int(state[0])
     slot = 1 + 3 * (k % periods)
