@@ -3,8 +3,8 @@
 ``python bench/run_all.py`` (what ``make bench`` runs) prints, in this order, the tables
 of bench_dynamics, bench_openloop, bench_slew, bench_laws, bench_scaling, bench_startup,
 bench_campaigns, bench_scale, bench_ensemble, bench_case_cost, bench_avionics,
-bench_reduction, bench_campaign_start, bench_modal, bench_figures, bench_demo,
-bench_basilisk and bench_basilisk_chain (the last two skipped with a line when Basilisk
+bench_avionics_parts, bench_reduction, bench_campaign_start, bench_modal, bench_figures,
+bench_demo, bench_basilisk and bench_basilisk_chain (the last two skipped with a line when Basilisk
 or the script is missing), then one table of the performance targets: each target, the
 measured value, and met / not met. A benchmark that fails is reported and the others
 still run; the exit status is then 1.
@@ -45,6 +45,7 @@ BENCHMARKS = (
     "bench_ensemble",
     "bench_case_cost",
     "bench_avionics",
+    "bench_avionics_parts",
     "bench_reduction",
     "bench_campaign_start",
     "bench_figures",
