@@ -107,8 +107,18 @@ def augmented_derivative_cs(cs, x, torque_B, n, Q, dx, packed):
     ----------
     cs : tuple of 6 float
         :func:`~flexsat.dynamics.kernels.hub_cs` of ``x`` [-].
-    x, torque_B, n, Q, dx, packed
-        As for :func:`augmented_derivative`.
+    x : ndarray, shape (2 n + 2,)
+        Augmented state: q [m, rad], q_dot [m/s, rad/s], W_in [J], W_diss [J].
+    torque_B : tuple of 3 float
+        Body torque on the hub, hub frame B [N m].
+    n : int
+        Number of generalized coordinates n_dof.
+    Q : ndarray, shape (n,)
+        Generalized forces [N, N m per coordinate]; ``Q[:6]`` is overwritten.
+    dx : ndarray, shape (2 n + 2,)
+        Output: the derivative [unit of x per s].
+    packed : PackedPlant
+        The plant's packed arrays and kernels.
 
     Returns
     -------

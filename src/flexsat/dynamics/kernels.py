@@ -185,8 +185,14 @@ def accelerations_cs(cs, q, qd, Q, packed, qdd):
     ----------
     cs : tuple of 6 float
         :func:`hub_cs` of ``q`` [-].
-    q, qd, Q, packed, qdd
-        As for :func:`accelerations`.
+    q, qd : ndarray, shape (n_dof,)
+        Generalized coordinates and their rates [m, rad; m/s, rad/s].
+    Q : ndarray, shape (n_dof,)
+        External generalized forces [N, N m per coordinate].
+    packed : PackedPlant
+        The plant's packed arrays and kernels.
+    qdd : ndarray, shape (n_dof,)
+        Output: generalized accelerations [m/s^2, rad/s^2].
 
     Returns
     -------
