@@ -31,7 +31,6 @@ __all__ = [
     "STATUS_NOT_FINITE",
     "applied_torque",
     "augmented_derivative",
-    "augmented_derivative_cs",
     "rk4_hold",
     "rk4_open_loop",
     "rk4_step",
@@ -68,10 +67,10 @@ def applied_torque(t, seg_start, seg_end, seg_torque, disturbance):
 
 
 @njit(cache=True, inline="always")
-def augmented_derivative(x, torque_B, n, Q, dx, packed):
+def augmented_derivative(x, torque_B, n, Q, dx, packed, cs):
     """dx/dt of the augmented state [q, q_dot, W_in, W_diss] under a body torque.
 
-    Shared by the compiled RK4 loop and the adaptive scipy solver. W_in integrates the
+    Shared by the compiled RK4 loops and the adaptive scipy solver. W_in integrates the
     power of every applied generalized force, hub torque and joint actuators.
 
     Parameters
@@ -90,35 +89,10 @@ def augmented_derivative(x, torque_B, n, Q, dx, packed):
         Output: the derivative [unit of x per s].
     packed : PackedPlant
         The plant's packed arrays and kernels (:class:`~flexsat.dynamics.packed.PackedPlant`).
-
-    Returns
-    -------
-    int
-        ``STATUS_OK`` or a kernel status.
-    """
-    return augmented_derivative_cs(hub_cs(x), x, torque_B, n, Q, dx, packed)
-
-
-@njit(cache=True, inline="always")
-def augmented_derivative_cs(cs, x, torque_B, n, Q, dx, packed):
-    """:func:`augmented_derivative` given the cosines and sines of the hub angles.
-
-    Parameters
-    ----------
     cs : tuple of 6 float
-        :func:`~flexsat.dynamics.kernels.hub_cs` of ``x`` [-].
-    x : ndarray, shape (2 n + 2,)
-        Augmented state: q [m, rad], q_dot [m/s, rad/s], W_in [J], W_diss [J].
-    torque_B : tuple of 3 float
-        Body torque on the hub, hub frame B [N m].
-    n : int
-        Number of generalized coordinates n_dof.
-    Q : ndarray, shape (n,)
-        Generalized forces [N, N m per coordinate]; ``Q[:6]`` is overwritten.
-    dx : ndarray, shape (2 n + 2,)
-        Output: the derivative [unit of x per s].
-    packed : PackedPlant
-        The plant's packed arrays and kernels.
+        The cosines and sines of the hub angles of ``x``,
+        :func:`~flexsat.dynamics.kernels.hub_cs` ``(x)`` [-]: a caller that needs them
+        too (the coupled step's body rate) computes them once for both.
 
     Returns
     -------
@@ -171,16 +145,16 @@ def rk4_step(x, dt, torque_B, n, Q, scratch, packed):
     x, Q, scratch, packed = borrowed(x), borrowed(Q), borrowed(scratch), borrowed(packed)
     size = x.shape[0]
     k1, k2, k3, k4, stage = scratch[0], scratch[1], scratch[2], scratch[3], scratch[4]
-    status = augmented_derivative(x, torque_B, n, Q, k1, packed)
+    status = augmented_derivative(x, torque_B, n, Q, k1, packed, hub_cs(x))
     for j in range(size):
         stage[j] = x[j] + 0.5 * dt * k1[j]
-    status |= augmented_derivative(stage, torque_B, n, Q, k2, packed)
+    status |= augmented_derivative(stage, torque_B, n, Q, k2, packed, hub_cs(stage))
     for j in range(size):
         stage[j] = x[j] + 0.5 * dt * k2[j]
-    status |= augmented_derivative(stage, torque_B, n, Q, k3, packed)
+    status |= augmented_derivative(stage, torque_B, n, Q, k3, packed, hub_cs(stage))
     for j in range(size):
         stage[j] = x[j] + dt * k3[j]
-    status |= augmented_derivative(stage, torque_B, n, Q, k4, packed)
+    status |= augmented_derivative(stage, torque_B, n, Q, k4, packed, hub_cs(stage))
     if status != STATUS_OK:
         return status
     for j in range(size):

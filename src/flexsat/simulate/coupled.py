@@ -19,7 +19,7 @@ import numpy as np
 from numba import njit
 
 from flexsat.dynamics.borrowed import borrowed
-from flexsat.dynamics.integrators import augmented_derivative_cs
+from flexsat.dynamics.integrators import augmented_derivative
 from flexsat.dynamics.kernels import hub_cs
 from flexsat.dynamics.linalg3 import euler_rate_matrix_cs, load_seg, mv
 from flexsat.dynamics.status import STATUS_NOT_FINITE, STATUS_OK
@@ -112,7 +112,7 @@ def _rates(x, n, t, derivatives, params, flow, Q, k, kc, packed, evaluate=True):
     status = chain_wrench(x, n, t, cs, derivatives, params, flow) if evaluate else 0
     h, w, dot = flow.held, flow.wrench, flow.dot
     torque = (h[0] + w[0], h[1] + w[1], h[2] + w[2])
-    status |= augmented_derivative_cs(cs, x, torque, n, Q, k, packed)
+    status |= augmented_derivative(x, torque, n, Q, k, packed, cs)
     for j in range(dot.shape[0]):
         kc[j] = dot[j]
     return status

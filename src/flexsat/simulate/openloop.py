@@ -19,7 +19,7 @@ from flexsat.dynamics.integrators import (
     augmented_derivative,
     rk4_open_loop,
 )
-from flexsat.dynamics.kernels import STATUS_OK
+from flexsat.dynamics.kernels import STATUS_OK, hub_cs
 from flexsat.dynamics.linalg3 import euler_rate_matrix_inv
 from flexsat.dynamics.plant import Plant
 from flexsat.errors import ConfigError
@@ -299,7 +299,7 @@ def _run_dop853(plant, scenario, q0, qd0, profile):
             nonlocal evaluations, kernel_status
             evaluations += 1
             dy = np.empty_like(y)
-            code = augmented_derivative(y, torque, n, Q, dy, plant.packed)
+            code = augmented_derivative(y, torque, n, Q, dy, plant.packed, hub_cs(y))
             if code != STATUS_OK:  # a joint's singularity: make the step fail here
                 kernel_status = code
                 dy[:] = np.nan
