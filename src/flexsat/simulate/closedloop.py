@@ -394,7 +394,7 @@ def _loop_data(layout: LoopLayout, scenario: SlewScenario, J: np.ndarray,
         return np.ascontiguousarray(values, dtype=float)
 
     # The coupled RK4 step carries each stage's integrated entries (the block ends with
-    # the last stage that integrates any, ActuatorStageConfig.integrated_size).
+    # the last stage that integrates any, StageConfig.integrated_size).
     block = layout.continuous_state
     if layout.continuous:
         last = max(i for i, s in enumerate(layout.actuators) if s.derivative is not None)
