@@ -232,7 +232,7 @@ def rk4_coupled_hold(x, t0, dt, n_steps, derivatives, params, flow, packed):
     x, params, flow, packed = borrowed(x), borrowed(params), borrowed(flow), borrowed(packed)
     n = packed.n_dof
     scratch = np.empty((5, x.shape[0]))
-    Q = np.empty(n)
+    Q = np.zeros(n)  # no joint actuators: Q[6:] is read, never written
     for k in range(n_steps):
         status = rk4_coupled_step(x, t0 + k * dt, dt, n, Q, scratch, derivatives, params, flow,
                                   packed, False)  # fmt: skip
