@@ -16,7 +16,7 @@ SHORT = {"duration_s": 2.0}
 SCENARIOS = [
     SHORT,
     {**SHORT, "controller": {"kind": "pd"}},  # another law: the same loop type
-    {**SHORT, "sensor_stages": [{"kind": "gyro"}]},  # a longer sensing chain: its own group
+    {**SHORT, "sensor_stages": [{"kind": "gyro"}]},  # a longer chain, padded: one loop type
     {**SHORT, "target_euler_deg": [10.0, -20.0, 5.0]},
     # diverges in a few steps: its status and partial records as alone
     {**SHORT, "controller": {"kind": "pd"}, "actuator": {"t_max_nm": 1e7},

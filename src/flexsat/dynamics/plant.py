@@ -27,6 +27,7 @@ from flexsat.dynamics.appendages.contract import (
     OBS_MOMENTUM,
     OBS_SIZE,
     SIGNATURES,
+    AppendageKernels,
 )
 from flexsat.dynamics.appendages.plate import JOINT_DOFS
 from flexsat.dynamics.layout import HUB_DOFS, StateLayout
@@ -133,13 +134,30 @@ class Plant:
         )  # fmt: skip
         return self._with_params(rows)
 
-    def _pack(self) -> PackedPlant:
-        """Group the appendages by model (one kernel call per group) and pack them."""
+    def _groups(self) -> list[list[int]]:
+        """The appendages' indices grouped by model (one kernel call per group)."""
         groups: dict[str, list[int]] = {}
         for i, model in enumerate(self.models):
             groups.setdefault(model.name, []).append(i)
-        members, params, kernel_sets, work = [], [], [], []
-        for indices in groups.values():
+        return list(groups.values())
+
+    def kernel_sets(self) -> tuple[AppendageKernels, ...]:
+        """The compiled kernels of each group of appendages
+        (:meth:`~flexsat.dynamics.appendages.contract.AppendageModel.group_kernels`).
+
+        Returns
+        -------
+        tuple of AppendageKernels
+            One per group, in the order of ``packed``'s groups.
+        """
+        return tuple(self.models[g[0]].group_kernels([self.params[i] for i in g])
+                     for g in self._groups())  # fmt: skip
+
+    def _pack(self) -> PackedPlant:
+        """Group the appendages by model (one kernel call per group) and pack them."""
+        members, params, work = [], [], []
+        kernel_sets = self.kernel_sets()
+        for indices in self._groups():
             offsets = [self.layout.blocks[i].offset for i in indices]
             members.append(np.array([indices, offsets], dtype=np.int64).T.copy())
             # Rows of one model may differ in length (a chain's grows with its segments):
@@ -150,7 +168,6 @@ class Plant:
                 stacked[k, : len(r)] = r
             params.append(stacked)
             model = self.models[indices[0]]
-            kernel_sets.append(model.kernels)
             work.append(np.zeros((len(rows), max(1, *(model.work_columns(r) for r in rows)))))
         hub_J = np.ascontiguousarray(self.hub_J, dtype=float)
         locked = self.locked_coordinates()

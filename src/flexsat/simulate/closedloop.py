@@ -33,6 +33,7 @@ from flexsat.simulate.common import PROGRESS_MIN_STEPS, progress_bar, run_attrib
 from flexsat.simulate.coupled import LoopFlow, rk4_coupled_hold
 from flexsat.simulate.layout import LoopLayout
 from flexsat.simulate.loops import (
+    CHAIN_SLOTS,
     LoopClock,
     LoopData,
     LoopRecords,
@@ -261,13 +262,14 @@ def prepare_slew(plant: Plant, scenario: SlewScenario,
     data = _loop_data(layout, scenario, J, plant)
     # each compiled with its role's signature on first use (flexsat.dynamics.packed)
     stages = LoopStages(
-        tuple(first_class(s.step, SENSOR_SIGNATURE) for s in layout.sensors),
+        _padded(tuple(first_class(s.step, SENSOR_SIGNATURE) for s in layout.sensors)),
         (first_class(law.step, LAW_SIGNATURE),),
-        tuple(first_class(s.step, ACTUATOR_SIGNATURE) for s in layout.actuators),
-        tuple(first_class(s.derivative or no_derivative, DERIVATIVE_SIGNATURE)
-              for s in layout.actuators),
+        _padded(tuple(first_class(s.step, ACTUATOR_SIGNATURE) for s in layout.actuators)),
+        _padded(tuple(first_class(s.derivative or no_derivative, DERIVATIVE_SIGNATURE)
+                      for s in layout.actuators)),
         (first_class(layout.reference.step, REFERENCE_SIGNATURE),),
         (first_class(layout.joint_actuator.step, JOINT_ACTUATOR_SIGNATURE),),
+        len(layout.sensors), len(layout.actuators),
     )  # fmt: skip
     return PreparedSlew(
         plant, scenario, law, layout, J, np.concatenate([q0, qd0, [0.0, 0.0]]),
@@ -325,7 +327,7 @@ def finish_slew(run: PreparedSlew, status: int, done: int, rows: int, wall: floa
     target = target_quaternion(scenario.target_euler_deg)
     attrs["target_quaternion"] = target.tolist()
     # gain (3), environment (3), sloshing ratio and Hz, residual (3), T_max
-    attrs["realised_disturbances"] = data.actuator_params[-1].tolist()
+    attrs["realised_disturbances"] = data.actuator_params[len(layout.actuators) - 1].tolist()
     at = layout.plant  # where each piece of the plant state lives
     ds = build_dataset(
         plant, rec_t, rec_x[:, at.q], rec_x[:, at.qd], rec_x[:, at.work_in],
@@ -382,6 +384,17 @@ def loop_layout(plant: Plant, scenario: SlewScenario) -> LoopLayout:
                       JOINT_ACTUATORS.get(scenario.joint_actuator.kind))  # fmt: skip
 
 
+def _padded(entries: tuple, filler=None) -> tuple:
+    """``entries`` padded to a multiple of :data:`~flexsat.simulate.loops.CHAIN_SLOTS`
+    with ``filler`` (default: the first entry), so every chain of up to that many
+    stages has one numba type and shares one compiled loop; the loop never reads the
+    padding (it runs the chain's own stages, ``LoopStages.n_sensor``, ``n_actuator``).
+    Arrays are padded with an empty array of their type."""
+    if filler is None:
+        filler = entries[0][:0] if isinstance(entries[0], np.ndarray) else entries[0]
+    return entries + (filler,) * (-len(entries) % CHAIN_SLOTS)
+
+
 def _loop_data(layout: LoopLayout, scenario: SlewScenario, J: np.ndarray,
                plant: Plant) -> LoopData:  # fmt: skip
     """The arrays of one run, record-row pieces as views into ``held``."""
@@ -395,7 +408,7 @@ def _loop_data(layout: LoopLayout, scenario: SlewScenario, J: np.ndarray,
 
     # The coupled RK4 step carries each stage's integrated entries (the block ends with
     # the last stage that integrates any, StageConfig.integrated_size).
-    block = layout.continuous_state
+    block, last = layout.continuous_state, -1
     if layout.continuous:
         last = max(i for i, s in enumerate(layout.actuators) if s.derivative is not None)
         size = chain[n_sensors + last].integrated_size()
@@ -412,9 +425,11 @@ def _loop_data(layout: LoopLayout, scenario: SlewScenario, J: np.ndarray,
                      for p in pieces)  # fmt: skip
 
     flow = LoopFlow(
-        state=state[block], eval=evaluation, eval_views=local(evaluation, layout.actuator_states),
-        dot=rate, dot_views=local(rate, layout.actuator_states), k=np.zeros((4, m)),
-        wrench=np.zeros(3), held=np.zeros(3), omega=np.zeros(3),
+        state=state[block], eval=evaluation,
+        eval_views=_padded(local(evaluation, layout.actuator_states), evaluation[:0]),
+        dot=rate, dot_views=_padded(local(rate, layout.actuator_states), rate[:0]),
+        k=np.zeros((4, m)), wrench=np.zeros(3), held=np.zeros(3), omega=np.zeros(3),
+        n_derivative=last + 1,
     )  # fmt: skip
 
     return LoopData(
@@ -424,18 +439,18 @@ def _loop_data(layout: LoopLayout, scenario: SlewScenario, J: np.ndarray,
         omega_dot_d=np.zeros(3),
         law_gains=packed(scenario.controller.gains(scenario.actuator)),
         law_state=state[layout.law_state],
-        sensor_params=tuple(packed(c.packed(scenario)) for c in chain[:n_sensors]),
-        sensor_state=tuple(state[p] for p in layout.sensor_states),
-        actuator_params=tuple(packed(c.packed(scenario)) for c in chain[n_sensors:]),
-        actuator_state=tuple(state[p] for p in layout.actuator_states),
+        sensor_params=_padded(tuple(packed(c.packed(scenario)) for c in chain[:n_sensors])),
+        sensor_state=_padded(tuple(state[p] for p in layout.sensor_states)),
+        actuator_params=_padded(tuple(packed(c.packed(scenario)) for c in chain[n_sensors:])),
+        actuator_state=_padded(tuple(state[p] for p in layout.actuator_states)),
         q_meas=np.zeros(4),
         omega_meas=np.zeros(3),
         held=held,
         tau_cmd=held[layout.tau_cmd],
         tau_applied=held[layout.tau_applied],
         law_diag=held[layout.law_diag],
-        sensor_record=tuple(held[p] for p in layout.sensor_records),
-        actuator_record=tuple(held[p] for p in layout.actuator_records),
+        sensor_record=_padded(tuple(held[p] for p in layout.sensor_records)),
+        actuator_record=_padded(tuple(held[p] for p in layout.actuator_records)),
         tau_between=np.zeros(3),
         flow=flow,
         reference_params=packed(scenario.reference.packed(scenario, plant)),

@@ -37,7 +37,8 @@ class LoopFlow(NamedTuple):
     eval, dot : ndarray, shape (m,)
         The chain's state at an RK4 stage and its rate [per stage, per stage per s].
     eval_views, dot_views : tuple of ndarray
-        Each stage's piece of ``eval`` and ``dot`` [per stage].
+        Each stage's piece of ``eval`` and ``dot`` [per stage] (padded like the
+        chain's tuples, :data:`flexsat.simulate.loops.CHAIN_SLOTS`).
     k : ndarray, shape (4, m)
         The four RK4 rates of the chain's state [per stage per s].
     wrench : ndarray, shape (3,)
@@ -47,6 +48,9 @@ class LoopFlow(NamedTuple):
     omega : ndarray, shape (3,)
         The hub's body rate omega_BN at the RK4 stage, hub frame B, that the
         derivatives read [rad/s].
+    n_derivative : int
+        Derivatives evaluated: the actuation stages up to the last one with a
+        derivative (0 without any) [-].
     """
 
     state: np.ndarray
@@ -58,6 +62,7 @@ class LoopFlow(NamedTuple):
     wrench: np.ndarray
     held: np.ndarray
     omega: np.ndarray
+    n_derivative: int
 
 
 @njit(cache=True, inline="always")
@@ -82,7 +87,8 @@ def chain_wrench(x, n, t, cs, derivatives, params, flow):
     cs : tuple of 6 float
         :func:`~flexsat.dynamics.kernels.hub_cs` of ``x`` [-].
     derivatives : tuple of first-class functions
-        One ``DERIVATIVE_SIGNATURE`` function per actuation stage.
+        One ``DERIVATIVE_SIGNATURE`` function per actuation stage (padded); the first
+        ``flow.n_derivative`` are evaluated.
     params : tuple of ndarray
         Each stage's packed parameters [per stage].
     flow : LoopFlow
@@ -100,7 +106,7 @@ def chain_wrench(x, n, t, cs, derivatives, params, flow):
     S = euler_rate_matrix_cs(cs[0], cs[1], cs[2], cs[3])
     omega[0], omega[1], omega[2] = mv(S, load_seg(x, n + 3))
     status = 0
-    for i in range(len(derivatives)):
+    for i in range(flow.n_derivative):
         status |= derivatives[i](x, n, t, omega, params[i], flow.eval_views[i],
                                  flow.dot_views[i], wrench)  # fmt: skip
     return status
@@ -141,7 +147,8 @@ def rk4_coupled_step(x, t, dt, n, Q, scratch, derivatives, params, flow, packed,
     scratch : ndarray, shape (5, len(x))
         Work array [-].
     derivatives : tuple of first-class functions
-        One ``DERIVATIVE_SIGNATURE`` function per actuation stage.
+        One ``DERIVATIVE_SIGNATURE`` function per actuation stage (padded); the first
+        ``flow.n_derivative`` are evaluated.
     params : tuple of ndarray
         Each stage's packed parameters [per stage].
     flow : LoopFlow
@@ -214,7 +221,8 @@ def rk4_coupled_hold(x, t0, dt, n_steps, derivatives, params, flow, packed):
     n_steps : int
         Number of steps.
     derivatives : tuple of first-class functions
-        One ``DERIVATIVE_SIGNATURE`` function per actuation stage.
+        One ``DERIVATIVE_SIGNATURE`` function per actuation stage (padded); the first
+        ``flow.n_derivative`` are evaluated.
     params : tuple of ndarray
         Each stage's packed parameters [per stage].
     flow : LoopFlow

@@ -3,12 +3,15 @@
 Each control instant runs them in that order; the RK4 plant steps in between (numba).
 
 The stages and the law are numba first-class functions handed over in tuples
-(:class:`LoopStages`), typed by their signatures: the loop is compiled once per
-chain length, cached across processes, and runs any law or stage of those
-signatures, a user's own included. They run every ``control_every`` plant steps and
-their outputs are held in between (zero-order hold). An actuation stage with a
-derivative integrates its states with the plant inside each RK4 step
-(:mod:`flexsat.simulate.coupled`). Nothing is allocated inside the loop.
+(:class:`LoopStages`), typed by their signatures. The chains' tuples are padded to a
+multiple of :data:`CHAIN_SLOTS` entries and the loop runs the active ones only
+(``n_sensor``, ``n_actuator``), so it is compiled once for every chain of up to
+:data:`CHAIN_SLOTS` stages (a longer one adds a specialization), cached across
+processes, and runs any law or stage of those signatures, a user's own included.
+They run every ``control_every`` plant steps and their outputs are held in between
+(zero-order hold). An actuation stage with a derivative integrates its states with
+the plant inside each RK4 step (:mod:`flexsat.simulate.coupled`). Nothing is
+allocated inside the loop.
 
 The hub attitude is re-based between steps (:mod:`flexsat.dynamics.attitude`); once a
 run has switched, the sensing chain reads the plant state relative to the inertial
@@ -32,6 +35,7 @@ from flexsat.dynamics.status import STATUS_CONTROL_FAILED, STATUS_OK
 from flexsat.simulate.coupled import LoopFlow, chain_wrench, rk4_coupled_step
 
 __all__ = [
+    "CHAIN_SLOTS",
     "LoopClock",
     "LoopData",
     "LoopRecords",
@@ -40,6 +44,11 @@ __all__ = [
     "run_actuators",
     "run_sensors",
 ]
+
+
+CHAIN_SLOTS = 4
+"""Entries per block of a chain's padded tuples: every chain of up to this many stages
+shares one compiled loop (the built-in stages make at most 4 per chain)."""
 
 
 class LoopClock(NamedTuple):
@@ -75,28 +84,36 @@ class LoopClock(NamedTuple):
 class LoopStages(NamedTuple):
     """The compiled steps, tuples of first-class functions (chains in order).
 
+    The chains' tuples (and :class:`LoopData`'s per-stage tuples) are padded to a
+    multiple of :data:`CHAIN_SLOTS` entries; the loop calls the first ``n_sensor``
+    and ``n_actuator`` only.
+
     Attributes
     ----------
     sensor : tuple
-        ``SENSOR_SIGNATURE`` functions: the sensing chain.
+        ``SENSOR_SIGNATURE`` functions: the sensing chain, padded.
     law : tuple
         One ``LAW_SIGNATURE`` function.
     actuator : tuple
-        ``ACTUATOR_SIGNATURE`` functions: the actuation chain.
+        ``ACTUATOR_SIGNATURE`` functions: the actuation chain, padded.
     derivative : tuple
-        ``DERIVATIVE_SIGNATURE`` functions, one per actuation stage.
+        ``DERIVATIVE_SIGNATURE`` functions, one per actuation stage, padded.
     reference : tuple
         One ``REFERENCE_SIGNATURE`` function.
     joint_actuator : tuple
         One ``JOINT_ACTUATOR_SIGNATURE`` function.
+    n_sensor, n_actuator : int
+        Stages of the sensing and of the actuation chain.
     """
 
-    sensor: tuple  # (SENSOR_SIGNATURE, ...): the sensing chain
+    sensor: tuple  # (SENSOR_SIGNATURE, ...): the sensing chain, padded
     law: tuple  # (LAW_SIGNATURE,)
-    actuator: tuple  # (ACTUATOR_SIGNATURE, ...): the actuation chain
-    derivative: tuple  # (DERIVATIVE_SIGNATURE, ...): one per actuation stage
+    actuator: tuple  # (ACTUATOR_SIGNATURE, ...): the actuation chain, padded
+    derivative: tuple  # (DERIVATIVE_SIGNATURE, ...): one per actuation stage, padded
     reference: tuple  # (REFERENCE_SIGNATURE,)
     joint_actuator: tuple  # (JOINT_ACTUATOR_SIGNATURE,)
+    n_sensor: int  # stages of the sensing chain
+    n_actuator: int  # stages of the actuation chain
 
 
 class LoopData(NamedTuple):
@@ -119,9 +136,10 @@ class LoopData(NamedTuple):
     law_gains, law_state : ndarray
         The law's packed gains and state [per law].
     sensor_params, sensor_state : tuple of ndarray
-        Each sensing stage's packed parameters and state [per stage].
+        Each sensing stage's packed parameters and state [per stage] (padded with
+        empty arrays like :class:`LoopStages`' chains).
     actuator_params, actuator_state : tuple of ndarray
-        Each actuation stage's packed parameters and state [per stage].
+        Each actuation stage's packed parameters and state [per stage] (padded).
     q_meas : ndarray, shape (4,)
         Measured attitude quaternion, scalar first [-].
     omega_meas : ndarray, shape (3,)
@@ -133,7 +151,7 @@ class LoopData(NamedTuple):
     law_diag : ndarray
         View into ``held``: the law's diagnostics [per channel].
     sensor_record, actuator_record : tuple of ndarray
-        Views into ``held``: each stage's records [per channel].
+        Views into ``held``: each stage's records [per channel] (padded).
     tau_between : ndarray, shape (3,)
         A stage's input inside the actuation chain [N m].
     flow : LoopFlow
@@ -231,7 +249,7 @@ def run_sensors(x, n, t, stages, d):
         0, or the OR of the stages' non-zero statuses.
     """
     status = 0
-    for i in range(len(stages.sensor)):
+    for i in range(stages.n_sensor):
         status |= stages.sensor[i](x, n, t, d.sensor_params[i], d.sensor_state[i], d.q_meas,
                                    d.omega_meas, d.sensor_record[i])  # fmt: skip
     return status
@@ -271,7 +289,7 @@ def run_actuators(x, n, t, control_dt, continuous, stages, d):
         d.tau_cmd, t, control_dt, d.actuator_params[0], d.actuator_state[0], d.tau_applied,
         d.actuator_record[0],
     )  # fmt: skip
-    for i in range(1, len(stages.actuator)):
+    for i in range(1, stages.n_actuator):
         copy_into(d.tau_between, d.tau_applied)
         status |= stages.actuator[i](
             d.tau_between, t, control_dt, d.actuator_params[i], d.actuator_state[i],

@@ -34,7 +34,7 @@ per member its appendage index and the offset of its first coordinate in q;
 from __future__ import annotations
 
 from abc import ABC, abstractmethod
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Any, ClassVar, NamedTuple
 
@@ -213,7 +213,8 @@ class AppendageModel(ABC):
         The validated parameters of one appendage; must have ``name: str`` and
         ``model: Literal["<name>"]``.
     kernels : AppendageKernels
-        The compiled kernels (signatures in this module).
+        The compiled kernels (signatures in this module), right for any group of
+        the model's appendages (:meth:`group_kernels` may pick leaner ones).
     transmits_inertia : bool
         False for a model on a full 6-DOF joint (the engine then skips the 6 x 6
         hub solve); True when ``pass1`` adds an articulated inertia.
@@ -295,6 +296,12 @@ class AppendageModel(ABC):
             f"initial.appendages: {config.name!r} is a {self.name!r} appendage, which has "
             "no initial state to set"
         )
+
+    def group_kernels(self, rows: Sequence[np.ndarray]) -> AppendageKernels:
+        """The kernels one group of this model's appendages runs, from their packed
+        rows (each (p,)). Default: :attr:`kernels`; a model may return a set compiled
+        for what the group needs (the plate without locked joint DOFs)."""
+        return self.kernels
 
     def work_columns(self, params: np.ndarray) -> int:
         """Columns of the scratch row one member with packed row ``params`` needs (a
