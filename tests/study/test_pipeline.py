@@ -134,7 +134,9 @@ def test_each_lane_loads_the_loops_only_its_parts_fly():
     lane = {part.name: part.lane for part in PARTS}
     for fields, parts in runs:
         lanes = {lane[name] for name in parts}
-        if len(lanes) == 1:  # flown by one lane's parts: loaded there, not before the fork
+        if not parts:  # only compiled (the drive's plant): flown by neither
+            assert fields not in shared and all(fields not in r for r in per_lane.values())
+        elif len(lanes) == 1:  # flown by one lane's parts: loaded there, not before the fork
             assert fields in per_lane[lanes.pop()] and fields not in shared
         else:
             assert fields in shared
@@ -142,7 +144,16 @@ def test_each_lane_loads_the_loops_only_its_parts_fly():
     assert None in per_lane[0]  # the solar-array drive: the avionics part's lane
     assert {"controller": {"kind": ctx.laws[0]}} in shared  # the slew's and law comparison's
     one = pipeline._split_runs(runs, lanes=1)
-    assert one == ([fields for fields, _ in runs], {})
+    assert one == ([fields for fields, parts in runs if parts], {})
+
+
+def test_the_compiling_processes_take_the_closed_loop_first():
+    # The first law's slew compiles the closed loop all other slews load from the disk
+    # cache; the two runs after it need none, so the second compiling process is busy
+    # with them meanwhile instead of compiling the closed loop a second time.
+    ctx = pipeline.StudyContext(nominal(), Path("."), quick=True, progress=False)
+    order = [fields for fields, _ in pipeline._compile_runs(ctx)]
+    assert order[:3] == [{"controller": {"kind": ctx.laws[0]}}, "open loop", "drive plant"]
 
 
 def test_the_lanes_fly_their_own_short_runs_before_their_parts(monkeypatch):

@@ -26,7 +26,7 @@ from flexsat.dynamics.plant import Plant
 from flexsat.simulate import SlewScenario, run_slew
 
 __all__ = ["AVIONICS", "DELAYS_S", "QUICK_DELAYS_S", "SADM_DRIVE", "SADM_RATE_DEG_S",
-           "avionics_study", "delayed", "render_avionics", "sadm_study"]
+           "avionics_study", "delayed", "render_avionics", "sadm_plant", "sadm_study"]
 
 AVIONICS = {
     "sensor_stages": [{"kind": "gyro"}, {"kind": "star_tracker"}, {"kind": "mekf"}],
@@ -103,13 +103,32 @@ def sadm_study(plant, duration_s: float | None = None) -> dict:
     return _sadm_summary(*(_sadm_run(driven, fields, duration_s) for fields in runs))
 
 
-def _sadm_runs(plant) -> tuple[Plant, list[dict]]:
-    """The driven satellite and the scenario fields of (c)'s runs, holding then turning."""
-    from flexsat.dynamics.appendages.sadm import DRIVE_COORDINATE, with_sadm
+def sadm_plant(plant: Plant) -> Plant:
+    """The satellite of (c): its plates on the drive :data:`SADM_DRIVE`.
+
+    Parameters
+    ----------
+    plant : Plant
+        The satellite.
+
+    Returns
+    -------
+    Plant
+        The same satellite with each plate on a drive (two-segment chains).
+    """
+    from flexsat.dynamics.appendages.sadm import with_sadm
 
     drive = SADM_DRIVE
-    driven = Plant.from_config(
+    return Plant.from_config(
         with_sadm(plant.config, drive["rotor_inertia_kg_m2"], drive["rotor_mass_kg"]))
+
+
+def _sadm_runs(plant) -> tuple[Plant, list[dict]]:
+    """The driven satellite and the scenario fields of (c)'s runs, holding then turning."""
+    from flexsat.dynamics.appendages.sadm import DRIVE_COORDINATE
+
+    drive = SADM_DRIVE
+    driven = sadm_plant(plant)
     plates = [a for a in plant.config.appendages if isinstance(a, AppendageConfig)]
     inertia = drive["rotor_inertia_kg_m2"] + max(a.centroidal_inertia()[1, 1] for a in plates)
     omega_n = 2.0 * np.pi * drive["frequency_hz"]
