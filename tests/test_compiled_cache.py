@@ -5,8 +5,13 @@ from __future__ import annotations
 import shutil
 from pathlib import Path
 
+import numpy as np
+
 import flexsat
-from flexsat._compiled_cache import COMPILED_MODULES, drop_stale_caches
+from flexsat._compiled_cache import COMPILED_MODULES, drop_stale_caches, kernels_cached
+from flexsat.config import nominal
+from flexsat.dynamics import kernels
+from flexsat.dynamics.plant import Plant
 
 
 def _package_copy(tmp_path: Path) -> Path:
@@ -62,3 +67,14 @@ def test_caches_under_numba_cache_dir_are_dropped_too(tmp_path, monkeypatch):
     laws.write_text(laws.read_text() + "\n# an edit\n")
     assert drop_stale_caches(package)
     assert not cached.exists()
+
+
+def test_kernels_cached_reads_the_folder_numba_caches_the_kernels_in(monkeypatch, tmp_path):
+    # The study compiles in two processes only when this says the cache is empty: it
+    # must look where numba writes (its cache locator's folder), not guess a path.
+    Plant.from_config(nominal()).accelerations(np.zeros(18), np.zeros(18))  # cached now
+    assert kernels_cached()
+    monkeypatch.setattr(kernels.accelerations._cache, "_cache_path", str(tmp_path))
+    assert not kernels_cached()
+    (tmp_path / "kernels.accelerations-152.py312.nbi").write_bytes(b"")
+    assert kernels_cached()

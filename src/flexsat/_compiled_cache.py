@@ -20,7 +20,7 @@ from pathlib import Path
 
 from numba.core.errors import NumbaExperimentalFeatureWarning
 
-__all__ = ["COMPILED_MODULES", "compiled_modules", "drop_stale_caches"]
+__all__ = ["COMPILED_MODULES", "compiled_modules", "drop_stale_caches", "kernels_cached"]
 
 # Pluggable compiled pieces (laws, loop stages, appendage kernels) reach the loops as
 # numba first-class functions, which numba flags as experimental on every use; the
@@ -102,3 +102,22 @@ def drop_stale_caches(package: Path | None = None) -> bool:
     except OSError:
         return False
     return True
+
+
+def kernels_cached() -> bool:
+    """True if numba's disk cache holds the compiled kernels: False on the first run
+    after an install or an upgrade (:func:`drop_stale_caches` drops them all together).
+
+    Looks for the cache index of :mod:`flexsat.dynamics.kernels` in the folder numba's
+    own cache locator chose (beside the sources, ``NUMBA_CACHE_DIR``, or a per-user
+    folder when the sources are read-only); compiles nothing.
+
+    Returns
+    -------
+    bool
+        Whether the kernels' cache index exists.
+    """
+    from flexsat.dynamics import kernels
+
+    cache = Path(kernels.accelerations._cache._cache_path)  # numba has no public getter
+    return any(cache.glob("kernels.*.nbi"))

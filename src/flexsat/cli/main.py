@@ -22,6 +22,7 @@ from rich.markup import escape
 from rich.table import Table
 
 from flexsat import __version__
+from flexsat._compiled_cache import kernels_cached
 from flexsat.errors import MAX_MESSAGE_CHARS, FlexsatError, shorten
 from flexsat.jsonable import jsonable
 
@@ -73,15 +74,8 @@ def _version(value: bool) -> None:
 
 
 def _announce_compilation() -> None:
-    """Say so on stderr when the compiled kernels are not cached yet (first run).
-
-    The folder is the one numba's own cache locator chose: beside the sources,
-    ``NUMBA_CACHE_DIR``, or a per-user folder when the sources are read-only.
-    """
-    from flexsat.dynamics import kernels
-
-    cache = Path(kernels.accelerations._cache._cache_path)  # numba has no public getter
-    if not any(cache.glob("kernels.*.nbi")):
+    """Say so on stderr when the compiled kernels are not cached yet (first run)."""
+    if not kernels_cached():
         _errors.print("compiling the dynamics kernels (first run only, cached on disk)...")
 
 

@@ -21,7 +21,7 @@ from pathlib import Path
 import numpy as np
 
 from flexsat.analysis.requirements import slew_metrics
-from flexsat.config.models import AppendageConfig
+from flexsat.config.models import AppendageConfig, SatelliteConfig
 from flexsat.dynamics.plant import Plant
 from flexsat.simulate import SlewScenario, run_slew
 
@@ -103,12 +103,12 @@ def sadm_study(plant, duration_s: float | None = None) -> dict:
     return _sadm_summary(*(_sadm_run(driven, fields, duration_s) for fields in runs))
 
 
-def sadm_plant(plant: Plant) -> Plant:
+def sadm_plant(config: SatelliteConfig) -> Plant:
     """The satellite of (c): its plates on the drive :data:`SADM_DRIVE`.
 
     Parameters
     ----------
-    plant : Plant
+    config : SatelliteConfig
         The satellite.
 
     Returns
@@ -120,7 +120,7 @@ def sadm_plant(plant: Plant) -> Plant:
 
     drive = SADM_DRIVE
     return Plant.from_config(
-        with_sadm(plant.config, drive["rotor_inertia_kg_m2"], drive["rotor_mass_kg"]))
+        with_sadm(config, drive["rotor_inertia_kg_m2"], drive["rotor_mass_kg"]))
 
 
 def _sadm_runs(plant) -> tuple[Plant, list[dict]]:
@@ -128,7 +128,7 @@ def _sadm_runs(plant) -> tuple[Plant, list[dict]]:
     from flexsat.dynamics.appendages.sadm import DRIVE_COORDINATE
 
     drive = SADM_DRIVE
-    driven = sadm_plant(plant)
+    driven = sadm_plant(plant.config)
     plates = [a for a in plant.config.appendages if isinstance(a, AppendageConfig)]
     inertia = drive["rotor_inertia_kg_m2"] + max(a.centroidal_inertia()[1, 1] for a in plates)
     omega_n = 2.0 * np.pi * drive["frequency_hz"]

@@ -32,6 +32,7 @@ from rich.console import Console
 from rich.markup import escape
 
 from flexsat import __version__
+from flexsat._compiled_cache import kernels_cached
 from flexsat.config.models import SatelliteConfig
 from flexsat.control.laws import LAWS
 from flexsat.parallel import figure_workers, forked_map, frozen_heap
@@ -352,14 +353,6 @@ def run_study(
     return manifest
 
 
-def _cache_was_empty(plant) -> bool:
-    """True if building ``plant`` compiled its appendage kernels instead of loading
-    them from numba's disk cache: the first run after an install (or an upgrade,
-    which drops every cached kernel together, :mod:`flexsat._compiled_cache`)."""
-    return any(sum(kernel.stats.cache_misses.values())
-               for model in plant.models for kernel in model.kernels)  # fmt: skip
-
-
 def _compile_runs(ctx: StudyContext) -> list[tuple[dict | str | None, frozenset[str]]]:
     """The short runs that compile every loop the parts fly, each with the parts that
     fly that loop (their lanes decide which process loads it, :func:`_compile`).
@@ -397,8 +390,8 @@ def _fly_short(ctx: StudyContext, fields: dict | str | None) -> None:
     short = {"duration_s": 0.02, "record_dt_s": 0.01}
     if fields == "open loop":
         run_openloop(ctx.plant, OpenLoopScenario.model_validate(short), progress=False)
-    elif fields == "drive plant":  # building it compiles its kernels
-        sadm_plant(ctx.plant)
+    elif fields == "drive plant":  # building it compiles its kernels (not the plates')
+        sadm_plant(ctx.config)
     elif fields is None:  # the arrays on a drive
         sadm_study(ctx.plant, duration_s=short["duration_s"])
     else:
@@ -426,10 +419,11 @@ def _compile(ctx: StudyContext, console: Console, lanes: int = 1) -> tuple[float
     hybrid damping and the solar-array drive; the parts' wall times then exclude
     compilation, which the manifest gives apart (``compilation_s``), and the forked
     processes the parts fly their runs in inherit the compiled loops instead of each
-    compiling them. When building the plant compiled its kernels
-    (:func:`_cache_was_empty`), two forked processes first compile the runs into the
-    disk cache side by side, the longest first, and this process then loads them
-    from it.
+    compiling them. When the disk cache holds no kernels yet
+    (:func:`flexsat._compiled_cache.kernels_cached`), two forked processes first
+    compile the runs into it side by side, in the order of :func:`_compile_runs`,
+    each building the plant it needs (the first one the study's: this process has
+    built none yet), and this process then loads them from it.
 
     With two lanes, this process loads only the loops that parts of both lanes fly;
     a loop that only one lane's parts fly is loaded by that lane before its first
@@ -458,7 +452,7 @@ def _compile(ctx: StudyContext, console: Console, lanes: int = 1) -> tuple[float
     try:
         runs = _compile_runs(ctx)
         shared, per_lane = _split_runs(runs, lanes)
-        if _cache_was_empty(ctx.plant):  # each process compiles its share into the cache
+        if not kernels_cached():  # each process compiles its share into the cache
             forked_map(lambda fields: _fly_short(ctx, fields), [fields for fields, _ in runs])
     except Exception:  # the part that needs it reports the problem
         pass
