@@ -150,10 +150,11 @@ def test_each_lane_loads_the_loops_only_its_parts_fly():
 def test_the_compiling_processes_take_the_closed_loop_first():
     # The first law's slew compiles the closed loop all other slews load from the disk
     # cache; the two runs after it need none, so the second compiling process is busy
-    # with them meanwhile instead of compiling the closed loop a second time.
+    # with them meanwhile instead of compiling the closed loop a second time (the
+    # drive's plant first: it needs no plate kernels, which the first process compiles).
     ctx = pipeline.StudyContext(nominal(), Path("."), quick=True, progress=False)
     order = [fields for fields, _ in pipeline._compile_runs(ctx)]
-    assert order[:3] == [{"controller": {"kind": ctx.laws[0]}}, "open loop", "drive plant"]
+    assert order[:3] == [{"controller": {"kind": ctx.laws[0]}}, "drive plant", "open loop"]
 
 
 def test_the_lanes_fly_their_own_short_runs_before_their_parts(monkeypatch):

@@ -358,14 +358,17 @@ def _compile_runs(ctx: StudyContext) -> list[tuple[dict | str | None, frozenset[
     fly that loop (their lanes decide which process loads it, :func:`_compile`).
 
     In the order two compiling processes take them (:func:`_compile`): the first law's
-    slew, which compiles the closed loop every other slew shares (one numba type for
-    every stage chain of up to four stages, :data:`flexsat.simulate.loops.CHAIN_SLOTS`),
-    then what needs no closed loop: the open loop and the drive's plant (its chain
-    kernels; no part flies it here, so its parts are empty). The runs after them load
-    the closed loop from the disk cache and compile only their own stages: the delay,
-    the avionics chain, the solar arrays on a drive, the hybrid damping and the other
-    laws. Measured on an empty cache (a quiet machine): the first law's slew 20-24 s,
-    the open loop 15 s, the drive's plant 14-17 s, the avionics chain's stages 7 s.
+    slew, which builds the study's plant (its plates' kernels) and compiles the closed
+    loop every other slew shares (one numba type for every stage chain of up to four
+    stages, :data:`flexsat.simulate.loops.CHAIN_SLOTS`); meanwhile the other process
+    builds the drive's plant (its chain kernels, from the config alone; no part flies
+    it here, so its parts are empty), then flies the open loop (which needs no closed
+    loop), loading the plates' kernels the first process has cached by then. The runs
+    after them load the closed loop from the disk cache and compile only their own
+    stages: the delay, the avionics chain, the solar arrays on a drive, the hybrid
+    damping and the other laws. Measured on an empty cache: the plates' kernels
+    10-12 s, the first law's slew 25-35 s more, the drive's plant 14-17 s, the open
+    loop 15-20 s, the avionics chain's stages 7 s.
     A run is the fields of a :class:`flexsat.simulate.SlewScenario`, ``"open loop"``,
     ``"drive plant"`` or None: the solar arrays on a drive
     (:func:`flexsat.study.avionics.sadm_study`).
@@ -376,8 +379,8 @@ def _compile_runs(ctx: StudyContext) -> list[tuple[dict | str | None, frozenset[
     laws = [{"controller": {"kind": kind}} for kind in ctx.laws]
     every_law = frozenset({"slew", "comparison", "laws"})
     avionics = frozenset({"avionics"})
-    return [(laws[0], every_law), ("open loop", frozenset({"openloop"})),
-            ("drive plant", frozenset()), (delayed(1), avionics), (AVIONICS, avionics),
+    return [(laws[0], every_law), ("drive plant", frozenset()),
+            ("open loop", frozenset({"openloop"})), (delayed(1), avionics), (AVIONICS, avionics),
             (None, avionics), ({"joint_actuator": HYBRID_DAMPING}, frozenset({"laws"})),
             *((law, every_law) for law in laws[1:])]  # fmt: skip
 
