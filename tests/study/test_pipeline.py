@@ -148,13 +148,14 @@ def test_each_lane_loads_the_loops_only_its_parts_fly():
 
 
 def test_the_compiling_processes_take_the_closed_loop_first():
-    # The first law's slew compiles the closed loop all other slews load from the disk
-    # cache; the two runs after it need none, so the second compiling process is busy
-    # with them meanwhile instead of compiling the closed loop a second time (the
-    # drive's plant first: it needs no plate kernels, which the first process compiles).
+    # The first law's slew builds the plant and compiles the closed loop all other
+    # slews load from the disk cache; the runs after it need no closed loop, so the
+    # second compiling process is busy with them meanwhile instead of compiling it a
+    # second time (the stages first: they need no plate kernels either).
     ctx = pipeline.StudyContext(nominal(), Path("."), quick=True, progress=False)
     order = [fields for fields, _ in pipeline._compile_runs(ctx)]
-    assert order[:3] == [{"controller": {"kind": ctx.laws[0]}}, "drive plant", "open loop"]
+    assert order[:4] == [{"controller": {"kind": ctx.laws[0]}}, "stages", "open loop",
+                         "drive plant"]  # fmt: skip
 
 
 def test_the_lanes_fly_their_own_short_runs_before_their_parts(monkeypatch):
@@ -180,3 +181,15 @@ def test_the_lanes_fly_their_own_short_runs_before_their_parts(monkeypatch):
     assert recorded["first"]["outputs"]["flown"] == [(os.getpid(), 0.01)]
     (pid, seconds), = recorded["second"]["outputs"]["flown"]
     assert pid != os.getpid() and seconds == 0.3
+
+
+def test_the_stages_run_compiles_every_other_slews_stages_without_a_plant():
+    # It runs beside the plant's compilation: it must not build the plant, and it must
+    # reach every stage kind the other runs fly (the drive's joint actuator included).
+    from flexsat.control.stages import JOINT_ACTUATORS
+
+    ctx = pipeline.StudyContext(nominal(), Path("."), quick=True, progress=False)
+    drive = JOINT_ACTUATORS.get("sadm_drive").step
+    pipeline._fly_short(ctx, "stages")
+    assert "plant" not in ctx.results
+    assert drive.signatures  # compiled (or loaded from the disk cache) by this process

@@ -53,6 +53,7 @@ __all__ = [
     "design_inertia",
     "finish_slew",
     "loop_layout",
+    "loop_stages",
     "prepare_slew",
     "run_slew",
     "slew_design_inertia",
@@ -260,17 +261,7 @@ def prepare_slew(plant: Plant, scenario: SlewScenario,
     q0, qd0 = initial_state(plant, scenario)
     n_records = scenario.n_steps // scenario.record_every + 2  # + the last good state
     data = _loop_data(layout, scenario, J, plant)
-    # each compiled with its role's signature on first use (flexsat.dynamics.packed)
-    stages = LoopStages(
-        _padded(tuple(first_class(s.step, SENSOR_SIGNATURE) for s in layout.sensors)),
-        (first_class(law.step, LAW_SIGNATURE),),
-        _padded(tuple(first_class(s.step, ACTUATOR_SIGNATURE) for s in layout.actuators)),
-        _padded(tuple(first_class(s.derivative or no_derivative, DERIVATIVE_SIGNATURE)
-                      for s in layout.actuators)),
-        (first_class(layout.reference.step, REFERENCE_SIGNATURE),),
-        (first_class(layout.joint_actuator.step, JOINT_ACTUATOR_SIGNATURE),),
-        len(layout.sensors), len(layout.actuators),
-    )  # fmt: skip
+    stages = loop_stages(scenario)
     return PreparedSlew(
         plant, scenario, law, layout, J, np.concatenate([q0, qd0, [0.0, 0.0]]),
         identity_frame(),  # attitude reference R_NF (flexsat.dynamics.attitude)
@@ -359,6 +350,17 @@ def finish_slew(run: PreparedSlew, status: int, done: int, rows: int, wall: floa
 
 
 
+def _specs(scenario: SlewScenario) -> tuple:
+    """The registered law, sensing and actuation stages, reference and joint actuator."""
+    chain = scenario.stage_chain()
+    n_sensors = 1 + len(scenario.sensor_stages)
+    sensors = tuple(SENSORS.get(c.kind) for _, c in chain[:n_sensors])
+    actuators = tuple(ACTUATORS.get(c.kind) for _, c in chain[n_sensors:])
+    return (get_law(scenario.controller.kind), sensors, actuators,
+            REFERENCES.get(scenario.reference.kind),
+            JOINT_ACTUATORS.get(scenario.joint_actuator.kind))  # fmt: skip
+
+
 def loop_layout(plant: Plant, scenario: SlewScenario) -> LoopLayout:
     """Where a slew's states and records live: its law, its two stage chains, its
     reference generator and its joint actuator.
@@ -375,13 +377,37 @@ def loop_layout(plant: Plant, scenario: SlewScenario) -> LoopLayout:
     LoopLayout
         The offsets of the plant state, control state and record row.
     """
-    chain = scenario.stage_chain()
-    n_sensors = 1 + len(scenario.sensor_stages)
-    sensors = tuple(SENSORS.get(c.kind) for _, c in chain[:n_sensors])
-    actuators = tuple(ACTUATORS.get(c.kind) for _, c in chain[n_sensors:])
-    return LoopLayout(plant.layout, get_law(scenario.controller.kind), sensors, actuators,
-                      REFERENCES.get(scenario.reference.kind),
-                      JOINT_ACTUATORS.get(scenario.joint_actuator.kind))  # fmt: skip
+    return LoopLayout(plant.layout, *_specs(scenario))
+
+
+def loop_stages(scenario: SlewScenario) -> LoopStages:
+    """The compiled law and stages of a slew, as the loop takes them.
+
+    Each is compiled with its role's signature on first use and cached on disk
+    (:func:`flexsat.dynamics.packed.first_class`); no plant is needed. The chains are
+    padded to a multiple of :data:`~flexsat.simulate.loops.CHAIN_SLOTS` entries.
+
+    Parameters
+    ----------
+    scenario : SlewScenario
+        The slew (its law and stages, by kind).
+
+    Returns
+    -------
+    LoopStages
+        The first-class functions and the chains' lengths.
+    """
+    law, sensors, actuators, reference, joint_actuator = _specs(scenario)
+    return LoopStages(
+        _padded(tuple(first_class(s.step, SENSOR_SIGNATURE) for s in sensors)),
+        (first_class(law.step, LAW_SIGNATURE),),
+        _padded(tuple(first_class(s.step, ACTUATOR_SIGNATURE) for s in actuators)),
+        _padded(tuple(first_class(s.derivative or no_derivative, DERIVATIVE_SIGNATURE)
+                      for s in actuators)),
+        (first_class(reference.step, REFERENCE_SIGNATURE),),
+        (first_class(joint_actuator.step, JOINT_ACTUATOR_SIGNATURE),),
+        len(sensors), len(actuators),
+    )  # fmt: skip
 
 
 def _padded(entries: tuple, filler=None) -> tuple:

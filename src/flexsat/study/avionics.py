@@ -26,7 +26,8 @@ from flexsat.dynamics.plant import Plant
 from flexsat.simulate import SlewScenario, run_slew
 
 __all__ = ["AVIONICS", "DELAYS_S", "QUICK_DELAYS_S", "SADM_DRIVE", "SADM_RATE_DEG_S",
-           "avionics_study", "delayed", "render_avionics", "sadm_plant", "sadm_study"]
+           "avionics_study", "delayed", "render_avionics", "sadm_plant", "sadm_runs",
+           "sadm_study"]
 
 AVIONICS = {
     "sensor_stages": [{"kind": "gyro"}, {"kind": "star_tracker"}, {"kind": "mekf"}],
@@ -123,13 +124,24 @@ def sadm_plant(config: SatelliteConfig) -> Plant:
         with_sadm(config, drive["rotor_inertia_kg_m2"], drive["rotor_mass_kg"]))
 
 
-def _sadm_runs(plant) -> tuple[Plant, list[dict]]:
-    """The driven satellite and the scenario fields of (c)'s runs, holding then turning."""
+def sadm_runs(config: SatelliteConfig) -> list[dict]:
+    """The slew scenario fields of (c)'s runs on :func:`sadm_plant`, holding then turning.
+
+    Parameters
+    ----------
+    config : SatelliteConfig
+        The satellite (its plates size the drive's loop).
+
+    Returns
+    -------
+    list of dict
+        The fields of the holding run (rate 0) and of the turning run
+        (:data:`SADM_RATE_DEG_S`) [-].
+    """
     from flexsat.dynamics.appendages.sadm import DRIVE_COORDINATE
 
     drive = SADM_DRIVE
-    driven = sadm_plant(plant.config)
-    plates = [a for a in plant.config.appendages if isinstance(a, AppendageConfig)]
+    plates = [a for a in config.appendages if isinstance(a, AppendageConfig)]
     inertia = drive["rotor_inertia_kg_m2"] + max(a.centroidal_inertia()[1, 1] for a in plates)
     omega_n = 2.0 * np.pi * drive["frequency_hz"]
     runs = []
@@ -138,7 +150,12 @@ def _sadm_runs(plant) -> tuple[Plant, list[dict]]:
                  "stiffness_nm_rad": inertia * omega_n**2,
                  "damping_nms_rad": 2.0 * drive["damping_ratio"] * omega_n * inertia}  # fmt: skip
         runs.append({"joint_actuator": joint})
-    return driven, runs
+    return runs
+
+
+def _sadm_runs(plant) -> tuple[Plant, list[dict]]:
+    """The driven satellite and the scenario fields of (c)'s runs, holding then turning."""
+    return sadm_plant(plant.config), sadm_runs(plant.config)
 
 
 def _sadm_run(driven, fields: dict, duration_s: float | None) -> dict:

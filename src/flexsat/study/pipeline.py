@@ -360,17 +360,18 @@ def _compile_runs(ctx: StudyContext) -> list[tuple[dict | str | None, frozenset[
     In the order two compiling processes take them (:func:`_compile`): the first law's
     slew, which builds the study's plant (its plates' kernels) and compiles the closed
     loop every other slew shares (one numba type for every stage chain of up to four
-    stages, :data:`flexsat.simulate.loops.CHAIN_SLOTS`); meanwhile the other process
-    builds the drive's plant (its chain kernels, from the config alone; no part flies
-    it here, so its parts are empty), then flies the open loop (which needs no closed
-    loop), loading the plates' kernels the first process has cached by then. The runs
-    after them load the closed loop from the disk cache and compile only their own
-    stages: the delay, the avionics chain, the solar arrays on a drive, the hybrid
-    damping and the other laws. Measured on an empty cache: the plates' kernels
-    10-12 s, the first law's slew 25-35 s more, the drive's plant 14-17 s, the open
-    loop 15-20 s, the avionics chain's stages 7 s.
-    A run is the fields of a :class:`flexsat.simulate.SlewScenario`, ``"open loop"``,
-    ``"drive plant"`` or None: the solar arrays on a drive
+    stages, :data:`flexsat.simulate.loops.CHAIN_SLOTS`). Meanwhile the other process
+    compiles what needs neither: ``"stages"``, the laws and stages of the other runs
+    (they need no plant), then the open loop and the drive's plant (its chain
+    kernels), loading the plates' kernels the first process has cached by then; no
+    part flies these two, so their parts are empty. The runs after them load what
+    they fly from the disk cache: the delay, the avionics chain, the solar arrays on
+    a drive, the hybrid damping and the other laws. Measured on an empty cache: the
+    plates' kernels 8-12 s, the first law's slew 25-35 s more, the other runs' stages
+    about 10 s, the open loop 10-15 s, the drive's plant 14-17 s.
+
+    A run is the fields of a :class:`flexsat.simulate.SlewScenario`, ``"stages"``,
+    ``"open loop"``, ``"drive plant"`` or None: the solar arrays on a drive
     (:func:`flexsat.study.avionics.sadm_study`).
     """
     from flexsat.study.avionics import AVIONICS, delayed
@@ -379,19 +380,25 @@ def _compile_runs(ctx: StudyContext) -> list[tuple[dict | str | None, frozenset[
     laws = [{"controller": {"kind": kind}} for kind in ctx.laws]
     every_law = frozenset({"slew", "comparison", "laws"})
     avionics = frozenset({"avionics"})
-    return [(laws[0], every_law), ("drive plant", frozenset()),
-            ("open loop", frozenset({"openloop"})), (delayed(1), avionics), (AVIONICS, avionics),
-            (None, avionics), ({"joint_actuator": HYBRID_DAMPING}, frozenset({"laws"})),
+    return [(laws[0], every_law), ("stages", frozenset()),
+            ("open loop", frozenset({"openloop"})), ("drive plant", frozenset()),
+            (delayed(1), avionics), (AVIONICS, avionics), (None, avionics),
+            ({"joint_actuator": HYBRID_DAMPING}, frozenset({"laws"})),
             *((law, every_law) for law in laws[1:])]  # fmt: skip
 
 
 def _fly_short(ctx: StudyContext, fields: dict | str | None) -> None:
     """Fly one run of :func:`_compile_runs` for 20 ms (it compiles or loads its loop)."""
     from flexsat.simulate import OpenLoopScenario, SlewScenario, run_openloop, run_slew
-    from flexsat.study.avionics import sadm_plant, sadm_study
+    from flexsat.simulate.closedloop import loop_stages
+    from flexsat.study.avionics import sadm_plant, sadm_runs, sadm_study
 
     short = {"duration_s": 0.02, "record_dt_s": 0.01}
-    if fields == "open loop":
+    if fields == "stages":  # the other slews' laws and stages: no plant needed
+        slews = [f for f, _ in _compile_runs(ctx)[1:] if isinstance(f, dict)]
+        for each in slews + sadm_runs(ctx.config):
+            loop_stages(SlewScenario.model_validate({**short, **each}))
+    elif fields == "open loop":
         run_openloop(ctx.plant, OpenLoopScenario.model_validate(short), progress=False)
     elif fields == "drive plant":  # building it compiles its kernels (not the plates')
         sadm_plant(ctx.config)
