@@ -154,8 +154,8 @@ def test_the_compiling_processes_take_the_closed_loop_first():
     # second time (the stages first: they need no plate kernels either).
     ctx = pipeline.StudyContext(nominal(), Path("."), quick=True, progress=False)
     order = [fields for fields, _ in pipeline._compile_runs(ctx)]
-    assert order[:4] == [{"controller": {"kind": ctx.laws[0]}}, "stages", "open loop",
-                         "drive plant"]  # fmt: skip
+    assert order[:4] == [{"controller": {"kind": ctx.laws[0]}}, "stages", "drive plant",
+                         "open loop"]  # fmt: skip
 
 
 def test_the_lanes_fly_their_own_short_runs_before_their_parts(monkeypatch):

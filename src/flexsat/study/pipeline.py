@@ -362,9 +362,9 @@ def _compile_runs(ctx: StudyContext) -> list[tuple[dict | str | None, frozenset[
     loop every other slew shares (one numba type for every stage chain of up to four
     stages, :data:`flexsat.simulate.loops.CHAIN_SLOTS`). Meanwhile the other process
     compiles what needs neither: ``"stages"``, the laws and stages of the other runs
-    (they need no plant), then the open loop and the drive's plant (its chain
-    kernels), loading the plates' kernels the first process has cached by then; no
-    part flies these two, so their parts are empty. The runs after them load what
+    (they need no plant), then the drive's plant (its chain kernels; its plates are
+    tuned on the plates' kernels, which the first process has cached by then) and the
+    open loop. No part flies the first two here, so their parts are empty. The runs after them load what
     they fly from the disk cache: the delay, the avionics chain, the solar arrays on
     a drive, the hybrid damping and the other laws. Measured on an empty cache: the
     plates' kernels 8-12 s, the first law's slew 25-35 s more, the other runs' stages
@@ -380,8 +380,8 @@ def _compile_runs(ctx: StudyContext) -> list[tuple[dict | str | None, frozenset[
     laws = [{"controller": {"kind": kind}} for kind in ctx.laws]
     every_law = frozenset({"slew", "comparison", "laws"})
     avionics = frozenset({"avionics"})
-    return [(laws[0], every_law), ("stages", frozenset()),
-            ("open loop", frozenset({"openloop"})), ("drive plant", frozenset()),
+    return [(laws[0], every_law), ("stages", frozenset()), ("drive plant", frozenset()),
+            ("open loop", frozenset({"openloop"})),
             (delayed(1), avionics), (AVIONICS, avionics), (None, avionics),
             ({"joint_actuator": HYBRID_DAMPING}, frozenset({"laws"})),
             *((law, every_law) for law in laws[1:])]  # fmt: skip
