@@ -90,7 +90,8 @@ def main(argv: list[str] | None = None) -> dict[str, float]:
     data.flow.held[:] = (0.1, -0.2, 0.05)
     data.flow.state[:4] = (0.3, -0.2, 0.1, 0.05)
     scratch, Q, torque = np.empty((5, x0.shape[0])), np.zeros(n), (0.1, -0.2, 0.05)
-    idle = (first_class(no_derivative, DERIVATIVE_SIGNATURE),)
+    # padded like the loop's chain (flexsat.simulate.loops.CHAIN_SLOTS): the same type
+    idle = (first_class(no_derivative, DERIVATIVE_SIGNATURE),) * len(stages.derivative)
     params = data.actuator_params
     ns = {
         "RK4 plant step (ideal loop)": _best(
