@@ -362,13 +362,14 @@ def _compile_runs(ctx: StudyContext) -> list[tuple[dict | str | None, frozenset[
     loop every other slew shares (one numba type for every stage chain of up to four
     stages, :data:`flexsat.simulate.loops.CHAIN_SLOTS`). Meanwhile the other process
     compiles what needs neither: ``"stages"``, the laws and stages of the other runs
-    (they need no plant), then the drive's plant (its chain kernels; its plates are
-    tuned on the plates' kernels, which the first process has cached by then) and the
-    open loop. No part flies the first two here, so their parts are empty. The runs after them load what
-    they fly from the disk cache: the delay, the avionics chain, the solar arrays on
-    a drive, the hybrid damping and the other laws. Measured on an empty cache: the
-    plates' kernels 8-12 s, the first law's slew 25-35 s more, the other runs' stages
-    about 10 s, the open loop 10-15 s, the drive's plant 14-17 s.
+    (they need no plant), then ``"drive plant"`` (its chain kernels; its plates are
+    tuned on the plates' kernels, which the first process has cached by then), then
+    the open loop. No part flies ``"stages"`` or ``"drive plant"``: their parts are
+    empty. The runs after them load what they fly from the disk cache: the delay, the
+    avionics chain, the solar arrays on a drive, the hybrid damping and the other
+    laws. Measured on an empty cache: the plates' kernels 8-12 s, the first law's
+    slew 25-35 s more, the other runs' stages about 10 s, the open loop 10-15 s, the
+    drive's plant 14-17 s.
 
     A run is the fields of a :class:`flexsat.simulate.SlewScenario`, ``"stages"``,
     ``"open loop"``, ``"drive plant"`` or None: the solar arrays on a drive

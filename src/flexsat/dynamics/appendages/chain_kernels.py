@@ -485,29 +485,37 @@ def pass1(q, qd, Q, members, params, work, hub, qdd):
                     y += w[b + W_DI + 6 * a + e] * w[b + W_TAU + e]
                 for r in range(6):
                     w[b + W_PA + r] += w[b + W_U + 6 * a + r] * y
-            for r in range(6):
-                # row r of U D^-1 (D^-1 symmetric), then I^A[r, :] -= (U D^-1)[r, :] U^T
-                for e in range(nf):
-                    v = 0.0
-                    for a in range(nf):
-                        v += w[b + W_U + 6 * a + r] * w[b + W_DI + 6 * a + e]
-                    if v != 0.0:
-                        for s in range(6):
-                            w[b + W_IA + 6 * r + s] -= v * w[b + W_U + 6 * e + s]
-            ia_n, ia_f = _mul6(w, b + W_IA, load_seg(w, b + W_CA), load_seg(w, b + W_CA + 3))
-            for r in range(3):
-                w[b + W_PA + r] += ia_n[r]
-                w[b + W_PA + 3 + r] += ia_f[r]
+            # A joint free in all six directions (S square, invertible) hands its parent
+            # no inertia: I^a = I^A - I^A S (S^T I^A S)^-1 S^T I^A = 0, and p^a = S^-T tau
+            # (the sum above). Only a joint with fewer DOFs transmits I^a.
+            transmits = nf < 6
+            if transmits:
+                for r in range(6):
+                    # row r of U D^-1 (D^-1 symmetric), then I^A[r, :] -= (U D^-1)[r, :] U^T
+                    for e in range(nf):
+                        v = 0.0
+                        for a in range(nf):
+                            v += w[b + W_U + 6 * a + r] * w[b + W_DI + 6 * a + e]
+                        if v != 0.0:
+                            for s in range(6):
+                                w[b + W_IA + 6 * r + s] -= v * w[b + W_U + 6 * e + s]
+                ia_n, ia_f = _mul6(w, b + W_IA, load_seg(w, b + W_CA),
+                                   load_seg(w, b + W_CA + 3))  # fmt: skip
+                for r in range(3):
+                    w[b + W_PA + r] += ia_n[r]
+                    w[b + W_PA + 3 + r] += ia_f[r]
             R, pos = _pose_of(w, b)
             pn, pf = _xft(R, pos, load_seg(w, b + W_PA), load_seg(w, b + W_PA + 3))
             if k > 0:
                 up = b - WSEG
-                _add_congruence(w, b + W_IA, R, pos, w, up + W_IA, 0)
+                if transmits:
+                    _add_congruence(w, b + W_IA, R, pos, w, up + W_IA, 0)
                 for r in range(3):
                     w[up + W_PA + r] += pn[r]
                     w[up + W_PA + 3 + r] += pf[r]
             else:
-                _add_congruence(w, b + W_IA, R, pos, hub, HUB_INERTIA, 3)
+                if transmits:
+                    _add_congruence(w, b + W_IA, R, pos, hub, HUB_INERTIA, 3)
                 for r in range(3):
                     hub[HUB_FORCE + r] -= pf[r]
                     hub[HUB_TORQUE + r] -= pn[r]
