@@ -99,7 +99,7 @@ def compare_reduction(
     out : path
         Stores go to ``out/full/<name>`` and ``out/reduced/<name>`` (resumed if there).
     reduced : Reduced, optional
-        Default: the root translations locked, 10 ms step and control period.
+        Default: the root translations locked, 20 ms step and control period.
     workers : int or None
         Worker processes of each campaign (None: one per core).
 
