@@ -4,7 +4,7 @@ Goal (issue 18, campaigns at scale): 1000 random Monte Carlo cases of the 120 s 
 slew in <= 30 s on 2 cores with the reduced model, so <= 0.06 CPU-s per case. Runs
 cases of ``montecarlo-random`` through :func:`flexsat.campaigns.runner.run_case` in
 this process (after one warm-up case), the full model (1 ms, controller every step)
-and the reduced one (root translations locked, 10 ms step and control period)
+and the reduced one (root translations locked, 20 ms step and control period)
 interleaved case by case, and prints the median CPU time (``time.process_time``) per
 case of each part: the compiled loop, the derived records (compiled), the rest of the
 result dataset (xarray, attitude conversions), the metrics, the decimated history and

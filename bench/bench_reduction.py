@@ -2,7 +2,7 @@
 
 Flies sensitivity, montecarlo-critical and deployment-shock (120 s slews) on the full
 model (1 ms, controller every step) and on the reduced one (root translations locked,
-10 ms step and control period), and prints, metric by metric, the verdicts changed
+20 ms step and control period), and prints, metric by metric, the verdicts changed
 and the largest differences (:func:`flexsat.campaigns.reduction.reduction_table`),
 for the slews from rest and for the deployment shock apart, with the wall times.
 

@@ -2,7 +2,7 @@
 local pool and Dask, 1 and 2 workers, against the goal.
 
 Goal (campaigns at scale): 1000 random Monte Carlo cases of the 120 s thesis slew in
-<= 30 s on 2 cores with the reduced model (root translations locked, 10 ms step and
+<= 30 s on 2 cores with the reduced model (root translations locked, 20 ms step and
 control period), the full model (1 ms) beside it; >= 90 % parallel efficiency from 1
 to 2 workers, local and Dask. Each configuration runs the same cases into a fresh
 temporary store; the wall time includes starting the workers. Backends: ``local``
