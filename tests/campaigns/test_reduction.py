@@ -23,9 +23,9 @@ def _short(name: str, duration: float) -> CampaignDefinition:
 def reduction(tmp_path_factory):
     """All 69 thesis cases over the first 6 s of the slew (the torque-saturated phase,
     where the panels are excited most), full model at 1 ms against root translations
-    locked at 20 ms (step and control period); bench/bench_reduction.py runs the full 120 s. Two tables: the
-    slews from rest (sensitivity, montecarlo-critical: 37 cases) and the deployment
-    shock (32 cases, panels released deformed)."""
+    locked at 20 ms (step and control period); bench/bench_reduction.py runs the full
+    120 s. Two tables: the slews from rest (sensitivity, montecarlo-critical: 37 cases)
+    and the deployment shock (32 cases, panels released deformed)."""
     out = tmp_path_factory.mktemp("reduction")
     tables = {}
     for key, names in {"rest": THESIS[:2], "shock": THESIS[2:]}.items():

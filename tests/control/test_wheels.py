@@ -112,7 +112,7 @@ def test_the_coupled_step_carries_the_integrated_entries_only(nominal_plant, pre
     # stage's 20 entries (sized for six wheels) ride in the RK4 stages.
     scenario = SlewScenario.model_validate({"actuator": {"kind": "wheels", "preset": preset}})
     flow = prepare_slew(nominal_plant, scenario).data.flow
-    assert flow.state.shape == flow.eval.shape == flow.k[0].shape == (3 * wheels + 2,)
+    assert flow.state.shape == flow.eval.shape == flow.rates.shape == (3 * wheels + 2,)
     assert WheelsConfig(preset=preset).integrated_size() == 3 * wheels + 2
 
 

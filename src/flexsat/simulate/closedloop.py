@@ -454,7 +454,7 @@ def _loop_data(layout: LoopLayout, scenario: SlewScenario, J: np.ndarray,
         state=state[block], eval=evaluation,
         eval_views=_padded(local(evaluation, layout.actuator_states), evaluation[:0]),
         dot=rate, dot_views=_padded(local(rate, layout.actuator_states), rate[:0]),
-        k=np.zeros((4, m)), wrench=np.zeros(3), held=np.zeros(3), omega=np.zeros(3),
+        rates=np.zeros(m), wrench=np.zeros(3), held=np.zeros(3), omega=np.zeros(3),
         n_derivative=last + 1,
     )  # fmt: skip
 
