@@ -95,7 +95,10 @@ P_K = 34  # (6) joint stiffness per DOF [N/m, N m/rad] (eq. 2.14)
 P_C = 40  # (6) joint damping per DOF [N s/m, N m s/rad] (eq. 2.15)
 P_TIP = 46  # (3) panel tip (mid-chord of the free edge), panel frame [m]
 P_LOCKED = 49  # (6) 1.0 where the joint DOF is locked (``locked_dofs``), else 0.0
-N_PARAMS = 55
+P_IP = 55  # (9) I_P, panel inertia about the root, panel frame [kg m^2]
+P_IP_INV = 64  # (9) its inverse
+P_M_ROOT = 73  # (9) M_P = m 1 + m^2 [d]x I_P^-1 [d]x, the effective mass at the root [kg]
+N_PARAMS = 82
 
 MIN_COS = 1e-9  # |cos(rho_y)| below this is treated as gimbal lock
 
@@ -251,42 +254,96 @@ def _inverse3(a):
     return transpose((scale(f, c0), scale(f, c1), scale(f, c2)))
 
 
-@njit(cache=True, error_model="numpy")
-def _rotations_solve(w, hub, m, R_MB, J_t, G, S_rho, J_p, R_BP, u_a, Xu):
-    """The free-rows solve of :func:`_locked_pass1` for root translations locked, in
-    3 x 3 blocks: F = the rotations, D = Mz_33, K_F = [K_30 | K_33].
+# Scratch of a plate on a spherical joint (root translations locked, rotations free),
+# after the pass-1 rows above: what pass 2 reads.
+W_SPH_R_P = W_MZ  # (3) r_P, the root, frame B [m]
+W_SPH_B_P = W_MZ + 3  # (3) omega_B x (omega_B x r_P): the root's acceleration at A_hub = 0, B
+W_SPH_H = W_MZ + 6  # (3) N_P - omega_P x I_P omega_P, frame P [N m]
+W_SPH_SPIN = W_MZ + 9  # (3) omega_P x (omega_P x d), frame P [m/s^2]
+W_SPH_Q_ETA = W_MZ + 12  # (3) Q_eta, the translations' joint forces, frame M [N]
 
-    Leaves in ``w`` what :func:`_locked_pass2` reads (the general layout with three
-    free rows: D^-1 K_F, D^-1 r_F, the locked rows of Mz and K), takes K_F^T D^-1 K_F
-    off ``hub``'s inertia and writes the wrench at A_hub = 0.
+
+@njit(cache=True, error_model="numpy")
+def _spherical_pass1(q, qd, Q, o, p, w, hub):
+    """Pass 1 of a plate whose root translations are locked (the reduced plant's set).
+
+    The joint is then spherical: the panel turns freely about its root P, which moves
+    with the hub. Euler's equations about P, I_P alpha + omega x I_P omega
+    + m d x a_P = N_P (d = P -> G, the joint torque N_P), give alpha from the root's
+    acceleration a_P, and m a_G = f the root force::
+
+        f = M_P a_P + m (omega x (omega x d) - d x I_P^-1 (N_P - omega x I_P omega))
+        M_P = m 1 + m^2 [d]x I_P^-1 [d]x
+
+    (panel frame; I_P, its inverse and M_P are constants of the panel, packed). M_P,
+    the effective mass at the root, is all the articulated inertia the panel hands
+    the hub: with a_P = a_hub + omega_dot x r_P + b_P it adds
+    [[M, -M [r_P]x], [[r_P]x M, -[r_P]x M [r_P]x]] (M = R_BP M_P R_BP^T) to the hub's
+    inertia, and the wrench -f0, -r_P x f0 - R_BP N_P at A_hub = 0: four 3 x 3
+    products instead of the general elimination over the free rows (docs/model.md,
+    'Locked coordinates'). Returns a status.
     """
-    D = _axpy(mtm(S_rho, mm(J_p, S_rho)), m, mtm(J_t, J_t))
-    K_30 = scale_m(m, transpose(J_t))
-    K_33 = _axpy(mtm(S_rho, mm(J_p, transpose(R_BP))), -m, mtm(J_t, G))
-    D_inv = _inverse3(D)
-    Y_0 = mm(D_inv, K_30)
-    Y_3 = mm(D_inv, K_33)
-    y = mv(D_inv, load_seg(w, W_RV + 3))
-    w[W_NF] = 3
-    nc = 10  # three free rows of [D | K_F | r_F]
-    Mz_03 = mm(R_MB, J_t)
-    K_03 = mm(R_MB, G)
-    for a in range(3):
-        w[W_FREE + a] = 3 + a
-        for b in range(3):
-            w[W_SOLVE + nc * a + 3 + b] = Y_0[a][b]
-            w[W_SOLVE + nc * a + 6 + b] = Y_3[a][b]
-            w[W_MZ + 6 * a + 3 + b] = m * Mz_03[a][b]
-            w[W_K + 6 * a + b] = m * R_MB[a][b]
-            w[W_K + 6 * a + 3 + b] = -m * K_03[a][b]
-        w[W_SOLVE + nc * a + 9] = y[a]
+    R_BM, R_MP, R_BP, S_rho, r_P, r_G = _pose(q, o, p)
+    if abs(cos(q[o + 4])) < MIN_COS:
+        return STATUS_JOINT_GIMBAL_LOCK
+    Q_eta, Q_rho = _joint_forces(q, qd, Q, o, p)
+    S_inv = euler_rate_matrix_inv(q[o + 3], q[o + 4])
+    N_P = mtv(S_inv, Q_rho)  # S(rho)^-T Q_rho
+    omega_B = load_seg(hub, HUB_OMEGA)
+    omega_rel_P = mv(S_rho, load_seg(qd, o + 3))
+    omega_P = add(mtv(R_BP, omega_B), omega_rel_P)
+    m = p[P_MASS]
+    d = load_seg(p, P_COM)
+    I_P = load_m33_at(p, P_IP)
+    h_P = sub(N_P, cross(omega_P, mv(I_P, omega_P)))
+    spin = cross(omega_P, cross(omega_P, d))
+    f_bias = scale(m, sub(spin, cross(d, mv(load_m33_at(p, P_IP_INV), h_P))))
+    M_P = load_m33_at(p, P_M_ROOT)
+    M_B = mm(R_BP, mm(M_P, transpose(R_BP)))
+    b_P = cross(omega_B, cross(omega_B, r_P))
+    f0 = add(mv(M_B, b_P), mv(R_BP, f_bias))
+    Rr = skew(r_P)
+    MR = mm(M_B, Rr)
     H = HUB_INERTIA
-    _add6(hub, H, 0, 0, mtm(K_30, Y_0), -1.0)
-    _add6(hub, H, 0, 3, mtm(K_30, Y_3), -1.0)
-    _add6(hub, H, 3, 0, mtm(K_33, Y_0), -1.0)
-    _add6(hub, H, 3, 3, mtm(K_33, Y_3), -1.0)
-    _store(w, W_WRENCH, sub(u_a, mtv(K_30, y)))
-    _store(w, W_WRENCH + 3, sub(Xu, mtv(K_33, y)))
+    _add6(hub, H, 0, 0, M_B, 1.0)
+    _add6(hub, H, 0, 3, MR, -1.0)
+    _add6(hub, H, 3, 0, transpose(MR), -1.0)  # [r_P]x M = -(M [r_P]x)^T
+    _add6(hub, H, 3, 3, mm(Rr, MR), -1.0)
+    _store(w, W_WRENCH, scale(-1.0, f0))
+    _store(w, W_WRENCH + 3, scale(-1.0, add(cross(r_P, f0), mv(R_BP, N_P))))
+    _store_m33(w, W_R_BP, R_BP)
+    _store(w, W_OMEGA_REL, omega_rel_P)
+    _store_m33(w, W_S_INV, S_inv)
+    _store(w, W_RHO_BIAS, euler_rate_bias(q[o + 3], q[o + 4], qd[o + 3], qd[o + 4], qd[o + 5]))
+    _store(w, W_SPH_R_P, r_P)
+    _store(w, W_SPH_B_P, b_P)
+    _store(w, W_SPH_H, h_P)
+    _store(w, W_SPH_SPIN, spin)
+    _store(w, W_SPH_Q_ETA, Q_eta)
+    return STATUS_OK
+
+
+@njit(cache=True, error_model="numpy")
+def _spherical_pass2(o, p, w, hub, qdd):
+    """rho_ddot of a plate on a spherical joint given the hub's accelerations, and in
+    the locked rows the constraint force lambda = R_MB f - Q_eta (mount frame; the
+    engine moves it out of ``qdd``): :func:`_spherical_pass1`'s equations."""
+    m = p[P_MASS]
+    d = load_seg(p, P_COM)
+    R_BP = load_m33_at(w, W_R_BP)
+    omega_B = load_seg(hub, HUB_OMEGA)
+    alpha_B = load_seg(hub, HUB_ALPHA)
+    a_P_B = add(sub(load_seg(hub, HUB_ACC), cross(load_seg(w, W_SPH_R_P), alpha_B)),
+                load_seg(w, W_SPH_B_P))  # fmt: skip
+    a_P = mtv(R_BP, a_P_B)
+    alpha_P = mv(load_m33_at(p, P_IP_INV), sub(load_seg(w, W_SPH_H), scale(m, cross(d, a_P))))
+    f_P = scale(m, add(add(a_P, cross(alpha_P, d)), load_seg(w, W_SPH_SPIN)))
+    lam = sub(mtv(load_m33_at(p, P_R_BM), mv(R_BP, f_P)), load_seg(w, W_SPH_Q_ETA))
+    omega_rel_P = load_seg(w, W_OMEGA_REL)
+    omega_dot_rel = add(sub(alpha_P, mtv(R_BP, alpha_B)), cross(omega_rel_P, mtv(R_BP, omega_B)))
+    rho_dd = mv(load_m33_at(w, W_S_INV), sub(omega_dot_rel, load_seg(w, W_RHO_BIAS)))
+    qdd[o], qdd[o + 1], qdd[o + 2] = lam
+    qdd[o + 3], qdd[o + 4], qdd[o + 5] = rho_dd
 
 
 @njit(cache=True, error_model="numpy")
@@ -301,8 +358,11 @@ def _locked_pass1(q, qd, Q, o, p, w, hub):
     On the free rows F (z_L = 0): z_F = D^-1 (r_F - K_F A_hub), D = Mz_FF, so the hub
     sees the articulated inertia X^T I_P X - K_F^T D^-1 K_F (added to ``hub``) and, at
     A_hub = 0, the wrench X^T u - K_F^T D^-1 r_F with u = b - I_P c (into
-    ``w[W_WRENCH:]``). Returns a status.
+    ``w[W_WRENCH:]``). Root translations locked alone: :func:`_spherical_pass1`.
+    Returns a status.
     """
+    if _rotations_free(p):
+        return _spherical_pass1(q, qd, Q, o, p, w, hub)
     R_BM, R_MP, R_BP, S_rho, r_P, r_G = _pose(q, o, p)
     omega_rel_P, rdot_G_rel = _rates(qd, o, p, R_BM, R_BP, S_rho)
     if abs(cos(q[o + 4])) < MIN_COS:
@@ -340,9 +400,6 @@ def _locked_pass1(q, qd, Q, o, p, w, hub):
     _add6(hub, H, 3, 3, mm(G, G), -m)
     _add6(hub, H, 3, 3, mm(R_BP, mm(J_p, transpose(R_BP))), 1.0)
     Xu = add(cross(r_G, u_a), mv(R_BP, u_w))
-    if _rotations_free(p):
-        _rotations_solve(w, hub, m, R_MB, J_t, G, S_rho, J_p, R_BP, u_a, Xu)
-        return STATUS_OK
     w[W_MZ : W_MZ + 72] = 0.0  # Mz and K
     _add6(w, W_MZ, 0, 0, identity, m)
     _add6(w, W_MZ, 0, 3, mm(R_MB, J_t), m)
@@ -394,9 +451,13 @@ def _locked_pass1(q, qd, Q, o, p, w, hub):
 
 
 @njit(cache=True, error_model="numpy")
-def _locked_pass2(o, w, hub, qdd):
+def _locked_pass2(o, p, w, hub, qdd):
     """z_F = D^-1 (r_F - K_F A_hub) on the free rows; on the locked rows the constraint
-    force lambda_L = (Mz z)_L + K_L A_hub - r_L (the engine moves it out of ``qdd``)."""
+    force lambda_L = (Mz z)_L + K_L A_hub - r_L (the engine moves it out of ``qdd``).
+    Root translations locked alone: :func:`_spherical_pass2`."""
+    if _rotations_free(p):
+        _spherical_pass2(o, p, w, hub, qdd)
+        return
     nf = int(w[W_NF])
     nc = nf + 7
     A = W_SOLVE
@@ -498,7 +559,7 @@ def _passes(holds_locks: bool) -> tuple:
             p = params[j]
             w = work[j]
             if holds_locks and _is_locked(p):  # pruned before typing when False
-                _locked_pass2(o, w, hub, qdd)
+                _locked_pass2(o, p, w, hub, qdd)
                 continue
             R_BM = load_m33_at(p, P_R_BM)
             R_BP = load_m33_at(w, W_R_BP)
@@ -707,6 +768,14 @@ class PlateModel(AppendageModel):
         row[P_J : P_J + 9] = J.ravel()
         row[P_J_INV : P_J_INV + 9] = np.linalg.inv(J).ravel()
         row[P_TIP : P_TIP + 3] = (0.0, sign * config.length_m, 0.0)
+        d = row[P_COM : P_COM + 3]
+        I_P = J + config.mass * (d @ d * np.eye(3) - np.outer(d, d))  # parallel axes
+        I_P_inv = np.linalg.inv(I_P)
+        D = np.array([[0.0, -d[2], d[1]], [d[2], 0.0, -d[0]], [-d[1], d[0], 0.0]])  # [d]x
+        row[P_IP : P_IP + 9] = I_P.ravel()
+        row[P_IP_INV : P_IP_INV + 9] = I_P_inv.ravel()
+        row[P_M_ROOT : P_M_ROOT + 9] = (config.mass * np.eye(3)
+                                        + config.mass**2 * D @ I_P_inv @ D).ravel()  # fmt: skip
         for name in config.locked_dofs:  # held by pass 1 and 2 themselves
             row[P_LOCKED + JOINT_DOFS.index(name)] = 1.0
         return row
