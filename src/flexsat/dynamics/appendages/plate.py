@@ -28,7 +28,7 @@ against ``MIN_COS`` before any ``euler_rate_matrix_inv``.
 from __future__ import annotations
 
 from collections.abc import Sequence
-from math import cos
+from math import cos, sin
 from typing import ClassVar
 
 import numpy as np
@@ -60,9 +60,10 @@ from flexsat.dynamics.linalg3 import (
     add_block,
     cross,
     dot,
-    euler_rate_bias,
+    euler_rate_bias_cs,
     euler_rate_matrix,
-    euler_rate_matrix_inv,
+    euler_rate_matrix_cs,
+    euler_rate_matrix_inv_cs,
     load_m33_at,
     load_seg,
     mm,
@@ -70,6 +71,7 @@ from flexsat.dynamics.linalg3 import (
     mtv,
     mv,
     rot_zyx,
+    rot_zyx_cs,
     scale,
     scale_m,
     skew,
@@ -104,17 +106,34 @@ MIN_COS = 1e-9  # |cos(rho_y)| below this is treated as gimbal lock
 
 
 @njit(cache=True, error_model="numpy")
-def _pose(q, o, p):
+def _rho_cs(q, o):
+    """Cosines and sines of the joint angles rho = q[o+3:o+6]: (c1, s1, c2, s2, c3, s3).
+
+    A pass computes them once for the pose, S(rho), S(rho)^-1 and the rate bias (the
+    ``_cs`` forms of :mod:`flexsat.dynamics.linalg3`, the same arithmetic) instead of
+    once per helper: four sines and cosines fewer per plate and evaluation.
+    """
+    return cos(q[o + 3]), sin(q[o + 3]), cos(q[o + 4]), sin(q[o + 4]), cos(q[o + 5]), sin(q[o + 5])
+
+
+@njit(cache=True, error_model="numpy")
+def _rho_bias(cs, qd, o):
+    """S_dot(rho) rho_dot of the joint angles, from :func:`_rho_cs` [rad/s^2]."""
+    return euler_rate_bias_cs(cs[0], cs[1], cs[2], cs[3], qd[o + 3], qd[o + 4], qd[o + 5])
+
+
+@njit(cache=True, error_model="numpy")
+def _pose(q, o, p, cs):
     """Pose of the plate whose coordinates start at q[o], relative to the hub, in B.
 
-    Returns R_BM, R_MP (panel -> mount), R_BP (panel -> hub), S(rho), r_P (root
-    position) and r_G (panel centre of mass), both from the hub centre of mass [m].
+    ``cs`` is :func:`_rho_cs` ``(q, o)``. Returns R_BM, R_MP (panel -> mount), R_BP
+    (panel -> hub), S(rho), r_P (root position) and r_G (panel centre of mass), both
+    from the hub centre of mass [m].
     """
-    rho = load_seg(q, o + 3)
     R_BM = load_m33_at(p, P_R_BM)
-    R_MP = rot_zyx(rho[0], rho[1], rho[2])
+    R_MP = rot_zyx_cs(cs[0], cs[1], cs[2], cs[3], cs[4], cs[5])
     R_BP = mm(R_BM, R_MP)
-    S_rho = euler_rate_matrix(rho[0], rho[1])
+    S_rho = euler_rate_matrix_cs(cs[0], cs[1], cs[2], cs[3])
     r_P = add(load_seg(p, P_MOUNT), mv(R_BM, load_seg(q, o)))
     r_G = add(r_P, mv(R_BP, load_seg(p, P_COM)))
     return R_BM, R_MP, R_BP, S_rho, r_P, r_G
@@ -149,20 +168,20 @@ def _joint_forces(q, qd, Q, o, p):
 
 
 @njit(cache=True, error_model="numpy")
-def _joint_wrench(q, qd, Q, o, p):
+def _joint_wrench(q, qd, Q, o, p, cs):
     """Joint wrench on the plate from its elastic, damping and external generalized forces.
 
     By virtual work the 6 generalized forces on (eta, rho) are a force F_M at the
     root (mount frame) and a torque N_P (panel frame) on the panel, with the
     opposite pair on the hub: F_M = Q_eta, N_P = S(rho)^-T Q_rho.
     Returns F_M, N_P, S(rho)^-1 and a status flag (S(rho)^-1 is undefined on a
-    gimbal lock).
+    gimbal lock). ``cs`` is :func:`_rho_cs` ``(q, o)``.
     """
     Q_eta, Q_rho = _joint_forces(q, qd, Q, o, p)
-    if abs(cos(q[o + 4])) < MIN_COS:
+    if abs(cs[2]) < MIN_COS:
         undefined = ((0.0, 0.0, 0.0), (0.0, 0.0, 0.0), (0.0, 0.0, 0.0))
         return Q_eta, Q_rho, undefined, STATUS_JOINT_GIMBAL_LOCK
-    S_inv = euler_rate_matrix_inv(q[o + 3], q[o + 4])
+    S_inv = euler_rate_matrix_inv_cs(cs[0], cs[1], cs[2], cs[3])
     return Q_eta, mtv(S_inv, Q_rho), S_inv, STATUS_OK
 
 
@@ -283,11 +302,12 @@ def _spherical_pass1(q, qd, Q, o, p, w, hub):
     products instead of the general elimination over the free rows (docs/model.md,
     'Locked coordinates'). Returns a status.
     """
-    R_BM, R_MP, R_BP, S_rho, r_P, r_G = _pose(q, o, p)
-    if abs(cos(q[o + 4])) < MIN_COS:
+    cs = _rho_cs(q, o)
+    R_BM, R_MP, R_BP, S_rho, r_P, r_G = _pose(q, o, p, cs)
+    if abs(cs[2]) < MIN_COS:
         return STATUS_JOINT_GIMBAL_LOCK
     Q_eta, Q_rho = _joint_forces(q, qd, Q, o, p)
-    S_inv = euler_rate_matrix_inv(q[o + 3], q[o + 4])
+    S_inv = euler_rate_matrix_inv_cs(cs[0], cs[1], cs[2], cs[3])
     N_P = mtv(S_inv, Q_rho)  # S(rho)^-T Q_rho
     omega_B = load_seg(hub, HUB_OMEGA)
     omega_rel_P = mv(S_rho, load_seg(qd, o + 3))
@@ -314,7 +334,7 @@ def _spherical_pass1(q, qd, Q, o, p, w, hub):
     _store_m33(w, W_R_BP, R_BP)
     _store(w, W_OMEGA_REL, omega_rel_P)
     _store_m33(w, W_S_INV, S_inv)
-    _store(w, W_RHO_BIAS, euler_rate_bias(q[o + 3], q[o + 4], qd[o + 3], qd[o + 4], qd[o + 5]))
+    _store(w, W_RHO_BIAS, _rho_bias(cs, qd, o))
     _store(w, W_SPH_R_P, r_P)
     _store(w, W_SPH_B_P, b_P)
     _store(w, W_SPH_H, h_P)
@@ -363,9 +383,10 @@ def _locked_pass1(q, qd, Q, o, p, w, hub):
     """
     if _rotations_free(p):
         return _spherical_pass1(q, qd, Q, o, p, w, hub)
-    R_BM, R_MP, R_BP, S_rho, r_P, r_G = _pose(q, o, p)
+    cs = _rho_cs(q, o)
+    R_BM, R_MP, R_BP, S_rho, r_P, r_G = _pose(q, o, p, cs)
     omega_rel_P, rdot_G_rel = _rates(qd, o, p, R_BM, R_BP, S_rho)
-    if abs(cos(q[o + 4])) < MIN_COS:
+    if abs(cs[2]) < MIN_COS:
         return STATUS_JOINT_GIMBAL_LOCK
     Q_eta, Q_rho = _joint_forces(q, qd, Q, o, p)
     omega_B = load_seg(hub, HUB_OMEGA)
@@ -374,7 +395,7 @@ def _locked_pass1(q, qd, Q, o, p, w, hub):
     J_p = load_m33_at(p, P_J)
     omega_B_P = mtv(R_BP, omega_B)
     omega_P = add(omega_B_P, omega_rel_P)
-    rho_bias = euler_rate_bias(q[o + 3], q[o + 4], qd[o + 3], qd[o + 4], qd[o + 5])
+    rho_bias = _rho_bias(cs, qd, o)
     c_a = add(
         add(cross(omega_B, cross(omega_B, r_G)), scale(2.0, cross(omega_B, rdot_G_rel))),
         mv(R_BP, add(cross(rho_bias, d), cross(omega_rel_P, cross(omega_rel_P, d)))),
@@ -515,9 +536,10 @@ def _passes(holds_locks: bool) -> tuple:
                     v = qd[o + k]
                     dissipated += p[P_C + k] * v * v  # q_dot^T C q_dot (eq. 2.36)
                 continue
-            R_BM, R_MP, R_BP, S_rho, r_P, r_G = _pose(q, o, p)
+            cs = _rho_cs(q, o)
+            R_BM, R_MP, R_BP, S_rho, r_P, r_G = _pose(q, o, p, cs)
             omega_rel_P, rdot_G_rel = _rates(qd, o, p, R_BM, R_BP, S_rho)
-            F_M, N_P, S_inv, status = _joint_wrench(q, qd, Q, o, p)
+            F_M, N_P, S_inv, status = _joint_wrench(q, qd, Q, o, p, cs)
             if status != STATUS_OK:
                 return status
             F_B = mv(R_BM, F_M)
@@ -540,7 +562,7 @@ def _passes(holds_locks: bool) -> tuple:
             _store(w, W_OMEGA_REL, omega_rel_P)
             _store(w, W_RDOT_G, rdot_G_rel)
             _store_m33(w, W_S_INV, S_inv)
-            rho_bias = euler_rate_bias(q[o + 3], q[o + 4], qd[o + 3], qd[o + 4], qd[o + 5])
+            rho_bias = _rho_bias(cs, qd, o)
             _store(w, W_RHO_BIAS, rho_bias)
         hub[HUB_FORCE], hub[HUB_FORCE + 1], hub[HUB_FORCE + 2] = force_B
         hub[HUB_TORQUE], hub[HUB_TORQUE + 1], hub[HUB_TORQUE + 2] = torque_B
@@ -608,7 +630,8 @@ def mass_matrix(q, members, params, M):
         p = params[j]
         m = p[P_MASS]
         J_p = load_m33_at(p, P_J)
-        R_BM, R_MP, R_BP, S_rho, r_P, r_G = _pose(q, o, p)
+        cs = _rho_cs(q, o)
+        R_BM, R_MP, R_BP, S_rho, r_P, r_G = _pose(q, o, p, cs)
         A_theta = scale_m(-1.0, mm(skew(r_G), S))
         A_rho = scale_m(-1.0, mm(R_BP, mm(skew(load_seg(p, P_COM)), S_rho)))
         B_theta = mtm(R_BP, S)
@@ -636,11 +659,12 @@ def bias_forces(q, qd, members, params, hub, h):
     for j in range(members.shape[0]):
         o = members[j, 1]
         p = params[j]
-        R_BM, R_MP, R_BP, S_rho, r_P, r_G = _pose(q, o, p)
+        cs = _rho_cs(q, o)
+        R_BM, R_MP, R_BP, S_rho, r_P, r_G = _pose(q, o, p, cs)
         omega_rel_P, rdot_G_rel = _rates(qd, o, p, R_BM, R_BP, S_rho)
         d = load_seg(p, P_COM)
         J_p = load_m33_at(p, P_J)
-        rho_bias = euler_rate_bias(q[o + 3], q[o + 4], qd[o + 3], qd[o + 4], qd[o + 5])
+        rho_bias = _rho_bias(cs, qd, o)
         a0 = add(
             add(cross(s_bias, r_G), cross(omega_B, cross(omega_B, r_G))),
             add(
@@ -674,7 +698,8 @@ def observe(q, qd, members, params, out):
         p = params[j]
         m = p[P_MASS]
         J_p = load_m33_at(p, P_J)
-        R_BM, R_MP, R_BP, S_rho, r_P, r_G = _pose(q, o, p)
+        cs = _rho_cs(q, o)
+        R_BM, R_MP, R_BP, S_rho, r_P, r_G = _pose(q, o, p, cs)
         omega_rel_P, rdot_G_rel = _rates(qd, o, p, R_BM, R_BP, S_rho)
         v_G = add(add(v_hub_B, cross(omega_B, r_G)), rdot_G_rel)
         omega_P = add(mtv(R_BP, omega_B), omega_rel_P)
@@ -709,8 +734,9 @@ def joint_wrench(q, qd, qdd, Q, members, params, out):
     for j in range(members.shape[0]):
         o = members[j, 1]
         p = params[j]
-        R_BM, R_MP, R_BP, S_rho, r_P, r_G = _pose(q, o, p)
-        F_M, N_P, S_inv, status = _joint_wrench(q, qd, Q, o, p)
+        cs = _rho_cs(q, o)
+        R_BM, R_MP, R_BP, S_rho, r_P, r_G = _pose(q, o, p, cs)
+        F_M, N_P, S_inv, status = _joint_wrench(q, qd, Q, o, p, cs)
         if status != STATUS_OK:
             return status
         _add_hub_wrench(out, 0, r_P, R_BM, R_BP, F_M, N_P)
