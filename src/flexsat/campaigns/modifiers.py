@@ -17,12 +17,12 @@ from typing import Annotated, Any, Literal
 
 import numpy as np
 from pydantic import Field, model_validator
-from scipy import stats
+from scipy import special, stats
 
 from flexsat.config.models import HubConfig, _Frozen
 from flexsat.dynamics.appendages import appendage_model
 
-__all__ = ["Modifier", "apply_modifiers"]
+__all__ = ["Modifier", "apply_modifiers", "truncnormal_ppf"]
 
 _APPENDAGE = re.compile(r"appendages\[\d+\]")
 _TOKEN = re.compile(r"([A-Za-z_][A-Za-z0-9_]*)|\[(\*|\d+)\]")
@@ -87,8 +87,46 @@ class Modifier(_Frozen):
         if self.normal is not None:
             return float(rng.normal(*self.normal))
         mean, std, low, high = self.truncnormal
-        a, b = (low - mean) / std, (high - mean) / std
-        return float(stats.truncnorm.ppf(rng.uniform(), a, b, loc=mean, scale=std))
+        return truncnormal_ppf(rng.uniform(), mean, std, low, high)
+
+
+def truncnormal_ppf(u: float, mean: float, std: float, low: float, high: float) -> float:
+    """The ``u`` quantile of the normal (mean, std) truncated to [low, high].
+
+    x = mean + std Phi^-1(Phi(a) + u (Phi(b) - Phi(a))), with a, b the standardized
+    bounds, from scipy's ``ndtr`` and ``ndtri``: about 1 us against 0.2 ms for
+    ``scipy.stats.truncnorm.ppf`` (the distribution machinery around the same
+    quantile), which was a quarter of a campaign process's work per random case. An
+    interval above the mean is mirrored below it, where Phi keeps its digits; a narrow
+    one far in a tail, where Phi(b) - Phi(a) cancels, goes to ``truncnorm.ppf``.
+    Agrees with ``truncnorm.ppf`` to 1e-12 std (``tests/campaigns/test_modifiers.py``).
+
+    Parameters
+    ----------
+    u : float
+        Probability in [0, 1] [-].
+    mean, std : float
+        Mean and standard deviation of the normal, std > 0 [unit of the parameter].
+    low, high : float
+        Bounds, low < high [unit of the parameter].
+
+    Returns
+    -------
+    float
+        The quantile, in [low, high] [unit of the parameter].
+    """
+    z = _standard_ppf(u, (low - mean) / std, (high - mean) / std)
+    return float(min(max(mean + std * z, low), high))
+
+
+def _standard_ppf(u: float, a: float, b: float) -> float:
+    """The ``u`` quantile of the standard normal truncated to [a, b]."""
+    if a > 0.0:  # the upper tail, mirrored: Phi near 1 would lose its digits
+        return -_standard_ppf(1.0 - u, -b, -a)
+    pa, pb = special.ndtr(a), special.ndtr(b)
+    if not pb - pa > 1e-3 * pb:  # narrow and far out (or underflowed): cancellation
+        return float(stats.truncnorm.ppf(u, a, b))
+    return float(special.ndtri(pa + u * (pb - pa)))
 
 
 def apply_modifiers(
