@@ -1,8 +1,10 @@
 """A local pool of worker processes that stops when told to and never outlives its parent.
 
 Unlike :class:`concurrent.futures.ProcessPoolExecutor`, which is handed every case
-up front and waits for all of them, :class:`LocalPool` gives each worker one item
-at a time. So:
+up front and waits for all of them, :class:`LocalPool` gives each worker at most
+:data:`DEPTH` items at a time: the one it runs and the next, queued in its pipe, so
+that it never waits while the parent stores a result and prepares the next item.
+So:
 
 - leaving the pool (an exception, Ctrl-C, SIGTERM turned into ``KeyboardInterrupt``)
   cancels what is pending and stops the workers at once (SIGTERM, then SIGKILL
@@ -32,7 +34,12 @@ from collections import deque
 from collections.abc import Callable, Iterable, Iterator
 from multiprocessing.connection import wait
 
-__all__ = ["LocalPool"]
+__all__ = ["DEPTH", "LocalPool"]
+
+DEPTH = 2
+"""Items given to a worker at a time: the one it runs and the next. With one, a
+worker waited for the parent to store its result and resolve the next case, about a
+tenth of a reduced campaign case (docs/performance.md, 'Campaigns at scale')."""
 
 _PARENT_POLL_S = 0.2  # how often a worker checks that its parent is alive
 _GRACE_S = 1.0  # time given to a worker to exit on SIGTERM before SIGKILL
@@ -41,7 +48,7 @@ _PR_SET_PDEATHSIG = 1  # prctl(2) option: signal sent to this process when its p
 
 
 class LocalPool:
-    """Run ``function`` on items in ``n_workers`` processes, one item per worker at a time.
+    """Run ``function`` on items in ``n_workers`` processes, :data:`DEPTH` items per worker.
 
     Use it as a context manager; leaving the block stops every worker.
 
@@ -79,23 +86,13 @@ class LocalPool:
 
     def map_unordered(self, items: Iterable) -> Iterator:
         """Results of ``function(item)`` as they come, in completion order."""
-        source = iter(items)  # pulled one item per free worker: never all up front
-        pending: deque = deque()  # items whose worker died, to run again first
+        source = iter(items)  # pulled as workers have room: never all up front
+        pending: deque = deque()  # items of a worker that died, to run again first
         attempts: dict[int, int] = {}
         while True:
-            for k, worker in enumerate(self._workers):
-                if worker.item is None:
-                    if not pending:
-                        pending.extend(itertools.islice(source, 1))
-                    if not pending:
-                        continue
-                    item = pending.popleft()
-                    try:
-                        worker.give(item)
-                    except OSError:  # it died while idle: a new worker takes the item
-                        self._replace(worker)
-                        self._workers[k].give(item)
-            busy = [w for w in self._workers if w.item is not None]
+            for k in range(len(self._workers)):
+                self._fill(k, pending, source)
+            busy = [w for w in self._workers if w.items]
             if not busy:
                 return
             ready = wait([w.conn for w in busy] + [w.process.sentinel for w in busy])
@@ -106,19 +103,36 @@ class LocalPool:
                     except (EOFError, OSError):  # died while sending: handled below
                         result = None
                     else:
-                        attempts.pop(id(worker.item), None)  # ids are reused once it is gone
-                        worker.item = None
-                        yield result
+                        done = worker.items.popleft()  # a worker runs its items in order
+                        attempts.pop(id(done), None)  # ids are reused once it is gone
+                        yield result  # meanwhile the worker runs its queued item
                         continue
                 if worker.process.sentinel in ready or not worker.process.is_alive():
-                    item, exitcode = worker.item, worker.process.exitcode
+                    running, queued = worker.items[0], list(worker.items)[1:]
+                    exitcode = worker.process.exitcode
                     self._replace(worker)
-                    attempts[id(item)] = attempts.get(id(item), 0) + 1
-                    if attempts[id(item)] >= _ATTEMPTS:
-                        del attempts[id(item)]
-                        yield self.on_lost(item, exitcode)
+                    pending.extendleft(reversed(queued))  # never started: no attempt
+                    attempts[id(running)] = attempts.get(id(running), 0) + 1
+                    if attempts[id(running)] >= _ATTEMPTS:
+                        del attempts[id(running)]
+                        yield self.on_lost(running, exitcode)
                     else:
-                        pending.appendleft(item)
+                        pending.appendleft(running)
+
+    def _fill(self, k: int, pending: deque, source: Iterator) -> None:
+        """Give worker ``k`` items (those to run again first) until it holds DEPTH."""
+        while len(self._workers[k].items) < DEPTH:
+            if not pending:
+                pending.extend(itertools.islice(source, 1))
+            if not pending:
+                return
+            item = pending.popleft()
+            try:
+                self._workers[k].give(item)
+            except OSError:  # it died: a new worker takes its items, this one included
+                lost = list(self._workers[k].items)
+                self._replace(self._workers[k])
+                pending.extendleft(reversed(lost))
 
     def _replace(self, worker: _Worker) -> None:
         worker.stop()
@@ -137,10 +151,10 @@ class LocalPool:
 
 class _Worker:
     def __init__(self, process, conn) -> None:
-        self.process, self.conn, self.item = process, conn, None
+        self.process, self.conn, self.items = process, conn, deque()
 
     def give(self, item) -> None:
-        self.item = item
+        self.items.append(item)
         self.conn.send(item)
 
     def stop(self) -> None:

@@ -1,0 +1,61 @@
+"""The local worker pool: items in flight per worker, deaths, nothing lost or repeated."""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+from flexsat.campaigns.pool import DEPTH, LocalPool
+
+
+def _square(item):
+    return item, item * item
+
+
+def _dies_once(item):
+    """Kills its worker the first time it meets item 3 (a marker file remembers)."""
+    value, folder = item
+    marker = Path(folder) / "died"
+    if value == 3 and not marker.exists():
+        marker.touch()
+        os._exit(9)
+    return value, value * value
+
+
+def _always_dies(item):
+    value, _ = item
+    if value == 3:
+        os._exit(9)
+    return value, value * value
+
+
+def _lost(item, exitcode):
+    return item[0], ("lost", exitcode)
+
+
+def test_every_item_comes_back_once_and_workers_hold_their_next_item():
+    with LocalPool(_square, 2, _lost) as pool:
+        results = []
+        for result in pool.map_unordered(range(40)):
+            if not results:  # the worker that answered still holds the item it queued
+                held = [len(w.items) for w in pool._workers]
+                assert sum(held) >= 2 * DEPTH - 1
+            results.append(result)
+    assert sorted(results) == [(i, i * i) for i in range(40)]
+
+
+def test_a_worker_killed_with_an_item_queued_loses_nothing(tmp_path):
+    # item 3 kills its worker once; the item queued behind it never started and is
+    # run by the new worker without counting an attempt; 3 is run again and passes
+    items = [(i, str(tmp_path)) for i in range(12)]
+    with LocalPool(_dies_once, 2, _lost) as pool:
+        results = list(pool.map_unordered(items))
+    assert sorted(results) == [(i, i * i) for i in range(12)]
+
+
+def test_an_item_that_always_kills_its_worker_is_handed_to_on_lost(tmp_path):
+    items = [(i, str(tmp_path)) for i in range(8)]
+    with LocalPool(_always_dies, 2, _lost) as pool:
+        results = dict(pool.map_unordered(items))
+    assert results.pop(3) == ("lost", 9)
+    assert results == {i: i * i for i in range(8) if i != 3}
