@@ -10,7 +10,7 @@ from numba import njit, typeof
 
 from flexsat.control import StageConfig, StageSpec, register_stage
 from flexsat.control.stages import ACTUATOR_SIGNATURE, ACTUATORS
-from flexsat.simulate import SlewScenario, run_slew
+from flexsat.simulate import SlewScenario, closedloop, run_slew
 from flexsat.simulate.closedloop import prepare_slew
 from flexsat.simulate.loops import CHAIN_SLOTS
 
@@ -70,3 +70,33 @@ def test_a_chain_longer_than_the_slots_runs_each_of_its_stages(nominal_plant, ga
     np.testing.assert_array_equal(a["tau_applied"].values, b["tau_applied"].values)
     np.testing.assert_array_equal(a["tau_cmd"].values, b["tau_cmd"].values)
     assert np.max(np.abs(a["tau_applied"].values)) > 0.01  # the slew applies torque [N m]
+
+
+@pytest.mark.parametrize(
+    ("stages", "ideal_runs"),
+    [
+        (["gyro", "star_tracker", "mekf"], False),  # both outputs replaced, then read
+        (["gyro", "star_tracker"], False),
+        (["gyro"], True),  # the law reads the ideal attitude
+        (["star_tracker"], True),  # the law reads the ideal rate
+        (["mekf", "gyro", "star_tracker"], True),  # the estimator reads the ideal ones
+    ],
+)
+def test_the_ideal_sensor_runs_only_where_something_reads_it(stages, ideal_runs):
+    scenario = SlewScenario.model_validate({"sensor_stages": [{"kind": k} for k in stages]})
+    chain, n_sensors = closedloop.flown_chain(scenario)
+    kinds = [config.kind for _, config in chain[:n_sensors]]
+    assert kinds == (["ideal"] if ideal_runs else []) + stages
+
+
+def test_leaving_the_unread_ideal_sensor_out_changes_no_output(nominal_plant, monkeypatch):
+    # The same avionics slew with the ideal sensor run (the whole chain forced) and
+    # left out: every recorded variable bit for bit, so nothing read its outputs.
+    scenario = SlewScenario.model_validate({**AVIONICS, **SHORT})
+    lean = run_slew(nominal_plant, scenario, progress=False).dataset
+    monkeypatch.setattr(closedloop, "flown_chain", lambda s: (
+        s.stage_chain(), 1 + len(s.sensor_stages)))  # fmt: skip
+    full = run_slew(nominal_plant, scenario, progress=False).dataset
+    for name in full.data_vars:
+        if full[name].dtype.kind == "f" and name != "wall_time_s":
+            np.testing.assert_array_equal(lean[name].values, full[name].values, err_msg=name)

@@ -39,7 +39,7 @@ __all__ = ["DEPTH", "LocalPool"]
 DEPTH = 2
 """Items given to a worker at a time: the one it runs and the next. With one, a
 worker waited for the parent to store its result and resolve the next case, about a
-tenth of a reduced campaign case (docs/performance.md, 'Campaigns at scale')."""
+tenth of a reduced campaign case (docs/performance.md, 'A reduced case at 20 ms')."""
 
 _PARENT_POLL_S = 0.2  # how often a worker checks that its parent is alive
 _GRACE_S = 1.0  # time given to a worker to exit on SIGTERM before SIGKILL

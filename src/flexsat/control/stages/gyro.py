@@ -123,4 +123,5 @@ GYRO = StageSpec(
     records=(Channel("gyro_bias", "rad/s", "b_0 + b_GM + b_RW, the true gyro bias",
                      per_axis=True),),
     description="rate gyro: ARW, bias instability, rate random walk, scale factor",
+    overwrites=("omega_meas",), leaves=("q_meas",),
 )  # fmt: skip

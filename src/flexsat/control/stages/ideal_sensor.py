@@ -41,4 +41,5 @@ def ideal_sensor_step(x, n_dof, t, params, state, q_meas, omega_meas, record):
 IDEAL_SENSOR = StageSpec(
     role="sensor", name="ideal", config=IdealSensorConfig, step=ideal_sensor_step,
     description="true attitude quaternion and body rate (the thesis's)",
+    overwrites=("q_meas", "omega_meas"),
 )  # fmt: skip

@@ -241,6 +241,12 @@ class StageSpec:
     derivative : numba dispatcher, optional
         Actuators only: compiled with :data:`DERIVATIVE_SIGNATURE`; its entries of
         ``state`` are integrated with the plant inside each RK4 step.
+    overwrites, leaves : tuple of {"q_meas", "omega_meas"}
+        Sensors only: the outputs the stage sets from the plant state alone, never
+        reading their incoming value, and those it neither reads nor writes. A stage
+        declaring neither is taken to read both. A stage without state or records
+        whose every output a later stage overwrites before any reads it is left out
+        of the flown chain (:func:`flexsat.simulate.closedloop.flown_chain`).
     """
 
     role: Role
@@ -251,6 +257,8 @@ class StageSpec:
     records: tuple[Channel, ...] = ()
     description: str = ""
     derivative: Any = None
+    overwrites: tuple[str, ...] = ()
+    leaves: tuple[str, ...] = ()
 
     @property
     def record_size(self) -> int:

@@ -102,4 +102,5 @@ STAR_TRACKER = StageSpec(
     records=(Channel("star_tracker_noise", "rad", "dtheta of the last sample, hub frame",
                      per_axis=True),),
     description="star tracker: per-axis arcsec noise, own rate, latency",
+    overwrites=("q_meas",), leaves=("omega_meas",),
 )  # fmt: skip
