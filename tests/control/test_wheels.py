@@ -136,12 +136,14 @@ def test_a_python_controller_flies_the_wheels_like_the_compiled_loop(nominal_pla
 
 
 def test_the_friction_sign_is_the_c_librarys_tanh_within_two_ulp() -> None:
-    """The exponential form agrees with ``math.tanh`` to 2 ulp (the exponential, the
-    sum, the difference and the quotient each round once, damped by 1 +- e with
-    e <= 1/3 where the form is used; near +-1 the ulp below 1 is half the one above,
-    which is where the measured maximum, 2 ulp, lies) over 400 001 arguments across
-    both switches (0.55 and 22); exact at zero, the infinities and where tanh is +-1;
-    NaN stays NaN."""
+    """The fast forms agree with ``math.tanh`` to 2 ulp over 400 001 arguments across
+    both switches (0.55 and 22). The exponential form: the exponential, the sum, the
+    difference and the quotient each round once, damped by 1 +- e with e <= 1/3
+    where it is used; near +-1 the ulp below 1 is half the one above, which is where
+    the measured maximum, 2 ulp, lies. Cephes' rational form below 0.55: its minimax
+    error is 2.5e-16 relative, measured at most 1 ulp from ``math.tanh`` over
+    200 001 arguments. Exact at zero (with its sign), the infinities and where tanh is
+    +-1; NaN stays NaN."""
     z = np.concatenate([np.linspace(-60.0, 60.0, 400_001), [0.55, -0.55, 0.549999999,
                         21.999999999, 22.0, -22.0, 0.0, -0.0, 1e-300]])  # fmt: skip
     fast = np.array([_smooth_sign(v) for v in z])
@@ -150,4 +152,5 @@ def test_the_friction_sign_is_the_c_librarys_tanh_within_two_ulp() -> None:
     assert np.all(np.sign(fast) == np.sign(exact))
     assert np.array_equal(np.array([_smooth_sign(v) for v in (np.inf, -np.inf, 30.0, -0.0)]),
                           [1.0, -1.0, 1.0, -0.0])  # fmt: skip
+    assert math.copysign(1.0, _smooth_sign(-0.0)) == -1.0
     assert math.isnan(_smooth_sign(math.nan))

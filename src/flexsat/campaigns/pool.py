@@ -109,8 +109,8 @@ class LocalPool:
                         continue
                 if worker.process.sentinel in ready or not worker.process.is_alive():
                     running, queued = worker.items[0], list(worker.items)[1:]
+                    self._replace(worker)  # joins it: its exit code is known after
                     exitcode = worker.process.exitcode
-                    self._replace(worker)
                     pending.extendleft(reversed(queued))  # never started: no attempt
                     attempts[id(running)] = attempts.get(id(running), 0) + 1
                     if attempts[id(running)] >= _ATTEMPTS:
