@@ -115,7 +115,7 @@ def augmented_derivative(x, torque_B, n, Q, dx, packed, cs):
 
 
 @njit(cache=True)
-def rk4_step(x, dt, torque_B, n, Q, scratch, packed):
+def rk4_step(x, dt, torque_B, n, Q, scratch, packed, first=False):
     """One RK4 step of the augmented state x, in place, under a held body torque.
 
     Parameters
@@ -136,6 +136,9 @@ def rk4_step(x, dt, torque_B, n, Q, scratch, packed):
         Work array the caller allocates once [-].
     packed : PackedPlant
         The plant's packed arrays and kernels.
+    first : bool
+        ``scratch[0]`` already holds the first stage, the derivative at ``x`` (a
+        caller that keeps it: the closed loop's records).
 
     Returns
     -------
@@ -145,7 +148,9 @@ def rk4_step(x, dt, torque_B, n, Q, scratch, packed):
     x, Q, scratch, packed = borrowed(x), borrowed(Q), borrowed(scratch), borrowed(packed)
     size = x.shape[0]
     k1, k2, k3, k4, stage = scratch[0], scratch[1], scratch[2], scratch[3], scratch[4]
-    status = augmented_derivative(x, torque_B, n, Q, k1, packed, hub_cs(x))
+    status = STATUS_OK
+    if not first:
+        status = augmented_derivative(x, torque_B, n, Q, k1, packed, hub_cs(x))
     for j in range(size):
         stage[j] = x[j] + 0.5 * dt * k1[j]
     status |= augmented_derivative(stage, torque_B, n, Q, k2, packed, hub_cs(stage))

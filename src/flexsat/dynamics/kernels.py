@@ -86,6 +86,7 @@ __all__ = [
     "hub_cs",
     "hub_joint_wrench",
     "joint_forces",
+    "keep_solution",
     "mass_matrix",
     "observe",
     "tip_displacement",
@@ -400,6 +401,29 @@ def joint_forces(Q, packed, out):
         reaction = packed.reaction[1]
         for i in range(out.shape[0]):
             out[i] += reaction[i]
+
+
+@njit(cache=True, inline="always")
+def keep_solution(qdd, packed, out):
+    """Keep what the last :func:`accelerations` evaluation solved for, in ``out``:
+    q_ddot and the constraint forces of the locked coordinates (zero without).
+
+    Parameters
+    ----------
+    qdd : ndarray, shape (n_dof,)
+        The q_ddot it returned [m/s^2, rad/s^2] (may be ``out[0]`` itself).
+    packed : PackedPlant
+        The plant's packed arrays and kernels.
+    out : ndarray, shape (2, n_dof)
+        Output: ``out[0]`` q_ddot [m/s^2, rad/s^2], ``out[1]`` the constraint forces
+        lambda (``packed.reaction[1]``) [N, N m per coordinate]; ``Q + out[1]`` is
+        what :func:`joint_forces` gives.
+    """
+    copy_into(out[0], qdd)
+    if packed.constrained:
+        copy_into(out[1], packed.reaction[1])
+    else:
+        out[1, :] = 0.0
 
 
 @njit(cache=True, error_model="numpy")

@@ -20,7 +20,7 @@ from flexsat.dynamics.borrowed import borrowed
 from flexsat.dynamics.kernels import (
     accelerations,
     hub_joint_wrench,
-    joint_forces,
+    keep_solution,
     observe,
     tip_displacement,
 )
@@ -40,7 +40,7 @@ __all__ = ["derive_records"]
 
 @njit(cache=True)
 def derive_records(
-    q, qd, tau_B, joint_force, packed,
+    q, qd, tau_B, joint_force, solved, packed,
     omega, omega_dot, tau_flex, H, H_rigid, kinetic, elastic, tips,
 ):  # fmt: skip
     """Fill the derived arrays, row by row, from recorded states.
@@ -55,6 +55,12 @@ def derive_records(
         Generalized forces of the joint actuators held from each record, on the
         appendage coordinates (columns 6 and on; the hub's are not read) [N, N m per
         coordinate]; zeros without joint actuators.
+    solved : ndarray, shape (m, 2, n_dof)
+        Each record's q_ddot [m/s^2, rad/s^2] and constraint forces of the locked
+        coordinates [N, N m per coordinate]
+        (:func:`~flexsat.dynamics.kernels.keep_solution`): a row given (the compiled
+        loop's, from the first stage of the RK4 step taken from that state) is used
+        as is; a row whose first entry is NaN is solved for here and written.
     packed : PackedPlant
         ``Plant.packed``.
     omega, omega_dot, tau_flex, H, H_rigid : ndarray, shape (m, 3)
@@ -70,30 +76,32 @@ def derive_records(
     -----
     Each row's q_ddot is that of the plant under the applied torque and the joint
     forces, and tau_flex the wrench of the joints carrying those forces plus, on a
-    locked plant, the locked coordinates' constraint forces
-    (:func:`~flexsat.dynamics.kernels.joint_forces`). A row whose state is singular
-    (the last state of a failed run) gets NaN accelerations and joint torque.
+    locked plant, the locked coordinates' constraint forces (what
+    :func:`~flexsat.dynamics.kernels.joint_forces` gives, from the kept solution). A
+    row whose state is singular (the last state of a failed run) gets NaN
+    accelerations and joint torque.
     """
     n = q.shape[1]
-    _derive_rows(q, qd, tau_B, joint_force, packed, omega, omega_dot, tau_flex, H, H_rigid,
-                 kinetic, elastic, tips, np.zeros(n), np.empty(n), np.empty(n), np.empty(6),
+    _derive_rows(q, qd, tau_B, joint_force, solved, packed, omega, omega_dot, tau_flex, H,
+                 H_rigid, kinetic, elastic, tips, np.zeros(n), np.empty(n), np.empty(6),
                  np.empty(OBS_SIZE))  # fmt: skip
 
 
 @njit(cache=True)
 def _derive_rows(
-    q, qd, tau_B, joint_force, packed,
+    q, qd, tau_B, joint_force, solved, packed,
     omega, omega_dot, tau_flex, H, H_rigid, kinetic, elastic, tips,
-    Q, joint, qdd, wrench, obs,
+    Q, joint, wrench, obs,
 ):  # fmt: skip
-    """:func:`derive_records` on work arrays its caller owns: Q, the joint forces and
-    q_ddot (n_dof,), the hub wrench (6,), the observation row (``OBS_SIZE``); all
-    borrowed (:mod:`flexsat.dynamics.borrowed`)."""
-    q, qd, tau_B, joint_force, packed = borrowed((q, qd, tau_B, joint_force, packed))
+    """:func:`derive_records` on work arrays its caller owns: Q and the joint forces
+    (n_dof,), the hub wrench (6,), the observation row (``OBS_SIZE``); all borrowed
+    (:mod:`flexsat.dynamics.borrowed`)."""
+    q, qd, tau_B, joint_force, solved = borrowed((q, qd, tau_B, joint_force, solved))
+    packed = borrowed(packed)
     omega, omega_dot, tau_flex, H = borrowed((omega, omega_dot, tau_flex, H))
     H_rigid, kinetic, elastic, tips = borrowed((H_rigid, kinetic, elastic, tips))
-    Q, joint, qdd, wrench, obs = borrowed((Q, joint, qdd, wrench, obs))
-    m = q.shape[0]
+    Q, joint, wrench, obs = borrowed((Q, joint, wrench, obs))
+    m, n = q.shape
     L = OBS_LOCKED_INERTIA
     for k in range(m):
         qk, qdk = q[k], qd[k]
@@ -102,12 +110,18 @@ def _derive_rows(
         omega[k, 0], omega[k, 1], omega[k, 2] = w
         Q[3], Q[4], Q[5] = mtv(S, load_seg(tau_B[k], 0))
         copy_into(Q[6:], joint_force[k, 6:])
-        status = accelerations(qk, qdk, Q, packed, qdd)
-        joint_forces(Q, packed, joint)
-        status |= hub_joint_wrench(qk, qdk, qdd, joint, packed, wrench)
+        row = solved[k]
+        qddk = row[0]
+        status = STATUS_OK
+        if np.isnan(qddk[0]):  # not given: solve for it
+            status = accelerations(qk, qdk, Q, packed, qddk)
+            keep_solution(qddk, packed, row)
+        for i in range(n):  # joint_forces, from the kept solution
+            joint[i] = Q[i] + row[1, i]
+        status |= hub_joint_wrench(qk, qdk, qddk, joint, packed, wrench)
         if status == STATUS_OK:
             bias = euler_rate_bias(qk[3], qk[4], qdk[3], qdk[4], qdk[5])
-            w_dot = mv(S, load_seg(qdd, 3))
+            w_dot = mv(S, load_seg(qddk, 3))
             for a in range(3):
                 omega_dot[k, a] = w_dot[a] + bias[a]
                 tau_flex[k, a] = wrench[3 + a]

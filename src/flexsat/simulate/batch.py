@@ -81,6 +81,9 @@ class BatchItem(NamedTuple):
         Recorded attitude references R_NF [-].
     rec_Q : ndarray, shape (m, n_dof)
         Recorded joint-actuator forces, hub columns zero [N, N m per coordinate].
+    rec_solved : ndarray, shape (m, 2, n_dof)
+        Recorded q_ddot and constraint forces where the loop has them
+        (``LoopRecords.solved``) [m/s^2, rad/s^2; N, N m per coordinate].
     plant : tuple
         The plant's named structure (``Plant.packed``) [-].
     frame : ndarray, shape (9,)
@@ -96,6 +99,7 @@ class BatchItem(NamedTuple):
     rec_ctrl: np.ndarray
     rec_frame: np.ndarray
     rec_Q: np.ndarray
+    rec_solved: np.ndarray
     plant: tuple
     frame: np.ndarray
 
@@ -131,13 +135,13 @@ def batch_item(run) -> BatchItem:
     BatchItem
     """
     return BatchItem(run.x, slew_timing(run), run.stages, run.data, run.rec_t, run.rec_x,
-                     run.rec_ctrl, run.rec_frame, run.rec_Q, run.plant.packed,
-                     run.frame)  # fmt: skip
+                     run.rec_ctrl, run.rec_frame, run.rec_Q, run.rec_solved,
+                     run.plant.packed, run.frame)  # fmt: skip
 
 
 @njit(cache=True, nogil=True)
-def fly(x, timing, stages, d, rec_t, rec_x, rec_ctrl, rec_frame, rec_Q, plant, frame, done,
-        rows, max_chunks):  # fmt: skip
+def fly(x, timing, stages, d, rec_t, rec_x, rec_ctrl, rec_frame, rec_Q, rec_solved, plant, frame,
+        done, rows, max_chunks):  # fmt: skip
     """Advance a slew by up to ``max_chunks`` compiled chunks from step ``done``.
 
     Stops after the run's last step or at the first non-zero status.
@@ -163,6 +167,9 @@ def fly(x, timing, stages, d, rec_t, rec_x, rec_ctrl, rec_frame, rec_Q, plant, f
         Recorded attitude references R_NF [-].
     rec_Q : ndarray, shape (m, n_dof)
         Recorded joint-actuator forces, hub columns zero [N, N m per coordinate].
+    rec_solved : ndarray, shape (m, 2, n_dof)
+        Recorded q_ddot and constraint forces, written where the loop has them
+        (``LoopRecords.solved``) [m/s^2, rad/s^2; N, N m per coordinate].
     plant : PackedPlant
         The plant's named structure (``Plant.packed``).
     frame : ndarray, shape (9,)
@@ -186,9 +193,9 @@ def fly(x, timing, stages, d, rec_t, rec_x, rec_ctrl, rec_frame, rec_Q, plant, f
         clock = LoopClock(done * timing.dt, timing.dt, n_chunk, final, timing.control_every,
                           timing.record_every, timing.continuous)  # fmt: skip
         status, ran, written = rk4_closed_loop(
-            x, clock, stages, d, LoopRecords(rec_t, rec_x, rec_ctrl, rows, rec_frame, rec_Q),
-            plant, frame,
-        )
+            x, clock, stages, d,
+            LoopRecords(rec_t, rec_x, rec_ctrl, rows, rec_frame, rec_Q, rec_solved), plant, frame,
+        )  # fmt: skip
         done += ran
         rows += written
         if final or status != 0:
@@ -210,8 +217,8 @@ def fly_batch(items, out):
     for i in prange(len(items)):
         it = items[np.int64(i)]  # the prange index is unsigned; the List takes int64
         status, done, rows = fly(it.x, it.timing, it.stages, it.data, it.rec_t, it.rec_x,
-                                 it.rec_ctrl, it.rec_frame, it.rec_Q, it.plant, it.frame, 0,
-                                 0, it.timing.n_steps + 1)  # fmt: skip
+                                 it.rec_ctrl, it.rec_frame, it.rec_Q, it.rec_solved, it.plant,
+                                 it.frame, 0, 0, it.timing.n_steps + 1)  # fmt: skip
         out[i, 0], out[i, 1], out[i, 2] = status, done, rows
 
 

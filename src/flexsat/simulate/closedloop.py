@@ -165,7 +165,7 @@ def run_slew(
                          scenario.record_every, layout.continuous)  # fmt: skip
         rk4_closed_loop(run.x.copy(), idle, run.stages, run.data,
                         LoopRecords(run.rec_t, run.rec_x, run.rec_ctrl, 0, run.rec_frame,
-                                    run.rec_Q),
+                                    run.rec_Q, run.rec_solved),
                         plant.packed, identity_frame())  # fmt: skip
     start = time.perf_counter()
     with progress_bar(show, scenario.duration_s) as (bar, task):
@@ -217,6 +217,10 @@ class PreparedSlew(NamedTuple):
     rec_Q : ndarray, shape (m, n_dof)
         Recorded joint-actuator forces held from each record, hub columns zero
         [N, N m per coordinate].
+    rec_solved : ndarray, shape (m, 2, n_dof)
+        q_ddot and the locked coordinates' constraint forces of each record where the
+        compiled loop has them, NaN elsewhere
+        (:class:`~flexsat.simulate.loops.LoopRecords`) [m/s^2, rad/s^2; N, N m].
     """
 
     plant: Plant
@@ -233,6 +237,7 @@ class PreparedSlew(NamedTuple):
     rec_ctrl: np.ndarray  # (m, record_size)
     rec_frame: np.ndarray  # (m, 9)
     rec_Q: np.ndarray  # (m, n_dof)
+    rec_solved: np.ndarray  # (m, 2, n_dof), NaN where the loop has not written it
 
 
 def prepare_slew(plant: Plant, scenario: SlewScenario,
@@ -270,6 +275,7 @@ def prepare_slew(plant: Plant, scenario: SlewScenario,
         np.full((n_records, layout.plant.size), np.nan),
         np.full((n_records, layout.record_size), np.nan), np.full((n_records, 9), np.nan),
         np.zeros((n_records, plant.n_dof)),  # a Python law's loop applies none
+        np.full((n_records, 2, plant.n_dof), np.nan),
     )  # fmt: skip
 
 
@@ -297,14 +303,14 @@ def finish_slew(run: PreparedSlew, status: int, done: int, rows: int, wall: floa
     Result
     """
     plant, scenario, law, layout, J, x, frame, data = run[:8]
-    records = run.rec_t, run.rec_x, run.rec_ctrl, run.rec_frame, run.rec_Q
-    rec_t, rec_x, rec_ctrl, rec_frame, rec_Q = records
+    records = run.rec_t, run.rec_x, run.rec_ctrl, run.rec_frame, run.rec_Q, run.rec_solved
+    rec_t, rec_x, rec_ctrl, rec_frame, rec_Q, _ = records
     t_fail = done * scenario.dt_s if status else -1.0
     if status:  # keep the last good state as the final record
         rec_t[rows], rec_x[rows], rec_ctrl[rows], rec_frame[rows] = t_fail, x, data.held, frame
         rec_Q[rows, :6], rec_Q[rows, 6:] = 0.0, data.Q[6:]  # as the loop records them
         rows += 1
-    rec_t, rec_x, rec_ctrl, rec_frame, rec_Q = (a[:rows] for a in records)
+    rec_t, rec_x, rec_ctrl, rec_frame, rec_Q, rec_solved = (a[:rows] for a in records)
     attrs = run_attributes(plant, scenario, "closed-loop", status, t_fail, wall, done)
     attrs["controller"] = law.name if compiled_law else "python"
     attrs["controller_label"] = law.label if compiled_law else "Python law"
@@ -324,7 +330,7 @@ def finish_slew(run: PreparedSlew, status: int, done: int, rows: int, wall: floa
     ds = build_dataset(
         plant, rec_t, rec_x[:, at.q], rec_x[:, at.qd], rec_x[:, at.work_in],
         rec_x[:, at.dissipated], rec_ctrl[:, layout.tau_cmd], rec_ctrl[:, layout.tau_applied],
-        attrs, frames=rec_frame, joint_force=rec_Q,
+        attrs, frames=rec_frame, joint_force=rec_Q, solved=rec_solved,
     )  # fmt: skip
     ta = ("time", "axis")
     added = {}  # one assign: each ``ds[name] =`` would re-merge the whole dataset
@@ -541,8 +547,8 @@ def _compiled_loop(run: PreparedSlew, bar, task) -> tuple[int, int, int]:
     per_call = 1 if bar is not None else timing.n_steps + 1
     while True:
         status, done, rows = fly(run.x, timing, run.stages, run.data, run.rec_t, run.rec_x,
-                                 run.rec_ctrl, run.rec_frame, run.rec_Q, run.plant.packed,
-                                 run.frame, done, rows, per_call)  # fmt: skip
+                                 run.rec_ctrl, run.rec_frame, run.rec_Q, run.rec_solved,
+                                 run.plant.packed, run.frame, done, rows, per_call)  # fmt: skip
         if bar is not None:
             bar.update(task, completed=done * run.scenario.dt_s)
         if status != 0 or done == timing.n_steps:

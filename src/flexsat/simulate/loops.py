@@ -28,8 +28,8 @@ from numba import njit
 
 from flexsat.dynamics.attitude import inertial_view, is_identity, rebase
 from flexsat.dynamics.borrowed import borrowed
-from flexsat.dynamics.integrators import rk4_step
-from flexsat.dynamics.kernels import hub_cs
+from flexsat.dynamics.integrators import augmented_derivative, rk4_step
+from flexsat.dynamics.kernels import hub_cs, keep_solution
 from flexsat.dynamics.linalg3 import copy_into
 from flexsat.dynamics.status import STATUS_CONTROL_FAILED, STATUS_OK
 from flexsat.simulate.coupled import LoopFlow, chain_wrench, rk4_coupled_step
@@ -216,6 +216,15 @@ class LoopRecords(NamedTuple):
         The joint actuator's generalized forces ``LoopData.Q`` held from each record
         (the plant steps under them from the recorded state), zero on the hub
         coordinates [N, N m per coordinate].
+    solved : ndarray, shape (m, 2, n_dof)
+        What the plant's solve gave at each recorded state, from the first stage of
+        the RK4 step taken from it: q_ddot [m/s^2, rad/s^2] and the locked
+        coordinates' constraint forces [N, N m per coordinate]
+        (:func:`~flexsat.dynamics.kernels.keep_solution`). Written without continuous
+        actuation stages; rows the loop does not write (the last record, one whose
+        step failed, every row of a coupled run) stay as they are (NaN from
+        :func:`~flexsat.simulate.closedloop.prepare_slew`) and
+        :func:`~flexsat.dynamics.records.derive_records` solves for them.
     """
 
     t: np.ndarray  # (m,) [s]
@@ -224,6 +233,7 @@ class LoopRecords(NamedTuple):
     start: int
     frame: np.ndarray  # (m, 9) attitude reference R_NF of each recorded state
     Q: np.ndarray  # (m, n_dof) joint forces held from each record, hub columns zero
+    solved: np.ndarray  # (m, 2, n_dof) q_ddot and constraint forces of each record
 
 
 @njit(cache=True, inline="always")
@@ -314,7 +324,8 @@ def rk4_closed_loop(x, clock, stages, d, records, plant, frame):
     update ``d.J_design`` for the law), the law and the actuation chain if k is a
     control instant, record if
     k is a record instant, then take one RK4 step under the held torque and joint
-    forces ``d.Q`` (coupled with the chain's continuous states if any). Chunk
+    forces ``d.Q`` (coupled with the chain's continuous states if any), whose first
+    stage gives the record's q_ddot (:class:`LoopRecords`, without continuous stages). Chunk
     boundaries must be multiples of ``control_every`` and ``record_every``.
 
     Parameters
@@ -353,7 +364,9 @@ def rk4_closed_loop(x, clock, stages, d, records, plant, frame):
     for k in range(clock.n_steps + (1 if clock.final else 0)):
         t = clock.t0 + k * clock.dt
         rebase(x, n, frame)
-        if k % clock.control_every == 0:
+        instant = k % clock.control_every == 0
+        recorded = k % clock.record_every == 0
+        if instant:
             status = stages.reference[0](t, d.reference_params, d.reference_state, d.q_d,
                                          d.omega_d, d.omega_dot_d, d.reference_record)  # fmt: skip
             sensed = x
@@ -372,7 +385,7 @@ def rk4_closed_loop(x, clock, stages, d, records, plant, frame):
             status |= run_actuators(x, n, t, control_dt, clock.continuous, stages, d)
             if status != 0:
                 return STATUS_CONTROL_FAILED, k, row - records.start
-        if k % clock.record_every == 0:
+        if recorded:
             records.t[row] = t
             copy_into(records.x[row], x)
             copy_into(records.frame[row], frame)
@@ -383,12 +396,18 @@ def rk4_closed_loop(x, clock, stages, d, records, plant, frame):
         if k == clock.n_steps:
             break
         if clock.continuous:
-            fresh = k % clock.control_every == 0  # run_actuators evaluated them at (x, t)
+            # at an instant, run_actuators evaluated the chain's rates at (x, t)
             status = rk4_coupled_step(x, t, clock.dt, n, d.Q, scratch, stages.derivative,
-                                      d.actuator_params, d.flow, plant, fresh)  # fmt: skip
+                                      d.actuator_params, d.flow, plant, instant)  # fmt: skip
         else:
             torque = (d.tau_applied[0], d.tau_applied[1], d.tau_applied[2])
-            status = rk4_step(x, clock.dt, torque, n, d.Q, scratch, plant)
+            status = STATUS_OK
+            if recorded:  # the first RK4 stage, kept for the record (LoopRecords.solved)
+                status = augmented_derivative(x, torque, n, d.Q, scratch[0], plant, hub_cs(x))
+                if status == STATUS_OK:
+                    keep_solution(scratch[0, n : 2 * n], plant, records.solved[row - 1])
+            if status == STATUS_OK:
+                status = rk4_step(x, clock.dt, torque, n, d.Q, scratch, plant, recorded)
         if status != STATUS_OK:
             return status, k, row - records.start
     return STATUS_OK, clock.n_steps, row - records.start

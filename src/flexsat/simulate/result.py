@@ -243,6 +243,7 @@ def build_dataset(
     energy0: float | None = None,
     frames: np.ndarray | None = None,
     joint_force: np.ndarray | None = None,
+    solved: np.ndarray | None = None,
 ) -> xr.Dataset:
     """Derive every recorded quantity from the recorded states.
 
@@ -273,6 +274,11 @@ def build_dataset(
         hub coordinates [N, N m per coordinate] (a slew's joint actuator): the
         accelerations and tau_flex are those of the plant under them, and the dataset
         holds them as ``joint_force``. Default: none (no variable).
+    solved : ndarray, shape (m, 2, n_dof), optional
+        q_ddot and the locked coordinates' constraint forces of the records the
+        compiled loop has them for, rows of NaN elsewhere [m/s^2, rad/s^2; N, N m]
+        (``PreparedSlew.rec_solved``); the missing rows are solved for and written
+        into it. Default: all solved for.
     """
     m, n = q.shape
     names = [a.name for a in plant.config.appendages]
@@ -286,11 +292,14 @@ def build_dataset(
     elastic = np.empty(m)
     tips = np.zeros((m, n_app, 3))
     joints = np.zeros((m, n)) if joint_force is None else np.ascontiguousarray(joint_force)
+    # the rows solved for are written into it (the run's own buffer, not copied)
+    kept = np.full((m, 2, n), np.nan) if solved is None else np.ascontiguousarray(solved)
     # A diverged run keeps its last finite state, whose derived values may overflow.
     with np.errstate(over="ignore", invalid="ignore"):
         derive_records(
             np.ascontiguousarray(q), np.ascontiguousarray(qd), np.ascontiguousarray(tau_applied),
-            joints, plant.packed, omega, omega_dot, tau_flex, H, H_rigid, kinetic, elastic, tips,
+            joints, kept, plant.packed, omega, omega_dot, tau_flex, H, H_rigid, kinetic, elastic,
+            tips,
         )  # fmt: skip
     if frames is not None:  # relative to N: H_N = R_NF H_F (docs/model.md)
         q, qd = inertial_records(q, qd, omega, frames)
