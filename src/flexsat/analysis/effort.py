@@ -36,9 +36,10 @@ def effort_metrics(ds: xr.Dataset) -> dict[str, float]:
         records); ``residual_elastic_energy_j``: max U over the last
         :data:`RESIDUAL_WINDOW_S` [J].
     """
-    t = np.asarray(ds["time"].values, dtype=float)
-    power = np.abs(np.sum(ds["tau_applied"].values * ds["omega"].values, axis=1))
-    elastic = np.asarray(ds["elastic_energy"].values, dtype=float)
+    v = ds.variables  # the arrays, without building a DataArray per lookup
+    t = np.asarray(v["time"].values, dtype=float)
+    power = np.abs(np.sum(v["tau_applied"].values * v["omega"].values, axis=1))
+    elastic = np.asarray(v["elastic_energy"].values, dtype=float)
     last = t >= t[-1] - RESIDUAL_WINDOW_S - 1e-9
     return {
         "control_energy_j": float(np.trapezoid(power, t)) if t.size > 1 else 0.0,

@@ -87,7 +87,8 @@ def finite_part(ds: xr.Dataset) -> xr.Dataset:
         Its finite leading records.
     """
     bad = np.zeros(ds.sizes["time"], dtype=bool)
-    for var in ds.data_vars.values():
+    # the variables themselves: ds.data_vars.values() builds a DataArray for each
+    for var in ds.data_vars.variables.values():
         if "time" in var.dims and np.issubdtype(var.dtype, np.floating):
             by_time = var if var.dims[0] == "time" else var.transpose("time", ...)
             values = by_time.values.reshape(ds.sizes["time"], -1)

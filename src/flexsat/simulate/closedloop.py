@@ -327,31 +327,36 @@ def finish_slew(run: PreparedSlew, status: int, done: int, rows: int, wall: floa
     # gain (3), environment (3), sloshing ratio and Hz, residual (3), T_max
     attrs["realised_disturbances"] = data.actuator_params[len(layout.actuators) - 1].tolist()
     at = layout.plant  # where each piece of the plant state lives
+    ta = ("time", "axis")
+
+    def added(data_vars: dict) -> dict:
+        """The control channels, pointing and rate errors, from the records."""
+        more = {}
+        for channel, columns in layout.channels():
+            values = rec_ctrl[:, columns] if channel.per_axis else rec_ctrl[:, columns.start]
+            attributes = {"units": channel.units, "long_name": channel.description}
+            more[channel.name] = (ta if channel.per_axis else "time", values, attributes)
+        # of the true attitude (relative to N), whatever the sensor measured
+        q_N, omega = data_vars["q"][1], data_vars["omega"][1]
+        pointing = pointing_errors(target, np.ascontiguousarray(q_N[:, at.attitude]))
+        more["pointing_error_deg"] = (
+            "time", np.degrees(pointing),
+            {"units": "deg", "long_name": "2 asin |q_v,e| of the true attitude from the "
+             "target: absolute pointing error"},
+        )  # fmt: skip
+        with np.errstate(over="ignore", invalid="ignore"):  # a diverged run's last state
+            rate_error = np.degrees(np.linalg.norm(omega, axis=1))
+        more["rate_error_deg_s"] = (
+            "time", rate_error,
+            {"units": "deg/s", "long_name": "|omega - omega_d|: residual rate (jitter)"},
+        )  # fmt: skip
+        return more
+
     ds = build_dataset(
         plant, rec_t, rec_x[:, at.q], rec_x[:, at.qd], rec_x[:, at.work_in],
         rec_x[:, at.dissipated], rec_ctrl[:, layout.tau_cmd], rec_ctrl[:, layout.tau_applied],
-        attrs, frames=rec_frame, joint_force=rec_Q, solved=rec_solved,
+        attrs, frames=rec_frame, joint_force=rec_Q, solved=rec_solved, more=added,
     )  # fmt: skip
-    ta = ("time", "axis")
-    added = {}  # one assign: each ``ds[name] =`` would re-merge the whole dataset
-    for channel, columns in layout.channels():
-        values = rec_ctrl[:, columns] if channel.per_axis else rec_ctrl[:, columns.start]
-        attributes = {"units": channel.units, "long_name": channel.description}
-        added[channel.name] = (ta if channel.per_axis else "time", values, attributes)
-    # of the true attitude, whatever the sensor measured
-    pointing = pointing_errors(target, np.ascontiguousarray(ds["q"].values[:, at.attitude]))
-    added["pointing_error_deg"] = (
-        "time", np.degrees(pointing),
-        {"units": "deg", "long_name": "2 asin |q_v,e| of the true attitude from the "
-         "target: absolute pointing error"},
-    )  # fmt: skip
-    with np.errstate(over="ignore", invalid="ignore"):  # a diverged run's last state
-        rate_error = np.degrees(np.linalg.norm(ds["omega"].values, axis=1))
-    added["rate_error_deg_s"] = (
-        "time", rate_error,
-        {"units": "deg/s", "long_name": "|omega - omega_d|: residual rate (jitter)"},
-    )  # fmt: skip
-    ds = ds.assign(added)
     return Result(ds)
 
 

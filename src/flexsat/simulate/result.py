@@ -17,6 +17,7 @@ a result needs neither matplotlib nor the analysis modules.
 from __future__ import annotations
 
 import shutil
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -244,6 +245,7 @@ def build_dataset(
     frames: np.ndarray | None = None,
     joint_force: np.ndarray | None = None,
     solved: np.ndarray | None = None,
+    more: Callable[[dict], dict] | None = None,
 ) -> xr.Dataset:
     """Derive every recorded quantity from the recorded states.
 
@@ -279,6 +281,10 @@ def build_dataset(
         compiled loop has them for, rows of NaN elsewhere [m/s^2, rad/s^2; N, N m]
         (``PreparedSlew.rec_solved``); the missing rows are solved for and written
         into it. Default: all solved for.
+    more : callable, optional
+        Given the data variables (name -> (dims, values, attributes)), returns more
+        of them, added before the dataset is built: one construction instead of a
+        merge per call of ``Dataset.assign`` (about 2 ms on a 6000-record slew).
     """
     m, n = q.shape
     names = [a.name for a in plant.config.appendages]
@@ -356,6 +362,8 @@ def build_dataset(
             "generalized forces of the joint actuators, held from each record (zero on "
             "the hub coordinates)",
         )  # fmt: skip
+    if more is not None:
+        data_vars.update(more(data_vars))
     coords = {
         "time": ("time", t, {"units": "s", "long_name": "time since the start of the run"}),
         "axis": list(AXES),
