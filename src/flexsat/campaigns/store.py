@@ -35,7 +35,7 @@ import pandas as pd
 import xarray as xr
 
 from flexsat.errors import ConfigError
-from flexsat.jsonable import jsonable
+from flexsat.jsonable import dumps
 
 __all__ = ["HISTORY_UNITS", "CampaignStore"]
 
@@ -196,7 +196,7 @@ class CampaignStore:
         _write_atomic(marker, json.dumps(stored, indent=2))
 
     def write_case(self, row: dict) -> None:
-        _write_atomic(self.cases_dir / f"{row['case_id']}.json", json.dumps(jsonable(row)))
+        _write_atomic(self.cases_dir / f"{row['case_id']}.json", dumps(row))
 
     def write_history(self, case_id: str, data: dict, status: str = "ok") -> Path:
         """Store a case's time history (arrays or lists keyed as :data:`HISTORY_UNITS`,

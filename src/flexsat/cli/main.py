@@ -24,7 +24,7 @@ from rich.table import Table
 from flexsat import __version__
 from flexsat._compiled_cache import kernels_cached
 from flexsat.errors import MAX_MESSAGE_CHARS, FlexsatError, shorten
-from flexsat.jsonable import jsonable
+from flexsat.jsonable import dumps
 
 __all__ = ["app", "main"]
 
@@ -115,7 +115,7 @@ def modal(
         raise FlexsatError(f"--animate: mode index must be in 1..{n_modes}, got {bad}")
     _, summary = write_modal(plant, out, animate)
     if json_output:
-        typer.echo(json.dumps(jsonable(summary)))
+        typer.echo(dumps(summary))
         return
     _print_modal(summary)
 
@@ -177,7 +177,7 @@ def linearize(
     plant = Plant.from_config(load_config(config))
     _, summary = write_linearize(plant, spin, groups, reduction, out, actuated)
     if json_output:
-        typer.echo(json.dumps(jsonable(summary)))
+        typer.echo(dumps(summary))
         return
     table = Table(title=f"Linear model about {summary['about']} — {summary['config_name']}")
     for column in ("mode", "f [Hz]", "damping ratio"):
@@ -228,7 +228,7 @@ def margins(
         summary["family"] = family["cases"]
         summary["files"] = summary.get("files", []) + family.get("files", [])
     if json_output:
-        typer.echo(json.dumps(jsonable(summary)))
+        typer.echo(dumps(summary))
         return
     table = Table(title=f"{summary['law'].upper()} loop margins — {summary['config_name']}")
     for column in ("axis", "PM [deg]", "at [Hz]", "GM", "delay margin [s]", "at [Hz]"):
@@ -296,7 +296,7 @@ def openloop(
         )
     result, metrics = fly_openloop(plant, chosen, out, progress=None if not json_output else False)
     if json_output:
-        typer.echo(json.dumps(jsonable(metrics)))
+        typer.echo(dumps(metrics))
     else:
         _print_metrics(metrics)
     if not result.ok:
@@ -378,7 +378,7 @@ def slew(
             failed.append(message)
     if json_output:
         payload = results if controller == "all" else next(iter(results.values()))
-        typer.echo(json.dumps(jsonable(payload)))
+        typer.echo(dumps(payload))
     elif controller == "all":
         _print_comparison(results)
     else:
@@ -556,7 +556,7 @@ def campaign(
         result.to_netcdf(target)
         metrics = result.metrics()  # R1-R3 from the case's stored scenario
         if json_output:
-            typer.echo(json.dumps(jsonable({**metrics, "files": [str(target)]})))
+            typer.echo(dumps({**metrics, "files": [str(target)]}))
             return
         _print_metrics({**metrics, "files": [str(target)]}, f"Replay of {case_id}")
         _console.print(f"replayed {case_id}: {result.dataset.attrs['status']}")
@@ -586,7 +586,7 @@ def campaign(
         runner=runner.value,
     )  # fmt: skip
     if json_output:
-        typer.echo(json.dumps(jsonable(summary)))
+        typer.echo(dumps(summary))
         return
     table = Table(title=f"Campaign {definition.name}: {summary['cases']} cases")
     table.add_column("metric", no_wrap=True)

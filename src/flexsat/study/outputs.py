@@ -8,14 +8,13 @@ the one source of the numbers that the CLI prints and the study report shows.
 
 from __future__ import annotations
 
-import json
 import tempfile
 from collections.abc import Callable
 from pathlib import Path
 from typing import TYPE_CHECKING
 
 from flexsat.errors import ConfigError
-from flexsat.jsonable import jsonable
+from flexsat.jsonable import dumps
 
 if TYPE_CHECKING:  # the CLI imports this module at start-up: keep numba out of it
     from flexsat.dynamics.plant import Plant
@@ -81,7 +80,7 @@ def write_json(path: str | Path, payload: dict) -> Path:
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     partial = path.with_suffix(path.suffix + ".partial")
-    partial.write_text(json.dumps(jsonable(payload), indent=2, allow_nan=False))
+    partial.write_text(dumps(payload, indent=2))
     partial.replace(path)
     return path
 
