@@ -30,6 +30,7 @@ __all__ = [
     "euler_rate_matrix_cs",
     "euler_rate_matrix_inv",
     "euler_rate_matrix_inv_cs",
+    "inverse3",
     "load_m33",
     "load_m33_at",
     "load_seg",
@@ -259,6 +260,31 @@ def mtm(a, b):
         The product [unit of a times unit of b].
     """
     return mm(transpose(a), b)
+
+
+@njit(cache=True, error_model="numpy")
+def inverse3(a):
+    """The inverse of a non-singular 3x3 matrix: its adjugate over its determinant.
+
+    Straight-line arithmetic in registers, one division: for the small solves inside
+    the dynamics kernels (a hub's or a joint's 3 x 3 blocks), where a loop with
+    pivoting would cost several times more.
+
+    Parameters
+    ----------
+    a : tuple of 3 rows of 3 float
+        The matrix [any].
+
+    Returns
+    -------
+    tuple of 3 rows of 3 float
+        Its inverse [1 / unit of a].
+    """
+    c0 = cross(a[1], a[2])
+    c1 = cross(a[2], a[0])
+    c2 = cross(a[0], a[1])
+    f = 1.0 / dot(a[0], c0)
+    return transpose((scale(f, c0), scale(f, c1), scale(f, c2)))
 
 
 @njit(cache=True, error_model="numpy")

@@ -35,12 +35,11 @@ class PackedPlant(NamedTuple):
         Hub inertia about its centre of mass, frame B, and its inverse [kg m^2].
     articulated : bool
         True if an appendage transmits articulated inertia (then the hub solve is the
-        6 x 6 system; else the bare hub's Newton-Euler equations).
+        6 x 6 system, solved by 3 x 3 block elimination; else the bare hub's
+        Newton-Euler equations).
     hub : ndarray, shape (HUB_SIZE,)
         Exchange array between the engine and the kernels (scratch, overwritten by
         every evaluation; slots in the contract module) [SI per slot].
-    solve : ndarray, shape (6, 7)
-        Scratch of the 6 x 6 hub solve [SI].
     constrained : bool
         True if some appendage coordinates are locked (held at their initial value) [-];
         ``reaction[1]`` then holds their constraint forces.
@@ -80,7 +79,6 @@ class PackedPlant(NamedTuple):
     hub_J_inv: np.ndarray
     articulated: bool
     hub: np.ndarray
-    solve: np.ndarray
     constrained: bool
     held: np.ndarray
     locked: bool

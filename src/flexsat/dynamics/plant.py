@@ -186,7 +186,6 @@ class Plant:
             articulated=any(m.transmits_inertia or k in locking
                             for k, m in enumerate(self.models)),
             hub=np.zeros(HUB_SIZE),
-            solve=np.zeros((6, 7)),
             constrained=bool(locked),
             held=np.array(held, dtype=np.int64),
             locked=projected,

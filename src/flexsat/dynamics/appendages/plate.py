@@ -263,16 +263,6 @@ def _axpy(a, s, b):
     return (add(a[0], scale(s, b[0])), add(a[1], scale(s, b[1])), add(a[2], scale(s, b[2])))
 
 
-@njit(cache=True, error_model="numpy")
-def _inverse3(a):
-    """The inverse of a 3 x 3 matrix (adjugate over determinant; D is positive definite)."""
-    c0 = cross(a[1], a[2])
-    c1 = cross(a[2], a[0])
-    c2 = cross(a[0], a[1])
-    f = 1.0 / dot(a[0], c0)
-    return transpose((scale(f, c0), scale(f, c1), scale(f, c2)))
-
-
 # Scratch of a plate on a spherical joint (root translations locked, rotations free),
 # after the pass-1 rows above: what pass 2 reads.
 W_SPH_R_P = W_MZ  # (3) r_P, the root, frame B [m]
