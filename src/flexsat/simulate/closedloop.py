@@ -353,9 +353,8 @@ def finish_slew(run: PreparedSlew, status: int, done: int, rows: int, wall: floa
         return more
 
     ds = build_dataset(
-        plant, rec_t, rec_x[:, at.q], rec_x[:, at.qd], rec_x[:, at.work_in],
-        rec_x[:, at.dissipated], rec_ctrl[:, layout.tau_cmd], rec_ctrl[:, layout.tau_applied],
-        attrs, frames=rec_frame, joint_force=rec_Q, solved=rec_solved, more=added,
+        plant, rec_t, rec_x, rec_ctrl[:, layout.tau_cmd], rec_ctrl[:, layout.tau_applied], attrs,
+        frames=rec_frame, joint_force=rec_Q, solved=rec_solved, more=added,
     )  # fmt: skip
     return Result(ds)
 
