@@ -12,7 +12,7 @@ from flexsat.control import StageConfig, StageSpec, register_stage
 from flexsat.control.stages import ACTUATOR_SIGNATURE, ACTUATORS
 from flexsat.simulate import SlewScenario, closedloop, run_slew
 from flexsat.simulate.closedloop import prepare_slew
-from flexsat.simulate.loops import CHAIN_SLOTS
+from flexsat.simulate.coupled import CHAIN_SLOTS
 
 SHORT = {"duration_s": 1.0}
 AVIONICS = {  # four sensing stages, three actuation stages (two of them integrate states)

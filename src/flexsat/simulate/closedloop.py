@@ -440,7 +440,7 @@ def loop_stages(scenario: SlewScenario) -> LoopStages:
 
     Each is compiled with its role's signature on first use and cached on disk
     (:func:`flexsat.dynamics.packed.first_class`); no plant is needed. The chains are
-    padded to a multiple of :data:`~flexsat.simulate.loops.CHAIN_SLOTS` entries.
+    padded to a multiple of :data:`~flexsat.simulate.coupled.CHAIN_SLOTS` entries.
 
     Parameters
     ----------
@@ -466,7 +466,7 @@ def loop_stages(scenario: SlewScenario) -> LoopStages:
 
 
 def _padded(entries: tuple, filler=None) -> tuple:
-    """``entries`` padded to a multiple of :data:`~flexsat.simulate.loops.CHAIN_SLOTS`
+    """``entries`` padded to a multiple of :data:`~flexsat.simulate.coupled.CHAIN_SLOTS`
     with ``filler`` (default: the first entry), so every chain of up to that many
     stages has one numba type and shares one compiled loop; the loop never reads the
     padding (it runs the chain's own stages, ``LoopStages.n_sensor``, ``n_actuator``).

@@ -24,7 +24,12 @@ from flexsat.dynamics.kernels import hub_cs
 from flexsat.dynamics.linalg3 import euler_rate_matrix_cs, load_seg, mv
 from flexsat.dynamics.status import STATUS_NOT_FINITE, STATUS_OK
 
-__all__ = ["LoopFlow", "chain_wrench", "rk4_coupled_hold", "rk4_coupled_step"]
+__all__ = ["CHAIN_SLOTS", "LoopFlow", "chain_wrench", "rk4_coupled_hold", "rk4_coupled_step"]
+
+CHAIN_SLOTS = 4
+"""Entries per block of a chain's padded tuples: every chain of up to this many stages
+shares one compiled loop (the built-in stages make at most 4 per chain), and the
+loops call these first stages by literal index."""
 
 
 class LoopFlow(NamedTuple):
@@ -38,7 +43,7 @@ class LoopFlow(NamedTuple):
         The chain's state at an RK4 stage and its rate [per stage, per stage per s].
     eval_views, dot_views : tuple of ndarray
         Each stage's piece of ``eval`` and ``dot`` [per stage] (padded like the
-        chain's tuples, :data:`flexsat.simulate.loops.CHAIN_SLOTS`).
+        chain's tuples, :data:`CHAIN_SLOTS`).
     rates : ndarray, shape (m,)
         The RK4 stages' weighted sum k1 + 2 k2 + 2 k3 + k4 of the chain's state
         rate, accumulated as the stages are evaluated [per stage per s].
@@ -75,10 +80,8 @@ def chain_wrench(x, n, t, cs, derivatives, params, flow):
     derivative takes too: at every RK4 stage they are computed once for both.
     Inlined where it is called, with element loops instead of slice assignments: the
     RK4 stages evaluate it four times per step, and this form costs about 0.25 us per
-    step less (measured, ``docs/performance.md``). The first stage is called by its
-    literal index: indexing the padded tuples with a loop variable copies each tuple
-    to the stack on every call, about 0.2 us per coupled step with one continuous
-    stage (the reaction wheels).
+    step less (measured, ``docs/performance.md``). The stages are called by literal
+    index (:func:`_derive`).
 
     Parameters
     ----------
@@ -109,15 +112,29 @@ def chain_wrench(x, n, t, cs, derivatives, params, flow):
     wrench[0], wrench[1], wrench[2] = 0.0, 0.0, 0.0
     S = euler_rate_matrix_cs(cs[0], cs[1], cs[2], cs[3])
     omega[0], omega[1], omega[2] = mv(S, load_seg(x, n + 3))
-    status = 0
     count = flow.n_derivative
-    if count > 0:
-        status |= derivatives[0](x, n, t, omega, params[0], flow.eval_views[0],
-                                 flow.dot_views[0], wrench)  # fmt: skip
-    for i in range(1, count):
-        status |= derivatives[i](x, n, t, omega, params[i], flow.eval_views[i],
-                                 flow.dot_views[i], wrench)  # fmt: skip
+    status = 0
+    if count > 0:  # by literal index (see _derive)
+        status |= _derive(0, x, n, t, derivatives, params, flow)
+    if count > 1:
+        status |= _derive(1, x, n, t, derivatives, params, flow)
+    if count > 2:
+        status |= _derive(2, x, n, t, derivatives, params, flow)
+    if count > 3:
+        status |= _derive(3, x, n, t, derivatives, params, flow)
+    for i in range(CHAIN_SLOTS, count):
+        status |= _derive(i, x, n, t, derivatives, params, flow)
     return status
+
+
+@njit(cache=True, inline="always")
+def _derive(i, x, n, t, derivatives, params, flow):
+    """Stage ``i``'s derivative. Inlined, a literal ``i`` makes every tuple access
+    static: indexing the padded tuples with a loop variable copies each tuple to the
+    stack on every access, about 0.2 us per coupled step with one continuous stage
+    (docs/performance.md, 'Stages by literal index')."""
+    return derivatives[i](x, n, t, flow.omega, params[i], flow.eval_views[i],
+                          flow.dot_views[i], flow.wrench)  # fmt: skip
 
 
 @njit(cache=True, inline="always")

@@ -4,9 +4,9 @@ Each control instant runs them in that order; the RK4 plant steps in between (nu
 
 The stages and the law are numba first-class functions handed over in tuples
 (:class:`LoopStages`), typed by their signatures. The chains' tuples are padded to a
-multiple of :data:`CHAIN_SLOTS` entries and the loop runs the active ones only
-(``n_sensor``, ``n_actuator``), so it is compiled once for every chain of up to
-:data:`CHAIN_SLOTS` stages (a longer one adds a specialization), cached across
+multiple of :data:`~flexsat.simulate.coupled.CHAIN_SLOTS` entries and the loop runs
+the active ones only (``n_sensor``, ``n_actuator``), so it is compiled once for every
+chain of up to that many stages (a longer one adds a specialization), cached across
 processes, and runs any law or stage of those signatures, a user's own included.
 They run every ``control_every`` plant steps and their outputs are held in between
 (zero-order hold). An actuation stage with a derivative integrates its states with
@@ -32,10 +32,9 @@ from flexsat.dynamics.integrators import augmented_derivative, rk4_step
 from flexsat.dynamics.kernels import hub_cs, keep_solution
 from flexsat.dynamics.linalg3 import copy_into
 from flexsat.dynamics.status import STATUS_CONTROL_FAILED, STATUS_OK
-from flexsat.simulate.coupled import LoopFlow, chain_wrench, rk4_coupled_step
+from flexsat.simulate.coupled import CHAIN_SLOTS, LoopFlow, chain_wrench, rk4_coupled_step
 
 __all__ = [
-    "CHAIN_SLOTS",
     "LoopClock",
     "LoopData",
     "LoopRecords",
@@ -44,11 +43,6 @@ __all__ = [
     "run_actuators",
     "run_sensors",
 ]
-
-
-CHAIN_SLOTS = 4
-"""Entries per block of a chain's padded tuples: every chain of up to this many stages
-shares one compiled loop (the built-in stages make at most 4 per chain)."""
 
 
 class LoopClock(NamedTuple):
@@ -85,8 +79,8 @@ class LoopStages(NamedTuple):
     """The compiled steps, tuples of first-class functions (chains in order).
 
     The chains' tuples (and :class:`LoopData`'s per-stage tuples) are padded to a
-    multiple of :data:`CHAIN_SLOTS` entries; the loop calls the first ``n_sensor``
-    and ``n_actuator`` only.
+    multiple of :data:`~flexsat.simulate.coupled.CHAIN_SLOTS` entries; the loop calls
+    the first ``n_sensor`` and ``n_actuator`` only.
 
     Attributes
     ----------
@@ -258,11 +252,31 @@ def run_sensors(x, n, t, stages, d):
     int
         0, or the OR of the stages' non-zero statuses.
     """
+    count = stages.n_sensor
     status = 0
-    for i in range(stages.n_sensor):
-        status |= stages.sensor[i](x, n, t, d.sensor_params[i], d.sensor_state[i], d.q_meas,
-                                   d.omega_meas, d.sensor_record[i])  # fmt: skip
+    # The first CHAIN_SLOTS stages by literal index (see _sense), the rest of a longer
+    # chain by a loop variable.
+    if count > 0:
+        status |= _sense(0, x, n, t, stages, d)
+    if count > 1:
+        status |= _sense(1, x, n, t, stages, d)
+    if count > 2:
+        status |= _sense(2, x, n, t, stages, d)
+    if count > 3:
+        status |= _sense(3, x, n, t, stages, d)
+    for i in range(CHAIN_SLOTS, count):
+        status |= _sense(i, x, n, t, stages, d)
     return status
+
+
+@njit(cache=True, inline="always")
+def _sense(i, x, n, t, stages, d):
+    """Sensing stage ``i``. Inlined, a literal ``i`` makes every tuple access static:
+    indexing the padded tuples with a loop variable copies each tuple to the stack on
+    every access, which inside the loop cost about as much as the call itself
+    (docs/performance.md, 'Stages by literal index')."""
+    return stages.sensor[i](x, n, t, d.sensor_params[i], d.sensor_state[i], d.q_meas,
+                            d.omega_meas, d.sensor_record[i])  # fmt: skip
 
 
 @njit(cache=True, inline="always")
@@ -299,12 +313,15 @@ def run_actuators(x, n, t, control_dt, continuous, stages, d):
         d.tau_cmd, t, control_dt, d.actuator_params[0], d.actuator_state[0], d.tau_applied,
         d.actuator_record[0],
     )  # fmt: skip
-    for i in range(1, stages.n_actuator):
-        copy_into(d.tau_between, d.tau_applied)
-        status |= stages.actuator[i](
-            d.tau_between, t, control_dt, d.actuator_params[i], d.actuator_state[i],
-            d.tau_applied, d.actuator_record[i],
-        )  # fmt: skip
+    count = stages.n_actuator
+    if count > 1:  # by literal index, as run_sensors
+        status |= _actuate(1, t, control_dt, stages, d)
+    if count > 2:
+        status |= _actuate(2, t, control_dt, stages, d)
+    if count > 3:
+        status |= _actuate(3, t, control_dt, stages, d)
+    for i in range(CHAIN_SLOTS, count):
+        status |= _actuate(i, t, control_dt, stages, d)
     if continuous:
         flow = d.flow
         copy_into(flow.held, d.tau_applied)
@@ -313,6 +330,15 @@ def run_actuators(x, n, t, control_dt, continuous, stages, d):
         for a in range(3):
             d.tau_applied[a] += flow.wrench[a]
     return status
+
+
+@njit(cache=True, inline="always")
+def _actuate(i, t, control_dt, stages, d):
+    """Actuation stage ``i`` > 0 on the previous stage's output (a literal ``i``: as
+    :func:`_sense`)."""
+    copy_into(d.tau_between, d.tau_applied)
+    return stages.actuator[i](d.tau_between, t, control_dt, d.actuator_params[i],
+                              d.actuator_state[i], d.tau_applied, d.actuator_record[i])  # fmt: skip
 
 
 @njit(cache=True)

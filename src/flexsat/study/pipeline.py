@@ -360,7 +360,7 @@ def _compile_runs(ctx: StudyContext) -> list[tuple[dict | str | None, frozenset[
     In the order two compiling processes take them (:func:`_compile`): the first law's
     slew, which builds the study's plant (its plates' kernels) and compiles the closed
     loop every other slew shares (one numba type for every stage chain of up to four
-    stages, :data:`flexsat.simulate.loops.CHAIN_SLOTS`). Meanwhile the other process
+    stages, :data:`flexsat.simulate.coupled.CHAIN_SLOTS`). Meanwhile the other process
     compiles what needs neither: ``"stages"``, the laws and stages of the other runs
     (they need no plant), then ``"drive plant"`` (its chain kernels; its plates are
     tuned on the plates' kernels, which the first process has cached by then), then
