@@ -32,8 +32,10 @@ def _flown(plant: Plant, scenario: SlewScenario):
 
 def _datasets(run, rows: int):
     """The records derived from the kept rows and from fresh solves."""
-    rec_ctrl = run.rec_ctrl[:rows]
-    args = (run.plant, run.rec_t[:rows], run.rec_x[:rows], rec_ctrl[:, run.layout.tau_cmd],
+    at = run.layout.plant
+    rec_x, rec_ctrl = run.rec_x[:rows], run.rec_ctrl[:rows]
+    args = (run.plant, run.rec_t[:rows], rec_x[:, at.q], rec_x[:, at.qd],
+            rec_x[:, at.work_in], rec_x[:, at.dissipated], rec_ctrl[:, run.layout.tau_cmd],
             rec_ctrl[:, run.layout.tau_applied], {})  # fmt: skip
     common = {"frames": run.rec_frame[:rows], "joint_force": run.rec_Q[:rows]}
     kept = build_dataset(*args, **common, solved=run.rec_solved[:rows].copy())

@@ -40,17 +40,15 @@ __all__ = ["derive_records"]
 
 @njit(cache=True)
 def derive_records(
-    x, tau_B, joint_force, solved, packed,
+    q, qd, tau_B, joint_force, solved, packed,
     omega, omega_dot, tau_flex, H, H_rigid, kinetic, elastic, tips,
 ):  # fmt: skip
     """Fill the derived arrays, row by row, from recorded states.
 
     Parameters
     ----------
-    x : ndarray, shape (m, 2 n_dof + 2), C order
-        Recorded augmented states [q, q_dot, W_in, W_diss] (the loops' record rows):
-        generalized coordinates [m, rad] and rates [m/s, rad/s] first. Each row's
-        q and q_dot are read in place (no copy of the columns).
+    q, qd : ndarray, shape (m, n_dof)
+        Recorded generalized coordinates [m, rad] and rates [m/s, rad/s].
     tau_B : ndarray, shape (m, 3)
         Applied body torque at each record [N m].
     joint_force : ndarray, shape (m, n_dof)
@@ -83,30 +81,30 @@ def derive_records(
     row whose state is singular (the last state of a failed run) gets NaN
     accelerations and joint torque.
     """
-    n = packed.n_dof
-    _derive_rows(x, tau_B, joint_force, solved, packed, omega, omega_dot, tau_flex, H,
+    n = q.shape[1]
+    _derive_rows(q, qd, tau_B, joint_force, solved, packed, omega, omega_dot, tau_flex, H,
                  H_rigid, kinetic, elastic, tips, np.zeros(n), np.empty(n), np.empty(6),
                  np.empty(OBS_SIZE))  # fmt: skip
 
 
 @njit(cache=True)
 def _derive_rows(
-    x, tau_B, joint_force, solved, packed,
+    q, qd, tau_B, joint_force, solved, packed,
     omega, omega_dot, tau_flex, H, H_rigid, kinetic, elastic, tips,
     Q, joint, wrench, obs,
 ):  # fmt: skip
     """:func:`derive_records` on work arrays its caller owns: Q and the joint forces
     (n_dof,), the hub wrench (6,), the observation row (``OBS_SIZE``); all borrowed
     (:mod:`flexsat.dynamics.borrowed`)."""
-    x, tau_B, joint_force, solved = borrowed((x, tau_B, joint_force, solved))
+    q, qd, tau_B, joint_force, solved = borrowed((q, qd, tau_B, joint_force, solved))
     packed = borrowed(packed)
     omega, omega_dot, tau_flex, H = borrowed((omega, omega_dot, tau_flex, H))
     H_rigid, kinetic, elastic, tips = borrowed((H_rigid, kinetic, elastic, tips))
     Q, joint, wrench, obs = borrowed((Q, joint, wrench, obs))
-    m, n = x.shape[0], packed.n_dof
+    m, n = q.shape
     L = OBS_LOCKED_INERTIA
     for k in range(m):
-        qk, qdk = x[k, :n], x[k, n : 2 * n]
+        qk, qdk = q[k], qd[k]
         S = euler_rate_matrix(qk[3], qk[4])
         w = mv(S, load_seg(qdk, 3))
         omega[k, 0], omega[k, 1], omega[k, 2] = w

@@ -30,10 +30,9 @@ from flexsat.dynamics.status import STATUS_CONTROL_FAILED
 from flexsat.errors import ConfigError, SimulationError
 from flexsat.simulate.batch import fly, slew_timing
 from flexsat.simulate.common import PROGRESS_MIN_STEPS, progress_bar, run_attributes
-from flexsat.simulate.coupled import LoopFlow, rk4_coupled_hold
+from flexsat.simulate.coupled import CHAIN_SLOTS, LoopFlow, rk4_coupled_hold
 from flexsat.simulate.layout import LoopLayout
 from flexsat.simulate.loops import (
-    CHAIN_SLOTS,
     LoopClock,
     LoopData,
     LoopRecords,
@@ -353,8 +352,9 @@ def finish_slew(run: PreparedSlew, status: int, done: int, rows: int, wall: floa
         return more
 
     ds = build_dataset(
-        plant, rec_t, rec_x, rec_ctrl[:, layout.tau_cmd], rec_ctrl[:, layout.tau_applied], attrs,
-        frames=rec_frame, joint_force=rec_Q, solved=rec_solved, more=added,
+        plant, rec_t, rec_x[:, at.q], rec_x[:, at.qd], rec_x[:, at.work_in],
+        rec_x[:, at.dissipated], rec_ctrl[:, layout.tau_cmd], rec_ctrl[:, layout.tau_applied],
+        attrs, frames=rec_frame, joint_force=rec_Q, solved=rec_solved, more=added,
     )  # fmt: skip
     return Result(ds)
 

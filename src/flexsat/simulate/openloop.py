@@ -190,13 +190,15 @@ def _temporary_record_file() -> Path:
 
 def _block(plant, t, X, tau, F, profile, attrs, stream) -> xr.Dataset:
     """The dataset of consecutive records (all of a run's, or one streamed block)."""
+    lay = plant.layout
     seg_start, seg_end, seg_torque, _ = profile
     tau_cmd = np.array(
         [applied_torque(tk, seg_start, seg_end, seg_torque, np.zeros(3)) for tk in t]
     ).reshape(-1, 3)
     energy0 = None if stream is None else stream.energy0
     return build_dataset(
-        plant, t, X, tau_cmd, tau, dict(attrs), energy0, frames=F,
+        plant, t, X[:, lay.q], X[:, lay.qd], X[:, lay.work_in], X[:, lay.dissipated], tau_cmd,
+        tau, dict(attrs), energy0, frames=F,
     )  # fmt: skip
 
 

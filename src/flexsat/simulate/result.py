@@ -234,7 +234,10 @@ class Result:
 def build_dataset(
     plant: Plant,
     t: np.ndarray,
-    x: np.ndarray,
+    q: np.ndarray,
+    qd: np.ndarray,
+    work_in: np.ndarray,
+    dissipated: np.ndarray,
     tau_cmd: np.ndarray,
     tau_applied: np.ndarray,
     attrs: dict,
@@ -252,11 +255,10 @@ def build_dataset(
         The plant that flew the run.
     t : ndarray, shape (m,)
         Record times [s].
-    x : ndarray, shape (m, 2 n_dof + 2)
-        Recorded augmented states [q, q_dot, W_in, W_diss], the loops' record rows:
-        generalized coordinates [m, rad], their rates [m/s, rad/s], the cumulative
-        work of the applied torque and the damper dissipation [J]. Read in place
-        (a C-ordered array is not copied).
+    q, qd : ndarray, shape (m, n_dof)
+        Recorded generalized coordinates [m, rad] and rates [m/s, rad/s].
+    work_in, dissipated : ndarray, shape (m,)
+        Cumulative work of the applied torque and damper dissipation [J].
     tau_cmd, tau_applied : ndarray, shape (m, 3)
         Commanded and applied body torque held from each record time [N m].
     attrs : dict
@@ -284,10 +286,7 @@ def build_dataset(
         of them, added before the dataset is built: one construction instead of a
         merge per call of ``Dataset.assign`` (about 2 ms on a 6000-record slew).
     """
-    x = np.ascontiguousarray(x, dtype=float)
-    lay = plant.layout
-    m, n = x.shape[0], lay.n_dof
-    q, qd, work_in, dissipated = x[:, lay.q], x[:, lay.qd], x[:, lay.work_in], x[:, lay.dissipated]
+    m, n = q.shape
     names = [a.name for a in plant.config.appendages]
     n_app = len(names)
     omega = np.empty((m, 3))
@@ -304,8 +303,9 @@ def build_dataset(
     # A diverged run keeps its last finite state, whose derived values may overflow.
     with np.errstate(over="ignore", invalid="ignore"):
         derive_records(
-            x, np.ascontiguousarray(tau_applied), joints, kept, plant.packed, omega, omega_dot,
-            tau_flex, H, H_rigid, kinetic, elastic, tips,
+            np.ascontiguousarray(q), np.ascontiguousarray(qd), np.ascontiguousarray(tau_applied),
+            joints, kept, plant.packed, omega, omega_dot, tau_flex, H, H_rigid, kinetic, elastic,
+            tips,
         )  # fmt: skip
     if frames is not None:  # relative to N: H_N = R_NF H_F (docs/model.md)
         q, qd = inertial_records(q, qd, omega, frames)
