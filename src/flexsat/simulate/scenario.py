@@ -46,6 +46,7 @@ __all__ = [
     "Requirements",
     "SlewScenario",
     "TorqueSegment",
+    "check_multiples_of_dt",
     "load_scenario",
     "load_slew",
     "pulse",
@@ -176,6 +177,31 @@ MAX_STEPS = 1e9
 default 1 ms step; about an hour of wall time on one core."""
 
 
+def check_multiples_of_dt(model: object, fields: tuple[str, ...]) -> None:
+    """Check that each named period of ``model`` is a whole multiple of its ``dt_s``.
+
+    Parameters
+    ----------
+    model : object
+        A config with a ``dt_s`` [s] and the named periods [s] as attributes.
+    fields : tuple of str
+        The periods' field names.
+
+    Raises
+    ------
+    ValueError
+        Naming the first period that is shorter than ``dt_s`` or not a whole
+        multiple of it (to 1e-6 relative).
+    """
+    for field in fields:
+        ratio = getattr(model, field) / model.dt_s
+        if ratio < 1.0 - 1e-9 or abs(ratio - round(ratio)) > 1e-6 * ratio:
+            raise ValueError(
+                f"{field} must be a whole multiple of dt_s ({model.dt_s}), "
+                f"got {getattr(model, field)}"
+            )
+
+
 class _TimedRun(_Frozen):
     """Duration, RK4 step and recording rate shared by every kind of run."""
 
@@ -194,13 +220,7 @@ class _TimedRun(_Frozen):
 
     @model_validator(mode="after")
     def _steps(self) -> _TimedRun:
-        for field in self._MULTIPLES_OF_DT:
-            ratio = getattr(self, field) / self.dt_s
-            if ratio < 1.0 - 1e-9 or abs(ratio - round(ratio)) > 1e-6 * ratio:
-                raise ValueError(
-                    f"{field} must be a whole multiple of dt_s ({self.dt_s}), "
-                    f"got {getattr(self, field)}"
-                )
+        check_multiples_of_dt(self, self._MULTIPLES_OF_DT)
         if self.duration_s < self.record_dt_s:
             raise ValueError(f"duration_s must be at least record_dt_s ({self.record_dt_s})")
         steps = self.duration_s / self.dt_s
