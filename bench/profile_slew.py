@@ -75,7 +75,7 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--top", type=int, default=25, help="symbols printed")
     parser.add_argument("--reduced", action="store_true",
                         help="the campaigns' reduced model: root translations locked, "
-                             "20 ms step, control period and records")  # fmt: skip
+                             "20 ms step and control period, 40 ms records")  # fmt: skip
     args = parser.parse_args(argv)
     if shutil.which("perf") is None:
         sys.exit("perf is not installed (Debian: linux-perf)")
@@ -86,7 +86,7 @@ def main(argv: list[str] | None = None) -> None:
             app.model_copy(update={"locked_dofs": reduced.locked_dofs})
             for app in config.appendages]})  # fmt: skip
         fields |= {"dt_s": reduced.dt_s, "control_dt_s": reduced.control_dt_s,
-                   "record_dt_s": reduced.dt_s}
+                   "record_dt_s": reduced.record_period_s}
     plant = Plant.from_config(config)
     scenario = SlewScenario.model_validate(fields)
     run_slew(plant, scenario.model_copy(update={"duration_s": 0.1}))  # compile
