@@ -61,6 +61,7 @@ from flexsat.dynamics.linalg3 import (
     euler_rate_matrix_cs,
     euler_rate_matrix_inv_cs,
     inverse3,
+    load_block33,
     load_seg,
     mm,
     mtm,
@@ -102,17 +103,6 @@ def _put(x, k, v):
 
 
 @njit(cache=True, error_model="numpy")
-def _block(hub, r0, c0):
-    """The 3 x 3 block at (r0, c0) of the summed articulated inertia (6 x 6, row-major)."""
-    k = HUB_INERTIA + 6 * r0 + c0
-    return (
-        (hub[k], hub[k + 1], hub[k + 2]),
-        (hub[k + 6], hub[k + 7], hub[k + 8]),
-        (hub[k + 12], hub[k + 13], hub[k + 14]),
-    )
-
-
-@njit(cache=True, error_model="numpy")
 def _solve_hub(packed, force_B, torque_B):
     """Hub accelerations (a_hub_B, omega_dot_B) under the summed articulated inertia.
 
@@ -126,19 +116,19 @@ def _solve_hub(packed, force_B, torque_B):
     """
     hub = packed.hub
     m = packed.hub_mass
-    P = _block(hub, 0, 0)
+    P = load_block33(hub, HUB_INERTIA, 0, 0)
     P = ((P[0][0] + m, P[0][1], P[0][2]), (P[1][0], P[1][1] + m, P[1][2]),
          (P[2][0], P[2][1], P[2][2] + m))  # fmt: skip
     J = packed.hub_J
-    D = _block(hub, 3, 3)
+    D = load_block33(hub, HUB_INERTIA, 3, 3)
     D = (
         (D[0][0] + J[0, 0], D[0][1] + J[0, 1], D[0][2] + J[0, 2]),
         (D[1][0] + J[1, 0], D[1][1] + J[1, 1], D[1][2] + J[1, 2]),
         (D[2][0] + J[2, 0], D[2][1] + J[2, 1], D[2][2] + J[2, 2]),
     )
-    C = _block(hub, 3, 0)
+    C = load_block33(hub, HUB_INERTIA, 3, 0)
     P_inv = inverse3(P)
-    X = mm(P_inv, _block(hub, 0, 3))
+    X = mm(P_inv, load_block33(hub, HUB_INERTIA, 0, 3))
     y = mv(P_inv, force_B)
     CX = mm(C, X)
     schur = (sub(D[0], CX[0]), sub(D[1], CX[1]), sub(D[2], CX[2]))

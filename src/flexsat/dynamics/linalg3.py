@@ -31,6 +31,7 @@ __all__ = [
     "euler_rate_matrix_inv",
     "euler_rate_matrix_inv_cs",
     "inverse3",
+    "load_block33",
     "load_m33",
     "load_m33_at",
     "load_seg",
@@ -515,6 +516,32 @@ def load_m33_at(x, k):
         (x[k], x[k + 1], x[k + 2]),
         (x[k + 3], x[k + 4], x[k + 5]),
         (x[k + 6], x[k + 7], x[k + 8]),
+    )
+
+
+@njit(cache=True, error_model="numpy")
+def load_block33(x, k, r0, c0):
+    """The 3x3 block at row r0, column c0 of a row-major 6x6 matrix packed at x[k:k+36].
+
+    Parameters
+    ----------
+    x : ndarray, shape (n,)
+        A packed array [any].
+    k : int
+        Offset of the 6x6 matrix's first entry.
+    r0, c0 : int
+        Row and column of the block's first entry (0 or 3).
+
+    Returns
+    -------
+    tuple of 3 rows of 3 float
+        The block [unit of x].
+    """
+    i = k + 6 * r0 + c0
+    return (
+        (x[i], x[i + 1], x[i + 2]),
+        (x[i + 6], x[i + 7], x[i + 8]),
+        (x[i + 12], x[i + 13], x[i + 14]),
     )
 
 

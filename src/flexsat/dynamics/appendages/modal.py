@@ -74,6 +74,7 @@ from flexsat.dynamics.linalg3 import (
     cross,
     dot,
     euler_rate_matrix,
+    load_block33,
     load_m33_at,
     load_seg,
     mm,
@@ -203,17 +204,6 @@ def _madd(a, b, s):
 
 
 @njit(cache=True, error_model="numpy")
-def _block(p, r0, c0):
-    """Block [r0:r0+3, c0:c0+3] of the packed residual mass M_rr - L^T L."""
-    k = P_RES + 6 * r0 + c0
-    return (
-        (p[k], p[k + 1], p[k + 2]),
-        (p[k + 6], p[k + 7], p[k + 8]),
-        (p[k + 12], p[k + 13], p[k + 14]),
-    )
-
-
-@njit(cache=True, error_model="numpy")
 def _add_inertia(hub, r0, c0, A):
     for a in range(3):
         for b in range(3):
@@ -271,9 +261,10 @@ def pass1(q, qd, Q, members, params, work, hub, qdd):
         c1 = add(load_seg(p, P_FIRST), s)  # c~ = m c + L_t^T eta
         # M_I = [[A, B], [C, D]] = M_res + [[0, -[s]x], [[s]x, J(eta) - J_I]], about I.
         S = skew(s)
-        A = _block(p, 0, 0)
-        D = _madd(_madd(_block(p, 3, 3), J, 1.0), load_m33_at(p, P_J_I), -1.0)
-        B, C = _madd(_block(p, 0, 3), S, -1.0), _madd(_block(p, 3, 0), S, 1.0)
+        A = load_block33(p, P_RES, 0, 0)
+        D = _madd(_madd(load_block33(p, P_RES, 3, 3), J, 1.0), load_m33_at(p, P_J_I), -1.0)
+        B = _madd(load_block33(p, P_RES, 0, 3), S, -1.0)
+        C = _madd(load_block33(p, P_RES, 3, 0), S, 1.0)
         # Wrench on the appendage at a_hub = 0, alpha = 0: M_I [w x (w x r); 0] + b_a.
         w2r = cross(omega, cross(omega, r))
         F = add(add(cross(omega, cross(omega, c1)), scale(2.0, cross(omega, s_dot))), g_t)
