@@ -88,3 +88,32 @@ def test_a_reduced_case_steps_controls_and_records_at_its_own_period():
     assert (case.scenario["dt_s"], case.scenario["control_dt_s"]) == (0.02, 0.02)
     assert case.scenario["record_dt_s"] == 0.04
     assert all(a["locked_dofs"] == ["eta_x", "eta_y", "eta_z"] for a in case.plant["appendages"])
+
+
+@pytest.mark.parametrize(
+    ("reduced", "fragment"),
+    [
+        ({"record_dt_s": 0.03}, "record_dt_s must be a whole multiple of dt_s (0.02), got 0.03"),
+        ({"record_dt_s": 0.01}, "record_dt_s must be a whole multiple of dt_s (0.02), got 0.01"),
+        ({"dt_s": 0.01, "control_dt_s": 0.015}, "control_dt_s must be a whole multiple"),
+    ],
+)
+def test_a_reduced_period_off_the_step_is_refused_naming_the_field(reduced, fragment):
+    from flexsat.errors import ConfigError
+
+    data = load_campaign("sensitivity").model_dump(mode="json")
+    data["reduced"] = reduced
+    with pytest.raises(ConfigError, match=fragment.replace("(", r"\(").replace(")", r"\)")):
+        validate_config(data, model=CampaignDefinition)
+
+
+def test_a_reduced_record_period_of_its_own_is_kept_and_a_longer_base_one_wins():
+    from flexsat.campaigns.definition import resolve_cases
+
+    data = load_campaign("sensitivity").model_dump(mode="json")
+    data["reduced"] = {"record_dt_s": 0.02}  # records at every step, as before 40 ms
+    case = resolve_cases(validate_config(data, model=CampaignDefinition), nominal())[0]
+    assert case.scenario["record_dt_s"] == 0.02
+    data["base"] = {**data["base"], "record_dt_s": 0.1}
+    case = resolve_cases(validate_config(data, model=CampaignDefinition), nominal())[0]
+    assert case.scenario["record_dt_s"] == 0.1
