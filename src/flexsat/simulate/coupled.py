@@ -28,8 +28,9 @@ __all__ = ["CHAIN_SLOTS", "LoopFlow", "chain_wrench", "rk4_coupled_hold", "rk4_c
 
 CHAIN_SLOTS = 4
 """Entries per block of a chain's padded tuples: every chain of up to this many stages
-shares one compiled loop (the built-in stages make at most 4 per chain), and the
-loops call these first stages by literal index."""
+shares one compiled loop (the built-in stages make at most 4 per chain)."""
+
+LITERAL_STAGES = 4  # stages 0-3 of a chain are called by literal index (see _derive)
 
 
 class LoopFlow(NamedTuple):
@@ -122,7 +123,7 @@ def chain_wrench(x, n, t, cs, derivatives, params, flow):
         status |= _derive(2, x, n, t, derivatives, params, flow)
     if count > 3:
         status |= _derive(3, x, n, t, derivatives, params, flow)
-    for i in range(CHAIN_SLOTS, count):
+    for i in range(LITERAL_STAGES, count):
         status |= _derive(i, x, n, t, derivatives, params, flow)
     return status
 

@@ -32,7 +32,7 @@ from flexsat.dynamics.integrators import augmented_derivative, rk4_step
 from flexsat.dynamics.kernels import hub_cs, keep_solution
 from flexsat.dynamics.linalg3 import copy_into
 from flexsat.dynamics.status import STATUS_CONTROL_FAILED, STATUS_OK
-from flexsat.simulate.coupled import CHAIN_SLOTS, LoopFlow, chain_wrench, rk4_coupled_step
+from flexsat.simulate.coupled import LITERAL_STAGES, LoopFlow, chain_wrench, rk4_coupled_step
 
 __all__ = [
     "LoopClock",
@@ -254,8 +254,8 @@ def run_sensors(x, n, t, stages, d):
     """
     count = stages.n_sensor
     status = 0
-    # The first CHAIN_SLOTS stages by literal index (see _sense), the rest of a longer
-    # chain by a loop variable.
+    # The first LITERAL_STAGES stages by literal index (see _sense), the rest of a
+    # longer chain by a loop variable.
     if count > 0:
         status |= _sense(0, x, n, t, stages, d)
     if count > 1:
@@ -264,7 +264,7 @@ def run_sensors(x, n, t, stages, d):
         status |= _sense(2, x, n, t, stages, d)
     if count > 3:
         status |= _sense(3, x, n, t, stages, d)
-    for i in range(CHAIN_SLOTS, count):
+    for i in range(LITERAL_STAGES, count):
         status |= _sense(i, x, n, t, stages, d)
     return status
 
@@ -320,7 +320,7 @@ def run_actuators(x, n, t, control_dt, continuous, stages, d):
         status |= _actuate(2, t, control_dt, stages, d)
     if count > 3:
         status |= _actuate(3, t, control_dt, stages, d)
-    for i in range(CHAIN_SLOTS, count):
+    for i in range(LITERAL_STAGES, count):
         status |= _actuate(i, t, control_dt, stages, d)
     if continuous:
         flow = d.flow
