@@ -196,7 +196,7 @@ class FirstClassKernel:
         return first_class, (self.dispatcher, self.signature)
 
 
-_KERNELS: dict[tuple[int, int], FirstClassKernel] = {}
+_KERNELS: dict[tuple[int, str], FirstClassKernel] = {}
 
 
 def first_class(dispatcher, signature) -> FirstClassKernel:
@@ -225,11 +225,9 @@ def first_class(dispatcher, signature) -> FirstClassKernel:
         If the kernel was declared with other signatures only, or does not compile
         with ``signature``.
     """
-    # Keyed by identity, not by the signature's text (formatting it cost about 0.1 ms per
-    # plant built, per campaign case). Each entry keeps its dispatcher and signature
-    # alive, so neither id is reused while cached; an equal signature built anew only
-    # adds an entry.
-    key = (id(dispatcher), id(signature))
+    # By the signature's text, not its identity: an unpickled kernel (another process)
+    # brings an equal signature that is a new object, and must find the same entry.
+    key = (id(dispatcher), str(signature))
     if key not in _KERNELS:
         name = getattr(dispatcher, "__name__", dispatcher)
         if signature.args not in dispatcher.signatures:
