@@ -126,3 +126,23 @@ def test_record_quaternions_are_scipys_zyx_rotations():
     xyzw = Rotation.from_euler("ZYX", euler[:, ::-1]).as_quat()
     expected = np.column_stack([xyzw[:, 3], xyzw[:, :3]])
     assert np.max(np.abs(_quaternions(euler) - expected)) <= 1e-15
+
+
+def test_the_dataset_built_from_its_parts_is_xarrays_own(slews):
+    # _dataset skips xarray's per-array checks; the result must be the dataset
+    # xr.Dataset(...) builds from the same pieces: same values, dims, dtypes
+    # (coordinates included) and attributes (identical, not only equal).
+    import xarray as xr
+
+    from flexsat.simulate.result import _dataset
+
+    ds = slews["asmc"].dataset
+    data_vars = {name: (var.dims, var.values, dict(var.attrs))
+                 for name, var in ds.data_vars.items()}  # fmt: skip
+    coords = {name: (ds[name].values, dict(ds[name].attrs)) for name in ds.dims}
+    built = _dataset(data_vars, coords, dict(ds.attrs))
+    expected = xr.Dataset(data_vars, coords={name: (name, *pair) for name, pair in coords.items()},
+                          attrs=dict(ds.attrs))  # fmt: skip
+    assert built.identical(expected) and built.identical(ds)
+    assert all(built[name].dtype == expected[name].dtype for name in coords)
+    assert built["dof"].dtype.kind == "U" and built["time"].attrs["units"] == "s"

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import numpy as np
-from scipy import signal
 
 __all__ = ["dominant_frequency"]
 
@@ -24,6 +23,10 @@ def dominant_frequency(values: np.ndarray, dt: float, min_hz: float = 0.0) -> fl
     min_hz : float
         Ignore lines below this frequency (drift) [Hz].
     """
+    # imported here: scipy.signal costs 0.6 s to import, and every campaign worker
+    # reaches this module through the slew metrics without calling it
+    from scipy import signal
+
     values = signal.detrend(np.asarray(values, dtype=float))
     freqs, power = signal.periodogram(values, fs=1.0 / dt, window="hann")
     power[freqs < max(min_hz, freqs[1])] = 0.0

@@ -17,7 +17,7 @@ from typing import Annotated, Any, Literal
 
 import numpy as np
 from pydantic import Field, model_validator
-from scipy import special, stats
+from scipy import special
 
 from flexsat.config.models import HubConfig, _Frozen
 from flexsat.dynamics.appendages import appendage_model
@@ -125,6 +125,10 @@ def _standard_ppf(u: float, a: float, b: float) -> float:
         return -_standard_ppf(1.0 - u, -b, -a)
     pa, pb = special.ndtr(a), special.ndtr(b)
     if not pb - pa > 1e-3 * pb:  # narrow and far out (or underflowed): cancellation
+        # imported here: scipy.stats costs every campaign worker 0.3 s to import, and
+        # only this rare branch needs it
+        from scipy import stats
+
         return float(stats.truncnorm.ppf(u, a, b))
     return float(special.ndtri(pa + u * (pb - pa)))
 

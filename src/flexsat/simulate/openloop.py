@@ -10,7 +10,6 @@ from pathlib import Path
 
 import numpy as np
 import xarray as xr
-from scipy.integrate import solve_ivp
 
 from flexsat.dynamics.attitude import SWITCH_PITCH, identity_frame, rebase
 from flexsat.dynamics.integrators import (
@@ -267,6 +266,10 @@ def _run_dop853(plant, scenario, q0, qd0, profile):
     piece continues from the event. A run that diverges stops there, like RK4: the
     records up to the failure and the last good state are kept, with its status.
     """
+    # imported here: scipy.integrate costs 0.2 s to import, and every process that
+    # imports the simulator (a campaign worker, any CLI command) would pay it
+    from scipy.integrate import solve_ivp
+
     n = plant.n_dof
     seg_start, seg_end, _, _ = profile
     every = scenario.record_every

@@ -22,7 +22,9 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
+import pandas as pd
 import xarray as xr
+from xarray.indexes import PandasIndex
 
 from flexsat.dynamics.attitude import inertial_records, vectors_to_inertial
 from flexsat.dynamics.plant import Plant
@@ -365,14 +367,45 @@ def build_dataset(
     if more is not None:
         data_vars.update(more(data_vars))
     coords = {
-        "time": ("time", t, {"units": "s", "long_name": "time since the start of the run"}),
-        "axis": list(AXES),
-        "euler": ["roll", "pitch", "yaw"],
-        "quat": ["q0", "q1", "q2", "q3"],
-        "appendage": names,
-        "dof": plant.dof_names(),
+        "time": (t, {"units": "s", "long_name": "time since the start of the run"}),
+        "axis": (list(AXES), {}),
+        "euler": (["roll", "pitch", "yaw"], {}),
+        "quat": (["q0", "q1", "q2", "q3"], {}),
+        "appendage": (names, {}),
+        "dof": (plant.dof_names(), {}),
     }
-    return xr.Dataset(data_vars, coords=coords, attrs=attrs)
+    return _dataset(data_vars, coords, attrs)
+
+
+def _dataset(data_vars: dict, coords: dict, attrs: dict) -> xr.Dataset:
+    """``xr.Dataset(data_vars, coords=...)`` of numpy arrays, built from its parts.
+
+    The same dataset (``identical``, coordinates of the same dtype) in half the time
+    (about 1 ms against 2 ms for a slew's): xarray's constructor inspects every array
+    for a dask or other chunked array, and on its first use in a process that imports
+    dask (0.4 s in each campaign worker). Here the arrays are numpy arrays by
+    construction, so the variables take them as they are (``fastpath``) and each
+    dimension coordinate gets its pandas index directly.
+
+    Parameters
+    ----------
+    data_vars : dict
+        Name -> (dims, ndarray, attributes).
+    coords : dict
+        Dimension name -> (values, attributes): one index coordinate per dimension.
+    attrs : dict
+        Dataset attributes.
+    """
+    variables, indexes = {}, {}
+    for name, (values, attributes) in coords.items():
+        values = np.asarray(values)
+        index = PandasIndex(pd.Index(values), name, coord_dtype=values.dtype)
+        (variable,) = index.create_variables().values()
+        variable.attrs.update(attributes)
+        variables[name], indexes[name] = variable, index
+    data = {name: xr.Variable(dims, values, attributes, fastpath=True)
+            for name, (dims, values, attributes) in data_vars.items()}  # fmt: skip
+    return xr.Dataset(data, coords=xr.Coordinates(variables, indexes=indexes), attrs=attrs)
 
 
 def _quaternions(euler: np.ndarray) -> np.ndarray:

@@ -16,7 +16,6 @@ from __future__ import annotations
 import shutil
 from pathlib import Path
 
-import netCDF4
 import xarray as xr
 
 from flexsat.errors import ConfigError
@@ -82,7 +81,7 @@ class RecordStream:
             self.energy0 = float(block["total_energy"].values[0])
         else:
             if self._file is None:
-                self._file = netCDF4.Dataset(self.partial, "a")
+                self._file = _open_appending(self.partial)
             start, stop = self.records, self.records + block.sizes["time"]
             for name, var in block.variables.items():
                 if "time" in var.dims:
@@ -91,9 +90,18 @@ class RecordStream:
 
     def finish(self, attrs: dict) -> xr.Dataset:
         """Write the run's final attributes, move the file in place, open it lazily."""
-        nc = self._file if self._file is not None else netCDF4.Dataset(self.partial, "a")
+        nc = self._file if self._file is not None else _open_appending(self.partial)
         self._file = None
         with nc:
             nc.setncatts({k: v for k, v in attrs.items() if v is not None})
         self.partial.replace(self.path)
         return xr.open_dataset(self.path)
+
+
+def _open_appending(path: Path):
+    """The netCDF4 handle of ``path``, opened to append. netCDF4 is imported here:
+    only a streamed run needs it, and every process importing the simulator (a
+    campaign worker, any CLI command) would otherwise pay for it."""
+    import netCDF4
+
+    return netCDF4.Dataset(path, "a")
