@@ -227,7 +227,7 @@ def _new_list(item):
     """A typed list of ``item``. Built here, its methods are compiled into this cached
     function: ``numba.typed.List()`` and its ``append`` called from Python are
     compiled for the item type in every process, uncached (2.8 s before the first
-    batch of each campaign worker, docs/performance.md, 'The ensemble's first call')."""
+    batch of each campaign worker, docs/performance.md, 'Workers that start sooner')."""
     items = List()
     items.append(item)
     return items
