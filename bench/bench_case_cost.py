@@ -38,8 +38,7 @@ from flexsat.config import nominal, validate_config
 GOAL_S = 0.06  # CPU-s per reduced-model case: 1000 cases in 30 s on 2 cores
 # (part, module, function): each part's CPU time is the function's, less the parts inside it
 PARTS = (
-    ("compiled loop", closedloop, "rk4_closed_loop"),  # loaded or compiled (0 steps)
-    ("compiled loop", closedloop, "fly"),  # the steps
+    ("compiled loop", closedloop, "fly"),  # loaded or compiled (no chunk), then the steps
     ("derived records", result, "derive_records"),
     ("dataset", closedloop, "build_dataset"),
     ("metrics", requirements, "slew_metrics"),

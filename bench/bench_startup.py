@@ -49,14 +49,13 @@ else:
     import flexsat.simulate.closedloop as closedloop
     if mode == "api":
         stamps["import flexsat.simulate"] = time.time()
-    compiled_loop = closedloop.rk4_closed_loop
+    compiled_loop = closedloop._compiled_loop  # called once the loop is compiled or loaded
 
     def first_chunk(*args):
-        out = compiled_loop(*args)
         stamps.setdefault("simulating", time.time())
-        return out
+        return compiled_loop(*args)
 
-    closedloop.rk4_closed_loop = first_chunk
+    closedloop._compiled_loop = first_chunk
     if mode == "cli":
         from flexsat.cli.main import main
         sys.argv = ["flexsat", *sys.argv[2:]]

@@ -32,15 +32,7 @@ from flexsat.simulate.batch import fly, slew_timing
 from flexsat.simulate.common import PROGRESS_MIN_STEPS, progress_bar, run_attributes
 from flexsat.simulate.coupled import CHAIN_SLOTS, LoopFlow, rk4_coupled_hold
 from flexsat.simulate.layout import LoopLayout
-from flexsat.simulate.loops import (
-    LoopClock,
-    LoopData,
-    LoopRecords,
-    LoopStages,
-    rk4_closed_loop,
-    run_actuators,
-    run_sensors,
-)
+from flexsat.simulate.loops import LoopData, LoopStages, run_actuators, run_sensors
 from flexsat.simulate.openloop import initial_state
 from flexsat.simulate.result import Result, build_dataset
 from flexsat.simulate.scenario import SlewScenario
@@ -159,13 +151,8 @@ def run_slew(
                           "actuators: remove [reference] and [joint_actuator]")  # fmt: skip
     steps = scenario.n_steps
     show = steps >= PROGRESS_MIN_STEPS if progress is None else progress
-    if controller is None:  # compile or load the loop now (0 steps): the wall time is the run's
-        idle = LoopClock(0.0, scenario.dt_s, 0, False, scenario.control_every,
-                         scenario.record_every, layout.continuous)  # fmt: skip
-        rk4_closed_loop(run.x.copy(), idle, run.stages, run.data,
-                        LoopRecords(run.rec_t, run.rec_x, run.rec_ctrl, 0, run.rec_frame,
-                                    run.rec_Q, run.rec_solved),
-                        plant.packed, identity_frame())  # fmt: skip
+    if controller is None:  # compile or load the loop now (no chunk): the wall time is the run's
+        fly(*_fly_arguments(run, 0, 0, 0))
     start = time.perf_counter()
     with progress_bar(show, scenario.duration_s) as (bar, task):
         if controller is None:
@@ -546,17 +533,21 @@ def _loop_data(layout: LoopLayout, scenario: SlewScenario, J: np.ndarray,
 
 def _compiled_loop(run: PreparedSlew, bar, task) -> tuple[int, int, int]:
     """The whole loop, stages and law included, in compiled chunks (one call without a bar)."""
-    timing = slew_timing(run)
+    per_call = 1 if bar is not None else run.scenario.n_steps + 1
     status, done, rows = 0, 0, 0
-    per_call = 1 if bar is not None else timing.n_steps + 1
     while True:
-        status, done, rows = fly(run.x, timing, run.stages, run.data, run.rec_t, run.rec_x,
-                                 run.rec_ctrl, run.rec_frame, run.rec_Q, run.rec_solved,
-                                 run.plant.packed, run.frame, done, rows, per_call)  # fmt: skip
+        status, done, rows = fly(*_fly_arguments(run, done, rows, per_call))
         if bar is not None:
             bar.update(task, completed=done * run.scenario.dt_s)
-        if status != 0 or done == timing.n_steps:
+        if status != 0 or done == run.scenario.n_steps:
             return status, done, rows
+
+
+def _fly_arguments(run: PreparedSlew, done: int, rows: int, max_chunks: int) -> tuple:
+    """:func:`~flexsat.simulate.batch.fly`'s arguments for ``run`` from step ``done``."""
+    return (run.x, slew_timing(run), run.stages, run.data, run.rec_t, run.rec_x, run.rec_ctrl,
+            run.rec_frame, run.rec_Q, run.rec_solved, run.plant.packed, run.frame, done, rows,
+            max_chunks)  # fmt: skip
 
 
 def _python_loop(plant, scenario, x, frame, stages, d, rec_t, rec_x, rec_ctrl, rec_frame, bar,
