@@ -33,3 +33,30 @@ def test_the_extreme_quantiles_are_the_bounds(u, bound):
     low, high = 0.8, 1.2
     assert truncnormal_ppf(u, 1.0, 0.1, low, high) == pytest.approx(
         {"low": low, "high": high}[bound], abs=1e-15)
+
+
+def test_the_modified_copy_is_a_deep_copy_of_the_config():
+    # apply_modifiers copies the base config before writing into it. The copy must be
+    # what copy.deepcopy gives (equal, no dict or list shared with the base), or one
+    # case's values would leak into the next case's base.
+    import copy
+
+    from flexsat.campaigns.definition import CampaignDefinition, CaseStream, Reduced
+    from flexsat.campaigns.modifiers import _copied
+    from flexsat.config import nominal
+
+    definition = CampaignDefinition(name="copy", reduced=Reduced())
+    stream = CaseStream(definition, nominal())
+    for base in (stream._plant_base, stream._scenario_base):
+        copied = _copied(base)
+        assert copied == copy.deepcopy(base)
+        originals = {id(node) for node in _containers(base)}
+        assert not originals & {id(node) for node in _containers(copied)}
+
+
+def _containers(node):
+    """Every dict and list inside ``node``, itself included."""
+    if isinstance(node, dict | list):
+        yield node
+        for value in node.values() if isinstance(node, dict) else node:
+            yield from _containers(value)

@@ -11,7 +11,6 @@ re-tuned to keep their target frequencies, as the thesis does).
 
 from __future__ import annotations
 
-import copy
 import re
 from typing import Annotated, Any, Literal
 
@@ -163,7 +162,7 @@ def apply_modifiers(
     KeyError
         If a path does not exist in ``data`` (the caller reports it).
     """
-    data = copy.deepcopy(data)
+    data = _copied(data)
     for modifier in modifiers:
         for concrete, parent, key in _targets(data, modifier.path):
             value = modifier.draw(rng)
@@ -176,6 +175,17 @@ def apply_modifiers(
                 parent[key] = value
             realised[concrete] = value
     return data
+
+
+def _copied(node: Any) -> Any:
+    """A copy of plain data (dicts, lists and immutable leaves: a config's
+    ``model_dump``): what ``copy.deepcopy`` gives, at a fifth of its cost (0.3 ms
+    per config, in the campaign's main process for every case)."""
+    if isinstance(node, dict):
+        return {key: _copied(value) for key, value in node.items()}
+    if isinstance(node, list):
+        return [_copied(value) for value in node]
+    return node
 
 
 def _scaled(current: Any, factor: float) -> Any:
