@@ -5,7 +5,11 @@ Goal (campaigns at scale): 1000 random Monte Carlo cases of the 120 s thesis sle
 <= 30 s on 2 cores with the reduced model (root translations locked, 20 ms step and
 control period), the full model (1 ms) beside it; >= 90 % parallel efficiency from 1
 to 2 workers, local and Dask. Each configuration runs the same cases into a fresh
-temporary store; the wall time includes starting the workers. Backends: ``local``
+temporary store; the wall time includes starting the workers. A one-worker run is
+confined to one core, with every process and thread it starts (``sched_setaffinity``):
+one worker on two cores would have a spare core for the campaign's own process (the
+store, Dask's client and scheduler) and the ensemble's second thread, and its run
+would not be one worker's. Backends: ``local``
 (the process pool; 1 worker runs in this process), ``ensemble`` (batches in one
 compiled call, 1 or 2 numba threads, in this process) and ``dask`` (LocalCluster,
 each task an ensemble). The CPU time per case is that of this process (threads
@@ -23,6 +27,7 @@ are pessimistic.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import os
 import resource
 import tempfile
@@ -78,8 +83,9 @@ def main(argv: list[str] | None = None) -> dict:
                                "ensemble": {"workers": workers, "runner": "ensemble"},
                                "dask": {"dask_local": workers}}[backend]  # fmt: skip
                     cpu, children = time.process_time(), _children_cpu()
-                    run = run_campaign(campaign, nominal(), store, n_random=args.cases,
-                                       progress=False, **options)  # fmt: skip
+                    with _cores(workers):
+                        run = run_campaign(campaign, nominal(), store, n_random=args.cases,
+                                           progress=False, **options)  # fmt: skip
                     walls[model, backend, workers] = run["wall_time_s"]
                     here = backend == "ensemble" or (backend == "local" and workers == 1)
                     if here:
@@ -119,6 +125,31 @@ def main(argv: list[str] | None = None) -> dict:
         results[f"{model} local"]["cpu_per_case_2_s"] = {"parent": parent, "workers": workers}
     console.print(f"load {', '.join(f'{x:.2f}' for x in os.getloadavg())}")
     return {"cases": n, "duration_s": args.duration, "results": results}
+
+
+@contextlib.contextmanager
+def _cores(count: int):
+    """Confine this process's threads, and so the processes and threads they start,
+    to ``count`` cores for the block.
+
+    One worker gets one core: otherwise its run has a spare core for the campaign's
+    own process (storing, resolving, Dask's client and scheduler) or for the
+    ensemble's second thread, and "one worker" would be measured on two cores.
+    """
+    everything = os.sched_getaffinity(0)
+    chosen = set(sorted(everything)[:count])
+    tasks = Path("/proc/self/task")
+
+    def pin(cores: set[int]) -> None:
+        for thread in tasks.iterdir():  # every thread: numba's, Dask's event loop...
+            with contextlib.suppress(ProcessLookupError):
+                os.sched_setaffinity(int(thread.name), cores)
+
+    pin(chosen)
+    try:
+        yield
+    finally:
+        pin(everything)
 
 
 def _children_cpu() -> float:

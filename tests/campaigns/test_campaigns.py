@@ -136,6 +136,18 @@ def test_serial_pool_ensemble_and_dask_give_identical_rows(tmp_path):
         run_campaign(definition, nominal(), tmp_path / "bad", runner="threads", progress=False)
 
 
+def test_dask_tasks_batch_cases_but_every_worker_thread_gets_several():
+    # At most DASK_BATCH cases per task (a task's overhead paid once per batch), and
+    # never so many that a worker thread has fewer than four tasks of the campaign: a
+    # worker lost mid-run then loses a task another re-runs, not its whole share (the
+    # real cluster's kill test flies 12 cases on two workers: one case per task).
+    from flexsat.campaigns.runner import DASK_BATCH, _dask_batch
+
+    assert _dask_batch(1000, 2) == DASK_BATCH == 32
+    assert _dask_batch(12, 2) == 1 and _dask_batch(69, 2) == 8 and _dask_batch(0, 4) == 1
+    assert all(size // _dask_batch(size, 2) >= 8 for size in range(8, 257))
+
+
 def test_kill_and_resume_loses_nothing_and_recomputes_nothing(tmp_path):
     store = tmp_path / "killed"
     command = [
