@@ -136,6 +136,9 @@ def _cores(count: int):
     own process (storing, resolving, Dask's client and scheduler) or for the
     ensemble's second thread, and "one worker" would be measured on two cores.
     """
+    if not hasattr(os, "sched_setaffinity"):  # Linux only: elsewhere, every core
+        yield
+        return
     everything = os.sched_getaffinity(0)
     chosen = set(sorted(everything)[:count])
     tasks = Path("/proc/self/task")
