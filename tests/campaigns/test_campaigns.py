@@ -146,6 +146,15 @@ def test_dask_tasks_batch_cases_but_every_worker_thread_gets_several():
     assert _dask_batch(1000, 2) == DASK_BATCH == 32
     assert _dask_batch(12, 2) == 1 and _dask_batch(69, 2) == 8 and _dask_batch(0, 4) == 1
     assert all(size // _dask_batch(size, 2) >= 8 for size in range(8, 257))
+    # The batches of a 1000-case campaign on two threads, as _dask submits them: full
+    # while plenty remain, then shrinking to single cases, so the workers' last tasks
+    # end together; every case is submitted once.
+    batches, remaining = [], 1000
+    while remaining:
+        batches.append(_dask_batch(remaining, 2))
+        remaining -= batches[-1]
+    assert batches[:24] == [32] * 24 and batches[-8:] == [1] * 8
+    assert sum(batches) == 1000 and batches == sorted(batches, reverse=True)
 
 
 def test_kill_and_resume_loses_nothing_and_recomputes_nothing(tmp_path):

@@ -76,12 +76,18 @@ class CampaignStore:
     ----------
     root : str or Path
         The store folder (``--out`` of ``flexsat campaign``); created when written.
+
+    Attributes
+    ----------
+    tables : tuple of Path
+        results.parquet and results.csv: every stored case, one row each.
     """
 
     def __init__(self, root: str | Path) -> None:
         self.root = Path(root)
         self.cases_dir = self.root / "cases"
         self.histories_dir = self.root / "histories"
+        self.tables = (self.root / "results.parquet", self.root / "results.csv")
 
     @contextlib.contextmanager
     def opened(self, fingerprint: dict, name: str, resume: bool) -> Iterator[None]:
@@ -268,17 +274,17 @@ class CampaignStore:
                 frame = pd.concat([frame.drop(columns=column), expanded], axis=1)
         return frame.sort_values("case_id").reset_index(drop=True) if len(frame) else frame
 
-    def write_tables(self) -> tuple[Path, Path]:
-        """Rebuild results.parquet and results.csv from the case files (atomically)."""
+    def write_tables(self) -> pd.DataFrame:
+        """Rebuild results.parquet and results.csv (:attr:`tables`) from the case files
+        (atomically); return the table written (:meth:`table`)."""
         frame = self.table()
-        parquet, csv = self.root / "results.parquet", self.root / "results.csv"
-        for path, writer in ((parquet, frame.to_parquet), (csv, frame.to_csv)):
+        for path, writer in zip(self.tables, (frame.to_parquet, frame.to_csv), strict=True):
             fd, tmp = tempfile.mkstemp(dir=self.root, suffix=".partial")
             os.close(fd)
             os.chmod(tmp, 0o666 & ~_UMASK)
             writer(tmp, index=False)
             os.replace(tmp, path)
-        return parquet, csv
+        return frame
 
 
 def _read_row(path: Path) -> dict | None:
