@@ -117,7 +117,7 @@ def run_worst_case(
         "cases": state["evaluations"], "ran": state["ran"], "failed": len(state["failed"]),
         "failed_cases": state["failed"], "generations": int(result.nit),
         "wall_time_s": time.perf_counter() - start,
-        "parquet": str(store.root / "results.parquet"), "csv": str(store.root / "results.csv"),
+        "parquet": str(store.tables[0]), "csv": str(store.tables[1]),
     }  # fmt: skip
     _write_atomic(store.root / "worst_case.json", json.dumps(summary, indent=2))
     return summary
