@@ -38,6 +38,7 @@ import contextlib
 import itertools
 import os
 import resource
+import shutil
 import tempfile
 import time
 from pathlib import Path
@@ -108,6 +109,7 @@ def main(argv: list[str] | None = None) -> dict:
                               f"{wall:.1f} s ({n / wall:.2f} cases/s)"
                               + (f", {(time.process_time() - cpu) / n:.3f} CPU s per case"
                                  if here else ""))  # fmt: skip
+                shutil.rmtree(store)  # about 0.24 GB per 1000 cases: not kept N times over
     table = Table(
         title=f"{n} random Monte Carlo cases ({args.duration:g} s slews), best of "
         f"{args.repeat} run{'s' * (args.repeat > 1)}"
