@@ -395,7 +395,11 @@ def _rest_matrices(plant: Plant, actuated: Sequence[int]) -> tuple[np.ndarray, n
     G = np.zeros((n, 3 + len(actuated)))
     G[3:6, :3] = np.eye(3)  # Q_Theta = S(0)^T tau = tau
     G[list(actuated), np.arange(3, G.shape[1])] = 1.0  # Q_j = u_j on an actuated q_j
-    B = np.vstack([np.zeros_like(G), np.linalg.solve(M0, G)])
+    # The torque's columns by a solve of their own: the same call as without actuated
+    # coordinates, so they are bit for bit the torque-only model's (one solve of all the
+    # columns may block its triangular solves differently and move the last bit).
+    torque, coordinates = np.linalg.solve(M0, G[:, :3]), np.linalg.solve(M0, G[:, 3:])
+    B = np.vstack([np.zeros_like(G), np.hstack([torque, coordinates])])
     return A, B
 
 
