@@ -3,9 +3,18 @@
 from __future__ import annotations
 
 import os
+import subprocess
+import sys
+import threading
 from pathlib import Path
 
-from flexsat.campaigns.pool import DEPTH, LocalPool
+import pytest
+
+from flexsat.campaigns.pool import DEPTH, LocalPool, safe_start_method
+
+# Both ways a worker starts: fork (the default on Linux from a one-thread process) and
+# spawn (elsewhere, and from this test runner's worker, which runs threads).
+START_METHODS = pytest.mark.parametrize("method", ["fork", "spawn"])
 
 
 def _square(item):
@@ -33,8 +42,9 @@ def _lost(item, exitcode):
     return item[0], ("lost", exitcode)
 
 
-def test_every_item_comes_back_once_and_workers_hold_their_next_item():
-    with LocalPool(_square, 2, _lost) as pool:
+@START_METHODS
+def test_every_item_comes_back_once_and_workers_hold_their_next_item(method):
+    with LocalPool(_square, 2, _lost, start_method=method) as pool:
         results = []
         for result in pool.map_unordered(range(40)):
             if not results:  # the worker that answered still holds the item it queued
@@ -44,18 +54,39 @@ def test_every_item_comes_back_once_and_workers_hold_their_next_item():
     assert sorted(results) == [(i, i * i) for i in range(40)]
 
 
-def test_a_worker_killed_with_an_item_queued_loses_nothing(tmp_path):
+@START_METHODS
+def test_a_worker_killed_with_an_item_queued_loses_nothing(tmp_path, method):
     # item 3 kills its worker once; the item queued behind it never started and is
     # run by the new worker without counting an attempt; 3 is run again and passes
     items = [(i, str(tmp_path)) for i in range(12)]
-    with LocalPool(_dies_once, 2, _lost) as pool:
+    with LocalPool(_dies_once, 2, _lost, start_method=method) as pool:
         results = list(pool.map_unordered(items))
     assert sorted(results) == [(i, i * i) for i in range(12)]
 
 
-def test_an_item_that_always_kills_its_worker_is_handed_to_on_lost(tmp_path):
+@START_METHODS
+def test_an_item_that_always_kills_its_worker_is_handed_to_on_lost(tmp_path, method):
     items = [(i, str(tmp_path)) for i in range(8)]
-    with LocalPool(_always_dies, 2, _lost) as pool:
+    with LocalPool(_always_dies, 2, _lost, start_method=method) as pool:
         results = dict(pool.map_unordered(items))
     assert results.pop(3) == ("lost", 9)
     assert results == {i: i * i for i in range(8) if i != 3}
+
+
+def test_workers_fork_only_from_a_process_with_one_thread():
+    # A fresh interpreter runs one thread: on Linux it forks its workers.
+    fresh = subprocess.run(
+        [sys.executable, "-c", "from flexsat.campaigns.pool import safe_start_method as m; "
+                               "print(m())"],
+        capture_output=True, text=True, check=True,
+    )  # fmt: skip
+    assert fresh.stdout.strip() == ("fork" if sys.platform.startswith("linux") else "spawn")
+    # A second thread (held alive here) makes the pool spawn: a fork would copy its locks.
+    release = threading.Event()
+    other = threading.Thread(target=release.wait)
+    other.start()
+    try:
+        assert safe_start_method() == "spawn"
+    finally:
+        release.set()
+        other.join()

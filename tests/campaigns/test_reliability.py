@@ -3,6 +3,7 @@ SIGTERM, dead workers and parents, damaged stores, the lock, paths."""
 
 from __future__ import annotations
 
+import fcntl
 import json
 import os
 import resource
@@ -148,17 +149,19 @@ def _wait_for(predicate, timeout: float = 240.0) -> None:
 
 
 def _workers_of(process: subprocess.Popen) -> list[psutil.Process]:
-    _wait_for(lambda: len(_children(process)) >= 2)
-    return _children(process)
+    _wait_for(lambda: len(pool_workers(process.pid)) >= 2)
+    return pool_workers(process.pid)
 
 
-def _children(process: subprocess.Popen) -> list[psutil.Process]:
-    """The pool's worker processes (spawned Pythons), not the other children (resource tracker)."""
+def pool_workers(pid: int) -> list[psutil.Process]:
+    """The live pool workers of a campaign process: its children but multiprocessing's
+    resource tracker (a spawned worker's command line names ``spawn_main``, a forked
+    one's is its parent's); one gone, or a zombie, while listed is left out."""
     try:
-        children = psutil.Process(process.pid).children()
+        children = psutil.Process(pid).children()
     except psutil.NoSuchProcess:
         return []
-    return [c for c in children if "spawn_main" in " ".join(_cmdline(c))]
+    return [c for c in children if _cmdline(c) and "resource_tracker" not in " ".join(_cmdline(c))]
 
 
 def _cmdline(child: psutil.Process) -> list[str]:
@@ -210,10 +213,15 @@ def test_killing_the_parent_leaves_no_worker_behind(tmp_path):
     store = tmp_path / "store"
     process = _start(store)
     workers = _workers_of(process)
+    if sys.platform.startswith("linux"):  # the command runs one thread: its workers fork
+        assert all(_cmdline(w) == psutil.Process(process.pid).cmdline() for w in workers)
     _wait_for(lambda: _stored(store) >= 1)  # the workers are past their start-up
     process.send_signal(signal.SIGKILL)  # as the out-of-memory killer does
     process.wait()
     assert _gone_within(workers, 2.0)
+    # A forked worker held a copy of the store's lock; gone with it, the store is free.
+    with open(store / "campaign.lock") as lock:
+        fcntl.flock(lock.fileno(), fcntl.LOCK_EX | fcntl.LOCK_NB)
 
 
 def test_a_killed_worker_is_replaced_and_the_campaign_completes(tmp_path):

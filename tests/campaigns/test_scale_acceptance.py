@@ -18,6 +18,7 @@ import pytest
 from flexsat.campaigns import run_campaign
 
 from .test_campaigns import TIMING, _short, _table
+from .test_reliability import pool_workers
 
 DASK = [str(Path(sys.executable).with_name("dask"))]
 FLEXSAT = [sys.executable, "-m", "flexsat"]
@@ -36,18 +37,6 @@ def _wait_for(predicate, timeout: float = 300.0) -> None:
         if time.monotonic() > deadline:
             raise AssertionError("timed out")
         time.sleep(0.05)
-
-
-def _pool_workers(pid: int) -> list[psutil.Process]:
-    """The live pool workers of a campaign process (one exiting now is left out)."""
-    workers = []
-    for child in psutil.Process(pid).children():
-        try:
-            if "spawn_main" in " ".join(child.cmdline()):
-                workers.append(child)
-        except psutil.NoSuchProcess:  # gone, or a zombie, while it was listed
-            pass
-    return workers
 
 
 def _stored(store: Path) -> int:
@@ -139,7 +128,7 @@ def test_seeded_kills_of_parent_and_workers_lose_and_recompute_nothing(tmp_path,
                                    stderr=subprocess.DEVNULL)  # fmt: skip
         _wait_for(lambda b=before: (store / "cases").exists() and _stored(store) > b)
         time.sleep(rng.uniform(0.1, 1.0))
-        workers = _pool_workers(process.pid)
+        workers = pool_workers(process.pid)
         if kill == "parent" or not workers:  # (no worker left: the run is ending)
             _kill_tree(process)
         else:

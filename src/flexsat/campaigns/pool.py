@@ -14,8 +14,16 @@ So:
 - a worker whose parent dies (even by SIGKILL, as the out-of-memory killer does)
   notices within a fraction of a second and exits.
 
-Workers are started with the ``spawn`` method: they share nothing with the parent
-(no inherited threads or locks, no inherited signal handlers).
+Workers are forked where that is safe: on Linux, from a parent that runs no thread
+but its main one. A forked worker starts with the parent's imported modules and
+loaded machine code (copy-on-write), instead of importing flexsat and loading the
+compiled code from numba's disk cache, about 2.5 s of each worker's start
+(docs/performance.md, 'Forked workers'). A thread's locks would be copied held, so
+a parent with other threads (a Jupyter kernel, a Dask client, a test runner's
+worker) and other systems (macOS's system libraries are not fork-safe) use
+``spawn``: a fresh interpreter that shares nothing with the parent. A forked worker
+resets the signal handlers it inherits, and holds copies of the parent's open files
+(the store's lock among them) until it exits: it exits with the parent.
 """
 
 from __future__ import annotations
@@ -34,7 +42,7 @@ from collections import deque
 from collections.abc import Callable, Iterable, Iterator
 from multiprocessing.connection import wait
 
-__all__ = ["DEPTH", "LocalPool"]
+__all__ = ["DEPTH", "LocalPool", "safe_start_method"]
 
 DEPTH = 2
 """Items given to a worker at a time: the one it runs and the next. With one, a
@@ -61,11 +69,16 @@ class LocalPool:
     on_lost : callable
         ``on_lost(item, exitcode)`` gives the result of an item whose worker died
         ``_ATTEMPTS`` times running it.
+    start_method : {"fork", "spawn"}, optional
+        How workers start; by default ``fork`` where it is safe (module docstring),
+        decided as each worker starts.
     """
 
-    def __init__(self, function: Callable, n_workers: int, on_lost: Callable) -> None:
+    def __init__(
+        self, function: Callable, n_workers: int, on_lost: Callable, start_method: str | None = None
+    ) -> None:
         self.function, self.n_workers, self.on_lost = function, n_workers, on_lost
-        self._context = multiprocessing.get_context("spawn")
+        self.start_method = start_method
         self._workers: list[_Worker] = []
 
     def __enter__(self) -> LocalPool:
@@ -76,8 +89,9 @@ class LocalPool:
         self.close()
 
     def _start(self) -> _Worker:
-        ours, theirs = self._context.Pipe()
-        process = self._context.Process(
+        context = multiprocessing.get_context(self.start_method or safe_start_method())
+        ours, theirs = context.Pipe()
+        process = context.Process(
             target=_serve, args=(theirs, self.function, os.getpid()), daemon=True
         )
         process.start()
@@ -167,6 +181,7 @@ class _Worker:
 def _serve(conn, function: Callable, parent_pid: int) -> None:
     """Worker loop: run each received item, send the result back; exit with the parent."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # the parent decides what Ctrl-C stops
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)  # a forked worker had the parent's
     _die_with_parent()
     threading.Thread(target=_exit_with_parent, args=(parent_pid,), daemon=True).start()
     while True:
@@ -175,6 +190,12 @@ def _serve(conn, function: Callable, parent_pid: int) -> None:
         except (EOFError, OSError):  # the parent closed the pipe
             return
         conn.send(function(item))
+
+
+def safe_start_method() -> str:
+    """``"fork"`` on Linux from a process whose only thread is its main one, else ``"spawn"``."""
+    single = threading.active_count() == 1
+    return "fork" if sys.platform.startswith("linux") and single else "spawn"
 
 
 def _die_with_parent() -> None:

@@ -52,6 +52,7 @@ __all__ = [
 RUNNERS = ("pool", "ensemble")
 """Local runners of :func:`run_campaign`."""
 
+_DRAW_S = 0.1  # s between redraws of the progress bar (rich's own rate, 10 per s)
 _CASE_ID = re.compile(r"^[A-Za-z0-9_+\-][A-Za-z0-9_.+\-]*$")
 
 
@@ -375,8 +376,12 @@ def run_campaign(
                 columns = (TextColumn(f"campaign {definition.name}"), BarColumn(),
                            MofNCompleteColumn(), TextColumn("failed {task.fields[failed]}"),
                            TimeRemainingColumn())  # fmt: skip
-                with Progress(*columns, disable=not progress, transient=True) as bar:
+                # Drawn from this thread (no refresh thread), so the local pool can fork
+                # its workers (flexsat.campaigns.pool); at most every 0.1 s, as rich would.
+                with Progress(*columns, disable=not progress, transient=True,
+                              auto_refresh=False) as bar:  # fmt: skip
                     task = bar.add_task("cases", total=len(cases), completed=0, failed=0)
+                    drawn = time.monotonic()
                     try:
                         for row in execute(todo, len(cases)):
                             history = row.pop(HISTORY_KEY, None)
@@ -386,8 +391,10 @@ def run_campaign(
                                                         status=row["status"])  # fmt: skip
                                 store.write_case(row)
                             failed += row["status"] != "ok"
+                            draw = time.monotonic() - drawn >= _DRAW_S
+                            drawn = time.monotonic() if draw else drawn
                             bar.update(task, completed=todo.skipped + todo.ran_done(),
-                                       failed=failed)  # fmt: skip
+                                       failed=failed, refresh=draw)  # fmt: skip
                     except OSError as exc:
                         raise _write_error(store, cases, exc) from None
                 try:
