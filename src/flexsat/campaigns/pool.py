@@ -42,6 +42,8 @@ from collections import deque
 from collections.abc import Callable, Iterable, Iterator
 from multiprocessing.connection import wait
 
+from flexsat.parallel import frozen_heap
+
 __all__ = ["DEPTH", "LocalPool", "safe_start_method"]
 
 DEPTH = 2
@@ -94,7 +96,8 @@ class LocalPool:
         process = context.Process(
             target=_serve, args=(theirs, self.function, os.getpid()), daemon=True
         )
-        process.start()
+        with frozen_heap():  # a forked worker's collections leave the parent's pages alone
+            process.start()
         theirs.close()
         return _Worker(process, ours)
 
