@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import gc
+import os
+import signal
 
 import pytest
 
@@ -29,3 +31,41 @@ def test_forked_map_returns_the_serial_results_in_order():
     items = list(range(7))
     assert forked_map(lambda x: x * x, items, workers=2) == [x * x for x in items]
     assert forked_map(lambda x: x * x, items, workers=1) == [x * x for x in items]
+
+
+def _killed_once(marker_dir):
+    """A job whose process is killed (SIGKILL, as by the out-of-memory killer) the first
+    time it runs item 3, and for item 5 every time."""
+
+    def job(x):
+        marker = marker_dir / f"ran-{x}"
+        if x == 5 or (x == 3 and not marker.exists()):
+            marker.touch()
+            os.kill(os.getpid(), signal.SIGKILL)
+        return x * x
+
+    return job
+
+
+def test_forked_map_runs_again_the_item_of_a_killed_process(tmp_path):
+    # multiprocessing's Pool, used before, never returned here: the killed process
+    # could hold the lock of the pool's shared queue.
+    job = _killed_once(tmp_path)
+    assert forked_map(job, [0, 1, 2, 3, 4], workers=2) == [0, 1, 4, 9, 16]
+    assert (tmp_path / "ran-3").exists()  # it did die once
+
+
+def test_forked_map_names_an_item_whose_process_died_twice(tmp_path):
+    # Item 5 is the second of [4, 5, 6]: its index, 1, is named.
+    with pytest.raises(RuntimeError, match=r"running item 1 died twice \(exit code -9\)"):
+        forked_map(_killed_once(tmp_path), [4, 5, 6], workers=2)
+
+
+def test_forked_map_raises_the_jobs_own_exception():
+    def job(x):
+        if x == 2:
+            raise ValueError(f"item {x} is bad")
+        return x
+
+    with pytest.raises(ValueError, match="item 2 is bad"):
+        forked_map(job, range(4), workers=2)

@@ -13,6 +13,7 @@ numba, so the command line can import it at start-up.
 
 from __future__ import annotations
 
+import functools
 import gc
 import multiprocessing
 import os
@@ -61,15 +62,16 @@ def frozen_heap() -> Iterator[None]:
         gc.unfreeze()
 
 
-_JOB: Callable | None = None  # the job of the running map, inherited by the forks
-
-
-def _run_job(item):
-    return _JOB(item)
-
-
 def forked_map(job: Callable, items: Iterable, workers: int | None = None) -> list:
     """``[job(item) for item in items]``, by forked processes when there are several.
+
+    The processes are a :class:`~flexsat.campaigns.pool.LocalPool`'s, forked inside
+    :func:`frozen_heap`, one item each at a time (items of uneven cost stay balanced).
+    A process that dies (killed, out of memory) is replaced and its item run again,
+    and every process exits with this one. :class:`multiprocessing.pool.Pool`, used
+    before, did neither: a process killed while taking the next item from the
+    pool's shared queue held the queue's lock for ever, so the map never returned,
+    and a killed parent left its processes behind.
 
     Parameters
     ----------
@@ -85,17 +87,40 @@ def forked_map(job: Callable, items: Iterable, workers: int | None = None) -> li
     -------
     list
         The results, in the order of ``items``.
+
+    Raises
+    ------
+    Exception
+        The first exception a job raised (the other processes are stopped), or a
+        :class:`RuntimeError` for an item whose process died twice.
     """
-    global _JOB
+    from flexsat.campaigns.pool import LocalPool  # not at import: the CLI starts without it
+
     items = list(items)
     workers = min(figure_workers() if workers is None else workers, len(items))
     if workers <= 1:
         return [job(item) for item in items]
-    _JOB = job
+    results: list = [None] * len(items)
+    run = functools.partial(_run_indexed, job)
+    with LocalPool(run, workers, _died_twice, start_method="fork", depth=1) as pool:
+        for index, ok, value in pool.map_unordered(enumerate(items)):
+            if not ok:
+                raise value
+            results[index] = value
+    return results
+
+
+def _run_indexed(job: Callable, indexed: tuple) -> tuple:
+    """``(index, True, job(item))``, or ``(index, False, exception)`` if the job raised."""
+    index, item = indexed
     try:
-        with frozen_heap():  # the pool's processes are started here
-            pool = multiprocessing.get_context("fork").Pool(workers)
-        with pool:
-            return pool.map(_run_job, items, chunksize=1)
-    finally:
-        _JOB = None
+        return index, True, job(item)
+    except Exception as exc:  # raised in the parent, as the serial loop would
+        return index, False, exc
+
+
+def _died_twice(indexed: tuple, exitcode: int | None) -> tuple:
+    index, _ = indexed
+    return index, False, RuntimeError(
+        f"the forked process running item {index} died twice (exit code {exitcode})"
+    )

@@ -2,9 +2,9 @@
 
 Unlike :class:`concurrent.futures.ProcessPoolExecutor`, which is handed every case
 up front and waits for all of them, :class:`LocalPool` gives each worker at most
-:data:`DEPTH` items at a time: the one it runs and the next, queued in its pipe, so
-that it never waits while the parent stores a result and prepares the next item.
-So:
+:data:`DEPTH` items at a time (by default): the one it runs and the next, queued in
+its pipe, so that it never waits while the parent stores a result and prepares the
+next item. So:
 
 - leaving the pool (an exception, Ctrl-C, SIGTERM turned into ``KeyboardInterrupt``)
   cancels what is pending and stops the workers at once (SIGTERM, then SIGKILL
@@ -58,7 +58,7 @@ _PR_SET_PDEATHSIG = 1  # prctl(2) option: signal sent to this process when its p
 
 
 class LocalPool:
-    """Run ``function`` on items in ``n_workers`` processes, :data:`DEPTH` items per worker.
+    """Run ``function`` on items in ``n_workers`` processes, ``depth`` items per worker.
 
     Use it as a context manager; leaving the block stops every worker.
 
@@ -74,13 +74,22 @@ class LocalPool:
     start_method : {"fork", "spawn"}, optional
         How workers start; by default ``fork`` where it is safe (module docstring),
         decided as each worker starts.
+    depth : int, optional
+        Items given to a worker at a time, :data:`DEPTH` by default. One suits items
+        of uneven cost (figures): an idle worker then takes the next item instead of
+        waiting behind one queued to a busy worker.
     """
 
     def __init__(
-        self, function: Callable, n_workers: int, on_lost: Callable, start_method: str | None = None
+        self,
+        function: Callable,
+        n_workers: int,
+        on_lost: Callable,
+        start_method: str | None = None,
+        depth: int = DEPTH,
     ) -> None:
         self.function, self.n_workers, self.on_lost = function, n_workers, on_lost
-        self.start_method = start_method
+        self.start_method, self.depth = start_method, depth
         self._workers: list[_Worker] = []
 
     def __enter__(self) -> LocalPool:
@@ -137,8 +146,8 @@ class LocalPool:
                         pending.appendleft(running)
 
     def _fill(self, k: int, pending: deque, source: Iterator) -> None:
-        """Give worker ``k`` items (those to run again first) until it holds DEPTH."""
-        while len(self._workers[k].items) < DEPTH:
+        """Give worker ``k`` items (those to run again first) until it holds ``depth``."""
+        while len(self._workers[k].items) < self.depth:
             if not pending:
                 pending.extend(itertools.islice(source, 1))
             if not pending:

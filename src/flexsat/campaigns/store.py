@@ -15,7 +15,9 @@ digest over all cases' inputs (``all_case_inputs``). Resuming is refused when an
 of them differs, naming which. While a
 campaign runs into the store, ``campaign.lock`` is locked (``flock``) and names
 the process holding it, so a second run into the same store is refused instead of
-recomputing the same cases.
+recomputing the same cases. A killed run's lock is freed by the kernel shortly
+after the run and its workers exit; a run started at once waits up to
+:data:`_DEAD_HOLDER_WAIT_S` for it when the process named in the lock is gone.
 """
 
 from __future__ import annotations
@@ -25,8 +27,10 @@ import datetime as dt
 import fcntl
 import json
 import os
+import re
 import socket
 import tempfile
+import time
 from collections.abc import Iterator
 from pathlib import Path
 
@@ -300,23 +304,50 @@ def _read_row(path: Path) -> dict | None:
     return row
 
 
+_DEAD_HOLDER_WAIT_S = 2.0
+"""Time a run waits for the lock of a process that is gone [s]. The kernel frees a
+killed process's ``flock`` after the process and the workers that share its open
+files have exited, not at once: measured up to 0.05 s after they were reaped."""
+
+
 def _acquire(lock, root: Path) -> None:
     """Lock the store for this process, or say which process holds it."""
-    try:
-        fcntl.flock(lock.fileno(), fcntl.LOCK_EX | fcntl.LOCK_NB)
-    except OSError:
-        lock.seek(0)
-        holder = lock.read().strip() or "another process"
-        lock.close()
-        raise ConfigError(
-            f"{root} is in use by {holder}; wait for it to finish (or stop it) "
-            "before running into this store"
-        ) from None
+    deadline = time.monotonic() + _DEAD_HOLDER_WAIT_S
+    while True:
+        try:
+            fcntl.flock(lock.fileno(), fcntl.LOCK_EX | fcntl.LOCK_NB)
+            break
+        except OSError:
+            lock.seek(0)
+            holder = lock.read().strip() or "another process"
+            if _gone(holder) and time.monotonic() < deadline:
+                time.sleep(0.01)
+                continue
+            lock.close()
+            raise ConfigError(
+                f"{root} is in use by {holder}; wait for it to finish (or stop it) "
+                "before running into this store"
+            ) from None
     lock.seek(0)
     lock.truncate()
     started = dt.datetime.now(dt.UTC).strftime("%Y-%m-%d %H:%M:%S UTC")
     lock.write(f"process {os.getpid()} on {socket.gethostname()} (since {started})")
     lock.flush()
+
+
+def _gone(holder: str) -> bool:
+    """Whether the lock's holder, as :func:`_acquire` names it, is a process of this
+    machine that no longer exists."""
+    named = re.match(r"process (\d+) on (\S+) ", holder)
+    if named is None or named[2] != socket.gethostname():
+        return False
+    try:
+        os.kill(int(named[1]), 0)
+    except ProcessLookupError:
+        return True
+    except OSError:  # it exists, as another user's
+        return False
+    return False
 
 
 def _write_netcdf3(path: str, data: dict, described: dict, attrs: dict) -> None:
