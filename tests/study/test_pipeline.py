@@ -6,7 +6,10 @@ import json
 import os
 import subprocess
 import sys
+import time
 from pathlib import Path
+
+import psutil
 
 from flexsat.config import nominal, preset_path
 from flexsat.study import PARTS, pipeline
@@ -125,6 +128,49 @@ def test_a_lane_that_dies_leaves_its_unfinished_parts_failed(monkeypatch):
     status = {name: entry["status"] for name, entry in recorded.items()}
     assert status == {"survivor": "ok", "done": "ok", "killer": "failed", "orphan": "failed"}
     assert recorded["orphan"]["error"] == "the process running it stopped (exit code 7)"
+
+
+_KILLED_STUDY = """
+import os, sys, time
+from pathlib import Path
+from flexsat.config import nominal
+from flexsat.study import pipeline
+
+def lane_part(ctx):
+    print(os.getpid(), flush=True)  # the lane's process id, for the test
+    time.sleep(600)
+
+def main_part(ctx):
+    time.sleep(600)  # killed meanwhile
+
+pipeline.PARTS = (pipeline.Part("main", "Main", main_part, lane=0),
+                  pipeline.Part("lane", "Lane", lane_part, lane=1))
+ctx = pipeline.StudyContext(nominal(), Path("."), quick=True, progress=False)
+pipeline._run_parts(ctx, lambda part, entry: None, lanes=2)
+"""
+
+
+def test_the_forked_lane_exits_with_a_killed_study():
+    # SIGKILL, as the out-of-memory killer sends: the study cannot stop its lane, which
+    # would otherwise run its parts to the end with no one to read them. Linux kills it
+    # at once; elsewhere it notices within 0.2 s. 2 s allowed.
+    study = subprocess.Popen([sys.executable, "-c", _KILLED_STUDY], stdout=subprocess.PIPE,
+                             text=True)  # fmt: skip
+    lane = int(study.stdout.readline())
+    study.kill()
+    study.wait()
+    deadline = time.monotonic() + 2.0
+    while _alive(lane):
+        assert time.monotonic() < deadline, "the lane outlived the study"
+        time.sleep(0.02)
+
+
+def _alive(pid: int) -> bool:
+    """Running (an orphan may stay a zombie until its new parent reaps it)."""
+    try:
+        return psutil.Process(pid).status() != psutil.STATUS_ZOMBIE
+    except psutil.NoSuchProcess:
+        return False
 
 
 def test_each_lane_loads_the_loops_only_its_parts_fly():

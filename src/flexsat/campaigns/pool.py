@@ -28,9 +28,6 @@ resets the signal handlers it inherits, and holds copies of the parent's open fi
 
 from __future__ import annotations
 
-import contextlib
-import ctypes
-import ctypes.util
 import itertools
 import multiprocessing
 import os
@@ -42,7 +39,7 @@ from collections import deque
 from collections.abc import Callable, Iterable, Iterator
 from multiprocessing.connection import wait
 
-from flexsat.parallel import frozen_heap
+from flexsat.parallel import die_with_parent, frozen_heap
 
 __all__ = ["DEPTH", "LocalPool", "safe_start_method"]
 
@@ -51,10 +48,8 @@ DEPTH = 2
 worker waited for the parent to store its result and resolve the next case, about a
 tenth of a reduced campaign case (docs/performance.md, 'A reduced case at 20 ms')."""
 
-_PARENT_POLL_S = 0.2  # how often a worker checks that its parent is alive
 _GRACE_S = 1.0  # time given to a worker to exit on SIGTERM before SIGKILL
 _ATTEMPTS = 2  # runs of an item whose worker died before it is given up
-_PR_SET_PDEATHSIG = 1  # prctl(2) option: signal sent to this process when its parent dies
 
 
 class LocalPool:
@@ -194,8 +189,7 @@ def _serve(conn, function: Callable, parent_pid: int) -> None:
     """Worker loop: run each received item, send the result back; exit with the parent."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # the parent decides what Ctrl-C stops
     signal.signal(signal.SIGTERM, signal.SIG_DFL)  # a forked worker had the parent's
-    _die_with_parent()
-    threading.Thread(target=_exit_with_parent, args=(parent_pid,), daemon=True).start()
+    die_with_parent(parent_pid)
     while True:
         try:
             item = conn.recv()
@@ -208,22 +202,3 @@ def safe_start_method() -> str:
     """``"fork"`` on Linux from a process whose only thread is its main one, else ``"spawn"``."""
     single = threading.active_count() == 1
     return "fork" if sys.platform.startswith("linux") and single else "spawn"
-
-
-def _die_with_parent() -> None:
-    """On Linux, have the kernel send SIGKILL to this worker when its parent dies.
-
-    Immediate even while the worker holds the GIL (compiling, in a compiled loop);
-    elsewhere :func:`_exit_with_parent` alone watches the parent.
-    """
-    if not sys.platform.startswith("linux"):
-        return
-    with contextlib.suppress(OSError, AttributeError):
-        libc = ctypes.CDLL(ctypes.util.find_library("c") or "libc.so.6", use_errno=True)
-        libc.prctl(_PR_SET_PDEATHSIG, signal.SIGKILL)
-
-
-def _exit_with_parent(parent_pid: int) -> None:
-    while os.getppid() == parent_pid:
-        time.sleep(_PARENT_POLL_S)
-    os._exit(1)

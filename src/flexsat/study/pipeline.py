@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import datetime as dt
 import multiprocessing
+import os
 import time
 import traceback
 from collections.abc import Callable
@@ -35,7 +36,7 @@ from flexsat import __version__
 from flexsat._compiled_cache import kernels_cached
 from flexsat.config.models import SatelliteConfig
 from flexsat.control.laws import LAWS
-from flexsat.parallel import figure_workers, forked_map, frozen_heap
+from flexsat.parallel import die_with_parent, figure_workers, forked_map, frozen_heap
 from flexsat.study.outputs import (
     derived_properties,
     fly_campaign,
@@ -516,8 +517,8 @@ def _run_parts(
     forked = [part for part in PARTS if part.lane == 1]
     context = multiprocessing.get_context("fork")
     receive, send = context.Pipe(duplex=False)
-    lane = context.Process(target=_run_lane, args=(forked, ctx, send, prepare.get(1, [])),
-                           name="flexsat-lane-1")  # fmt: skip
+    lane = context.Process(target=_run_lane, name="flexsat-lane-1",
+                           args=(forked, ctx, send, prepare.get(1, []), os.getpid()))  # fmt: skip
     with frozen_heap():
         lane.start()
     send.close()  # the lane holds the only writing end: its exit ends the reading
@@ -556,10 +557,11 @@ def _run_parts(
     return max(prepared)
 
 
-def _run_lane(parts: list[Part], ctx: StudyContext, send, runs: list = ()) -> None:
+def _run_lane(parts: list[Part], ctx: StudyContext, send, runs: list, parent_pid: int) -> None:
     """Lane 1 in its forked process: fly ``runs`` (its share of :func:`_compile`) and send
     (None, their time [s], None), then run ``parts`` in order, send (name, entry,
-    outputs) each."""
+    outputs) each. It exits with the study's process (``parent_pid``), even killed."""
+    die_with_parent(parent_pid)
     ctx.progress = False  # two lanes' progress bars would interleave
     send.send((None, _fly_each(ctx, list(runs)), None))
     for part in parts:
