@@ -5,6 +5,8 @@ from __future__ import annotations
 import gc
 import os
 import signal
+import subprocess
+import sys
 
 import pytest
 
@@ -69,3 +71,20 @@ def test_forked_map_raises_the_jobs_own_exception():
 
     with pytest.raises(ValueError, match="item 2 is bad"):
         forked_map(job, range(4), workers=2)
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="prctl is Linux's")
+def test_die_with_parent_asks_the_kernel_for_sigkill():
+    # PR_GET_PDEATHSIG (2) reads back the signal the kernel sends as the parent dies;
+    # in a child process, so that this one's parent is left alone.
+    script = (
+        "import ctypes, os\n"
+        "from flexsat.parallel import die_with_parent\n"
+        "die_with_parent(os.getppid())\n"
+        "signal = ctypes.c_int()\n"
+        "ctypes.CDLL(None).prctl(2, ctypes.byref(signal))\n"
+        "print(signal.value)\n"
+    )
+    out = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True,
+                         check=True).stdout  # fmt: skip
+    assert int(out) == signal.SIGKILL
