@@ -231,6 +231,24 @@ def test_interrupt_cancels_pending_cases_and_stops_the_workers(tmp_path, signum,
     assert "Traceback" not in stderr
 
 
+def test_ctrl_c_while_drawing_the_figures_says_the_cases_are_stored(tmp_path):
+    # The figures' folder is made just before the first figure is drawn (each takes
+    # tenths of a second): SIGINT then lands while they are drawn. The command says
+    # what is stored, and --resume runs no case and draws the figures.
+    store = tmp_path / "store"
+    process = _start(store)
+    _wait_for(lambda: (store / "figures").exists(), timeout=300)
+    process.send_signal(signal.SIGINT)
+    _, stderr = process.communicate(timeout=30)
+    assert process.returncode == 130
+    assert "interrupted (SIGINT) while drawing its figures: its 12 cases are stored" in stderr
+    assert "--resume" in stderr and "Traceback" not in stderr
+    resumed = subprocess.run([*process.args, "--resume"], capture_output=True, text=True,
+                             check=True)  # fmt: skip
+    summary = json.loads(resumed.stdout)
+    assert summary["ran"] == 0 and len(summary["figures"]) > 0
+
+
 def test_killing_the_parent_leaves_no_worker_behind(tmp_path):
     store = tmp_path / "store"
     process = _start(store)

@@ -4,8 +4,10 @@ from __future__ import annotations
 
 import json
 import os
+import signal
 import subprocess
 import sys
+import time
 
 import numpy as np
 import pytest
@@ -230,3 +232,20 @@ def test_the_command_exits_without_a_last_collection_and_its_files_are_whole(tmp
     assert result.returncode == 0, result.stderr
     assert result.stdout.splitlines()[-1] == "frozen True"
     assert run("config", "show", "--config", str(out)).returncode == 0
+
+
+def test_ctrl_c_ends_a_command_with_one_line_and_code_130(tmp_path):
+    # typer turns Ctrl-C into a silent exit 130; the command says why it stopped. The
+    # study makes its output folder once it has started: SIGINT then lands in it.
+    out = tmp_path / "study"
+    command = [*FLEXSAT, "study", "--quick", "--out", str(out)]
+    process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    deadline = time.monotonic() + 120
+    while not out.exists():
+        assert time.monotonic() < deadline, "the study did not start"
+        time.sleep(0.01)
+    process.send_signal(signal.SIGINT)
+    _, stderr = process.communicate(timeout=60)
+    assert process.returncode == 130
+    assert stderr.endswith("error: interrupted\n")
+    assert "Traceback" not in stderr

@@ -11,6 +11,7 @@ import gc
 import json
 import math
 import shutil
+import signal
 import sys
 import warnings
 from enum import StrEnum
@@ -806,8 +807,13 @@ def main() -> None:
     # objects freed by reference counting are still finalized (docs/performance.md,
     # 'Exits without the last collection').
     atexit.register(gc.freeze)
+    signal.signal(signal.SIGINT, _on_ctrl_c)
     try:
         app()
+    except SystemExit as exc:  # typer ends a command stopped by Ctrl-C with a silent 130
+        if exc.code == 130 and _ctrl_c:
+            _print_error("interrupted")
+        raise
     except FlexsatError as exc:
         _print_error(str(exc))
         sys.exit(exc.exit_code)
@@ -818,6 +824,16 @@ def main() -> None:
     except KeyboardInterrupt:
         _print_error("interrupted")
         sys.exit(130)
+
+
+_ctrl_c: list[int] = []  # the SIGINTs :func:`_on_ctrl_c` received (a campaign has its own)
+
+
+def _on_ctrl_c(signum, frame) -> None:
+    """Python's own SIGINT handling (``KeyboardInterrupt``), remembering the signal:
+    typer turns the interrupt into exit code 130 before :func:`main` sees it."""
+    _ctrl_c.append(signum)
+    raise KeyboardInterrupt
 
 
 def _print_warning(message, category, filename, lineno, file=None, line=None) -> None:

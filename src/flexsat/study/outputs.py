@@ -272,6 +272,7 @@ def fly_campaign(definition, config, store: Path, *, progress: bool = True, **ba
         ``parquet``, ``csv`` and ``figures``; also written to ``store/summary.json``.
     """
     from flexsat.campaigns import run_campaign, summarize
+    from flexsat.campaigns.runner import CampaignInterrupted
     from flexsat.plots.campaign import write_campaign_figures
     from flexsat.plots.campaign_statistics import write_statistics_figures
 
@@ -288,6 +289,14 @@ def fly_campaign(definition, config, store: Path, *, progress: bool = True, **ba
         figures += write_statistics_figures(store)
     except ValueError:  # no successful case history to draw
         figures = []
+    except KeyboardInterrupt:  # the cases are stored; their figures can be drawn again
+        interrupted = CampaignInterrupted(
+            f"campaign {definition.name} interrupted (SIGINT) while drawing its figures: its "
+            f"{summary['cases']} cases are stored in {store}; run the same command with "
+            "--resume to draw them"
+        )
+        interrupted.exit_code = 130
+        raise interrupted from None
     if "worst_case" in run:  # a worst-case search: what it found
         summary["worst_case"] = {k: run[k] for k in ("case_id", "metric", "value", "parameters")}
     summary["figures"] = [str(path) for path in figures]
