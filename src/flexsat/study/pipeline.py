@@ -457,21 +457,23 @@ def _compile(ctx: StudyContext, console: Console, lanes: int = 1) -> tuple[float
     per_lane : dict
         Lane -> the runs left for it to fly (empty with one lane).
     """
-    console.print("compiling the simulation kernels (the first run only; later runs load "
+    cached = kernels_cached()
+    console.print("loading the simulation kernels from the disk cache..." if cached else
+                  "compiling the simulation kernels (the first run only; later runs load "
                   "them from the disk cache)...", highlight=False)  # fmt: skip
     start = time.perf_counter()
     shared, per_lane = [], {}
     try:
         runs = _compile_runs(ctx)
         shared, per_lane = _split_runs(runs, lanes)
-        if not kernels_cached():  # each process compiles its share into the cache
+        if not cached:  # each process compiles its share into the cache
             forked_map(lambda fields: _fly_short(ctx, fields), [fields for fields, _ in runs])
     except Exception:  # the part that needs it reports the problem
         pass
     _fly_each(ctx, shared)
     elapsed = time.perf_counter() - start
-    console.print(f"compiled in {elapsed:.1f} s; the wall times below exclude it",
-                  highlight=False)  # fmt: skip
+    console.print(f"{'loaded' if cached else 'compiled'} in {elapsed:.1f} s; the wall times "
+                  "below exclude it", highlight=False)  # fmt: skip
     return elapsed, per_lane
 
 
