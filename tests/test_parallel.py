@@ -10,7 +10,7 @@ import sys
 
 import pytest
 
-from flexsat.parallel import figure_workers, forked_map, frozen_heap
+from flexsat.parallel import figure_workers, forked_map, frozen_heap, signals_deferred
 
 
 def test_frozen_heap_freezes_the_objects_only_while_processes_start():
@@ -88,3 +88,26 @@ def test_die_with_parent_asks_the_kernel_for_sigkill():
     out = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True,
                          check=True).stdout  # fmt: skip
     assert int(out) == signal.SIGKILL
+
+
+class _Stop(Exception):
+    pass
+
+
+def test_a_signal_during_a_processes_start_reaches_its_handler_after_it():
+    # A handler that raises inside an interpreter's after-fork callback is lost
+    # ("Exception ignored"): inside the block the signal is only noted, and its own
+    # handler runs, and raises, once the block ends.
+    def stop(signum, frame):
+        raise _Stop(signum)
+
+    previous = signal.signal(signal.SIGINT, stop)
+    try:
+        reached = False
+        with pytest.raises(_Stop), signals_deferred():
+            signal.raise_signal(signal.SIGINT)
+            reached = True  # not raised in the block
+        assert reached
+        assert signal.getsignal(signal.SIGINT) is stop  # the handler is back
+    finally:
+        signal.signal(signal.SIGINT, previous)

@@ -4,8 +4,11 @@
 - :func:`forked_map`: ``[job(item) for item in items]`` by forked processes.
 - :func:`frozen_heap`: what a fork is started inside of, so the children's garbage
   collections leave the parent's objects (and their memory pages) alone.
-- :func:`die_with_parent`: what a child process calls first, so that it never
-  outlives its parent, even one killed with SIGKILL.
+- :func:`signals_deferred`: what a process is started inside of, so that a Ctrl-C
+  landing during the fork is not lost.
+- :func:`start_child`: what a child process calls first: Ctrl-C is its parent's to
+  handle, and it never outlives its parent, even one killed with SIGKILL
+  (:func:`die_with_parent`).
 
 Forked processes start in milliseconds with the parent's memory, including every
 numba kernel the parent already compiled or loaded from its disk cache, so a
@@ -28,7 +31,16 @@ import time
 from collections.abc import Callable, Iterable, Iterator
 from contextlib import contextmanager
 
-__all__ = ["die_with_parent", "figure_workers", "forked_map", "frozen_heap"]
+__all__ = [
+    "die_with_parent",
+    "figure_workers",
+    "forked_map",
+    "frozen_heap",
+    "signals_deferred",
+    "start_child",
+]
+
+_STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM)
 
 _PARENT_POLL_S = 0.2  # how often a child checks that its parent is alive
 _PR_SET_PDEATHSIG = 1  # prctl(2) option: signal sent to this process when its parent dies
@@ -71,6 +83,47 @@ def frozen_heap() -> Iterator[None]:
         yield
     finally:
         gc.unfreeze()
+
+
+@contextmanager
+def signals_deferred() -> Iterator[None]:
+    """Start processes inside this: SIGINT and SIGTERM are noted meanwhile, and given
+    to their handlers once the block ends.
+
+    A signal's Python handler runs wherever the interpreter next checks for signals.
+    During a fork that can be inside one of its after-fork callbacks (logging's lock
+    release, for one), where an exception is printed as "Exception ignored" and lost:
+    a Ctrl-C that landed as a process started was dropped and the run went on. Only
+    the main thread may change handlers; elsewhere the block runs as it is.
+    """
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    noted: list[int] = []
+    previous = {signum: signal.signal(signum, lambda signum, _: noted.append(signum))
+                for signum in _STOP_SIGNALS}  # fmt: skip
+    try:
+        yield
+    finally:
+        for signum, handler in previous.items():
+            signal.signal(signum, signal.SIG_DFL if handler is None else handler)
+        for signum in dict.fromkeys(noted):
+            signal.raise_signal(signum)  # its handler runs here, in this thread
+
+
+def start_child(parent_pid: int) -> None:
+    """What a child process runs first. Ctrl-C is its parent's to handle (ignored here:
+    a terminal sends it to the whole group), SIGTERM ends it (a forked child had its
+    parent's handlers), and it exits with its parent (:func:`die_with_parent`).
+
+    Parameters
+    ----------
+    parent_pid : int
+        The parent's process id, as the parent saw it (``os.getpid()`` there) [-].
+    """
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    die_with_parent(parent_pid)
 
 
 def die_with_parent(parent_pid: int) -> None:

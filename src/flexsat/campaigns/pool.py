@@ -31,7 +31,6 @@ from __future__ import annotations
 import itertools
 import multiprocessing
 import os
-import signal
 import sys
 import threading
 import time
@@ -39,7 +38,7 @@ from collections import deque
 from collections.abc import Callable, Iterable, Iterator
 from multiprocessing.connection import wait
 
-from flexsat.parallel import die_with_parent, frozen_heap
+from flexsat.parallel import frozen_heap, signals_deferred, start_child
 
 __all__ = ["DEPTH", "LocalPool", "safe_start_method"]
 
@@ -100,7 +99,9 @@ class LocalPool:
         process = context.Process(
             target=_serve, args=(theirs, self.function, os.getpid()), daemon=True
         )
-        with frozen_heap():  # a forked worker's collections leave the parent's pages alone
+        # a forked worker's collections leave the parent's pages alone; a Ctrl-C during
+        # the fork reaches its handler after it
+        with frozen_heap(), signals_deferred():
             process.start()
         theirs.close()
         return _Worker(process, ours)
@@ -187,9 +188,7 @@ class _Worker:
 
 def _serve(conn, function: Callable, parent_pid: int) -> None:
     """Worker loop: run each received item, send the result back; exit with the parent."""
-    signal.signal(signal.SIGINT, signal.SIG_IGN)  # the parent decides what Ctrl-C stops
-    signal.signal(signal.SIGTERM, signal.SIG_DFL)  # a forked worker had the parent's
-    die_with_parent(parent_pid)
+    start_child(parent_pid)  # Ctrl-C is the parent's; SIGTERM ends it; exits with the parent
     while True:
         try:
             item = conn.recv()

@@ -36,7 +36,13 @@ from flexsat import __version__
 from flexsat._compiled_cache import kernels_cached
 from flexsat.config.models import SatelliteConfig
 from flexsat.control.laws import LAWS
-from flexsat.parallel import die_with_parent, figure_workers, forked_map, frozen_heap
+from flexsat.parallel import (
+    figure_workers,
+    forked_map,
+    frozen_heap,
+    signals_deferred,
+    start_child,
+)
 from flexsat.study.outputs import (
     derived_properties,
     fly_campaign,
@@ -521,7 +527,7 @@ def _run_parts(
     receive, send = context.Pipe(duplex=False)
     lane = context.Process(target=_run_lane, name="flexsat-lane-1",
                            args=(forked, ctx, send, prepare.get(1, []), os.getpid()))  # fmt: skip
-    with frozen_heap():
+    with frozen_heap(), signals_deferred():
         lane.start()
     send.close()  # the lane holds the only writing end: its exit ends the reading
     pending = {part.name: part for part in forked}
@@ -562,8 +568,9 @@ def _run_parts(
 def _run_lane(parts: list[Part], ctx: StudyContext, send, runs: list, parent_pid: int) -> None:
     """Lane 1 in its forked process: fly ``runs`` (its share of :func:`_compile`) and send
     (None, their time [s], None), then run ``parts`` in order, send (name, entry,
-    outputs) each. It exits with the study's process (``parent_pid``), even killed."""
-    die_with_parent(parent_pid)
+    outputs) each. Ctrl-C is the study's process's to handle; the lane exits with it
+    (``parent_pid``), even killed."""
+    start_child(parent_pid)
     ctx.progress = False  # two lanes' progress bars would interleave
     send.send((None, _fly_each(ctx, list(runs)), None))
     for part in parts:
