@@ -38,7 +38,7 @@ chromium:
 TEST_WORKERS ?= 2
 test: $(DEV) chromium
 	$(BIN)/ruff check src tests bench examples
-	$(BIN)/python -m pytest -q -n $(TEST_WORKERS) --dist loadfile
+	$(BIN)/python -m pytest -q -n $(TEST_WORKERS) --dist loadfile --durations=15
 	$(MAKE) docs
 
 # Every benchmark and the table of performance targets (docs/performance.md); the
