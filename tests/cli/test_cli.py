@@ -28,6 +28,16 @@ def test_help_reads_well():
         assert command in result.stdout
 
 
+def test_slew_help_names_every_built_in_law():
+    # --controller's help lists the laws flexsat registers itself (it had missed the
+    # two beyond the thesis): no user's law is registered in this process.
+    result = run("slew", "--help")
+    assert result.returncode == 0
+    text = " ".join(result.stdout.split())
+    listed = text.split("built in:")[1].split(")")[0]
+    assert sorted(name.strip() for name in listed.split(",")) == sorted(law_names())
+
+
 def test_modal_json_has_the_documented_keys():
     result = run("modal", "--json")
     assert result.returncode == 0, result.stderr

@@ -318,7 +318,7 @@ def slew(
         str | None,
         typer.Option(
             help="Override the law: any registered law by name, with its default gains "
-            "(built in: asmc, smc, pd), or all (compare every registered law)."
+            "(built in: asmc, smc, pd, stsmc, ismc), or all (compare every registered law)."
         ),
     ] = None,
     target_euler_deg: Annotated[
