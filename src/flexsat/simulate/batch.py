@@ -15,10 +15,10 @@ from typing import NamedTuple
 
 import numpy as np
 from numba import config, njit, prange, set_num_threads, typeof
-from numba.typed import List
 
 from flexsat.simulate.common import chunk_steps
 from flexsat.simulate.loops import LoopClock, LoopRecords, rk4_closed_loop
+from flexsat.simulate.typed_call import typed_append, typed_list
 
 __all__ = [
     "BatchItem",
@@ -222,23 +222,6 @@ def fly_batch(items, out):
         out[i, 0], out[i, 1], out[i, 2] = status, done, rows
 
 
-@njit(cache=True)
-def _new_list(item):
-    """A typed list of ``item``. Built here, its methods are compiled into this cached
-    function: ``numba.typed.List()`` and its ``append`` called from Python are
-    compiled for the item type in every process, uncached (2.8 s before the first
-    batch of each campaign worker, docs/performance.md, 'Workers that start sooner')."""
-    items = List()
-    items.append(item)
-    return items
-
-
-@njit(cache=True)
-def _append(items, item):
-    """``items.append(item)``, cached (see :func:`_new_list`)."""
-    items.append(item)
-
-
 def fly_prepared(runs: list, threads: int = 1) -> np.ndarray:
     """Fly prepared slews to their ends, those of one structure in one compiled call.
 
@@ -265,9 +248,9 @@ def fly_prepared(runs: list, threads: int = 1) -> np.ndarray:
     out = np.zeros((len(runs), 3), dtype=np.int64)
     set_num_threads(max(1, min(threads, config.NUMBA_NUM_THREADS)))
     for members in groups.values():
-        items = _new_list(members[0][1])
+        items = typed_list(members[0][1])
         for _, item in members[1:]:
-            _append(items, item)
+            typed_append(items, item)
         flown = np.zeros((len(members), 3), dtype=np.int64)
         fly_batch(items, flown)
         out[[index for index, _ in members]] = flown

@@ -7,6 +7,7 @@ import time
 from typing import NamedTuple, Protocol
 
 import numpy as np
+from numba import njit
 
 from flexsat.config import nominal
 from flexsat.config.models import SatelliteConfig
@@ -36,7 +37,7 @@ from flexsat.simulate.loops import LoopData, LoopStages, run_actuators, run_sens
 from flexsat.simulate.openloop import initial_state
 from flexsat.simulate.result import Result, build_dataset
 from flexsat.simulate.scenario import SlewScenario
-from flexsat.simulate.typed_call import TypedOnce
+from flexsat.simulate.typed_call import TypedOnce, typed_list
 
 __all__ = [
     "Controller",
@@ -550,6 +551,40 @@ def _fly_arguments(run: PreparedSlew, done: int, rows: int, max_chunks: int) -> 
             max_chunks)  # fmt: skip
 
 
+@njit(cache=True)
+def _listed_sensors(x, n, t, loop):
+    """:func:`~flexsat.simulate.loops.run_sensors` on the structures in ``loop``, a typed
+    list of one (stages, data, packed plant) tuple: unboxed as one pointer, where
+    the structures themselves would unbox every array and first-class function at
+    every call (:mod:`flexsat.simulate.typed_call`)."""
+    stages, d, _ = loop[0]
+    return run_sensors(x, n, t, stages, d)
+
+
+@njit(cache=True)
+def _listed_actuators(x, n, t, control_dt, continuous, loop):
+    """:func:`~flexsat.simulate.loops.run_actuators` on ``loop`` (:func:`_listed_sensors`)."""
+    stages, d, _ = loop[0]
+    return run_actuators(x, n, t, control_dt, continuous, stages, d)
+
+
+@njit(cache=True)
+def _listed_coupled_hold(x, t0, dt, n_steps, loop):
+    """:func:`~flexsat.simulate.coupled.rk4_coupled_hold` on ``loop`` (:func:`_listed_sensors`)."""
+    stages, d, packed = loop[0]
+    return rk4_coupled_hold(x, t0, dt, n_steps, stages.derivative, d.actuator_params, d.flow,
+                            packed)  # fmt: skip
+
+
+@njit(cache=True)
+def _listed_hold(x, dt, n_steps, frame, loop):
+    """:func:`~flexsat.dynamics.integrators.rk4_hold` under the held ``tau_applied``, on
+    ``loop`` (:func:`_listed_sensors`)."""
+    _, d, packed = loop[0]
+    torque = (d.tau_applied[0], d.tau_applied[1], d.tau_applied[2])
+    return rk4_hold(x, dt, n_steps, torque, packed, frame)
+
+
 def _python_loop(plant, scenario, x, frame, stages, d, rec_t, rec_x, rec_ctrl, rec_frame, bar,
                  task, controller, continuous):  # fmt: skip
     """Python controller at each control instant between the compiled stages; the plant
@@ -561,9 +596,11 @@ def _python_loop(plant, scenario, x, frame, stages, d, rec_t, rec_x, rec_ctrl, r
     limit = scenario.actuator.reduction_factor * scenario.actuator.t_max_nm
     d.law_diag[:] = np.nan
     view = np.empty_like(x)
-    # the same arguments at every instant: typed once (flexsat.simulate.typed_call)
-    sensors, actuators = TypedOnce(run_sensors), TypedOnce(run_actuators)
-    coupled_hold, hold = TypedOnce(rk4_coupled_hold), TypedOnce(rk4_hold)
+    # the same arguments at every instant: typed once, and the loop's structures in a
+    # typed list, unboxed as one pointer (flexsat.simulate.typed_call)
+    loop = typed_list((stages, d, plant.packed))
+    sensors, actuators = TypedOnce(_listed_sensors), TypedOnce(_listed_actuators)
+    coupled_hold, hold = TypedOnce(_listed_coupled_hold), TypedOnce(_listed_hold)
     rows, status, k = 0, 0, 0
     while True:
         t = k * scenario.dt_s
@@ -572,12 +609,12 @@ def _python_loop(plant, scenario, x, frame, stages, d, rec_t, rec_x, rec_ctrl, r
             if not is_identity(frame):  # re-based between steps: the sensors read N
                 inertial_view(x, n, frame, view)
                 sensed = view
-            status = sensors(sensed, n, t, stages, d)
+            status = sensors(sensed, n, t, loop)
             tau_cmd = np.asarray(controller(t, d.q_meas.copy(), d.omega_meas.copy()), dtype=float)
             if tau_cmd.shape != (3,) or not np.all(np.isfinite(tau_cmd)):
                 raise SimulationError(f"controller returned {tau_cmd!r} at t = {t:.6g} s")
             d.tau_cmd[:] = np.clip(tau_cmd, -limit, limit)
-            status |= actuators(x, n, t, control_dt, continuous, stages, d)
+            status |= actuators(x, n, t, control_dt, continuous, loop)
             if status:
                 return STATUS_CONTROL_FAILED, k, rows
         if k % every == 0:
@@ -587,11 +624,9 @@ def _python_loop(plant, scenario, x, frame, stages, d, rec_t, rec_x, rec_ctrl, r
             return 0, k, rows
         if continuous:  # re-based once per block (a few steps: far from the pole)
             rebase(x, n, frame)
-            status, ran = coupled_hold(x, t, scenario.dt_s, block, stages.derivative,
-                                       d.actuator_params, d.flow, plant.packed)  # fmt: skip
+            status, ran = coupled_hold(x, t, scenario.dt_s, block, loop)
         else:
-            torque = (d.tau_applied[0], d.tau_applied[1], d.tau_applied[2])
-            status, ran = hold(x, scenario.dt_s, block, torque, plant.packed, frame)
+            status, ran = hold(x, scenario.dt_s, block, frame, loop)
         k += ran
         if status:
             return status, k, rows

@@ -10,6 +10,7 @@ from pathlib import Path
 
 import numpy as np
 import xarray as xr
+from numba import njit
 
 from flexsat.dynamics.attitude import SWITCH_PITCH, identity_frame, rebase
 from flexsat.dynamics.integrators import (
@@ -32,8 +33,9 @@ from flexsat.simulate.common import (
 from flexsat.simulate.result import Result, build_dataset
 from flexsat.simulate.scenario import OpenLoopScenario, thesis_openloop
 from flexsat.simulate.stream import RecordStream, check_disk_space
+from flexsat.simulate.typed_call import typed_list
 
-__all__ = ["initial_state", "run_openloop"]
+__all__ = ["initial_state", "listed_derivative", "run_openloop"]
 
 
 
@@ -258,6 +260,38 @@ def _run_rk4(plant, scenario, q0, qd0, profile, progress, keep, capacity=None):
     return status, t_fail, done
 
 
+@njit(cache=True)
+def listed_derivative(x, torque_B, n, Q, dx, plants):
+    """:func:`~flexsat.dynamics.integrators.augmented_derivative` of the plant held in
+    a typed list, for a solver that calls it from Python at every evaluation.
+
+    Passed as it is, the :class:`~flexsat.dynamics.packed.PackedPlant` would be
+    unboxed at every call, each array and kernel of it: about 60 us, ten times the
+    rest of the call (:mod:`flexsat.simulate.typed_call`).
+
+    Parameters
+    ----------
+    x : ndarray, shape (2 n + 2,)
+        Augmented state [q, q_dot, W_in, W_diss] (SI: m, rad, m/s, rad/s, J).
+    torque_B : tuple of 3 float
+        Applied torque on the hub, hub frame B [N m].
+    n : int
+        Number of generalized coordinates.
+    Q : ndarray, shape (n,)
+        Generalized forces on the joints [N, N m per coordinate].
+    dx : ndarray, shape (2 n + 2,)
+        Written: the state's rate [SI per s].
+    plants : numba.typed.List of PackedPlant
+        :func:`~flexsat.simulate.typed_call.typed_list` of ``Plant.packed``.
+
+    Returns
+    -------
+    int
+        ``STATUS_OK`` or the kernel's status.
+    """
+    return augmented_derivative(x, torque_B, n, Q, dx, plants[0], hub_cs(x))
+
+
 def _run_dop853(plant, scenario, q0, qd0, profile):
     """Adaptive DOP853 (scipy), integrated piecewise between torque switching times.
 
@@ -278,6 +312,7 @@ def _run_dop853(plant, scenario, q0, qd0, profile):
         np.clip(np.concatenate([[0.0, scenario.duration_s], seg_start, seg_end]), 0.0, t_rec[-1])
     )
     x = np.concatenate([q0, qd0, [0.0, 0.0]])
+    plants = typed_list(plant.packed)  # passed to the compiled derivative in one pointer
     X = np.empty((t_rec.size, x.size))
     X[0] = x
     frame = identity_frame()
@@ -302,7 +337,7 @@ def _run_dop853(plant, scenario, q0, qd0, profile):
             nonlocal evaluations, kernel_status
             evaluations += 1
             dy = np.empty_like(y)
-            code = augmented_derivative(y, torque, n, Q, dy, plant.packed, hub_cs(y))
+            code = listed_derivative(y, torque, n, Q, dy, plants)
             if code != STATUS_OK:  # a joint's singularity: make the step fail here
                 kernel_status = code
                 dy[:] = np.nan
