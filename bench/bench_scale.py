@@ -40,6 +40,7 @@ from __future__ import annotations
 import argparse
 import contextlib
 import itertools
+import math
 import os
 import resource
 import shutil
@@ -138,7 +139,8 @@ def main(argv: list[str] | None = None) -> dict:
             scaling = "met" if efficiency >= GOAL_EFFICIENCY else "not met"
             cpu = cpus.get((model, backend, 1), float("nan"))
             table.add_row(model, backend, f"{one:.1f}", f"{two:.1f}", f"{n / two:.2f}",
-                          f"{efficiency:.0%}", f"{pairs:.0%}", f"{per_1000:.0f}", f"{cpu:.3f}",
+                          f"{efficiency:.0%}", f"{pairs:.0%}", f"{per_1000:.0f}",
+                          "-" if math.isnan(cpu) else f"{cpu:.3f}",  # NaN: run elsewhere
                           speed, scaling)  # fmt: skip
             results[f"{model} {backend}"] = {"wall_1_s": one, "wall_2_s": two,
                                              "cases_per_s_2": n / two, "efficiency": efficiency,
