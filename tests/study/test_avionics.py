@@ -9,7 +9,12 @@ import pytest
 
 from flexsat.config import nominal
 from flexsat.dynamics.plant import Plant
-from flexsat.study.avionics import SADM_RATE_DEG_S, avionics_study, render_avionics
+from flexsat.study.avionics import (
+    AVIONICS_FIGURES,
+    SADM_RATE_DEG_S,
+    avionics_study,
+    render_avionics,
+)
 
 HORIZON_S = 40.0
 
@@ -76,3 +81,13 @@ def test_report_rows_trace_every_number(study):
     assert ("sadm", "turning", "settling_time_s") in [row[2] for row in sadm]
     assert "0.06 deg/s" in sentence and "unstable from 0.5 s" in sentence
     assert written["figures"][0].exists()
+
+
+def test_the_avionics_runs_stage_figures_are_written(study):
+    # The report shows the avionics run's estimation (MEKF) and wheel figures beside
+    # the delay boundary (their content: tests/plots/test_stage_plots.py).
+    out, written, _ = study
+    names = [path.name for path in written["figures"]]
+    assert names == ["delay_boundary.png", *(f"{name}.png" for name in AVIONICS_FIGURES)]
+    for path in written["figures"]:
+        assert path.parent == out and path.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"

@@ -23,6 +23,8 @@ run (``ds.attrs["scenario"]``), so they match whatever scenario flew the slew.
   drawn for the slew (without their torque-on shading, torque being commanded
   throughout a slew).
 - :func:`attitude_error_vector`: q_v,e at every record, for the phase plane.
+- the loop stages' figures (:mod:`flexsat.plots.stages`): one per stage that
+  records something (wheels, gyro, star tracker, MEKF, drive...), named after it.
 - :func:`write_slew_figures`: all of the above into a folder as PNG.
 """
 
@@ -44,7 +46,7 @@ from pydantic import ValidationError
 
 from flexsat.analysis.requirements import settling_time, slew_metrics
 from flexsat.control.quaternion import quaternion_error, target_quaternion
-from flexsat.plots import style
+from flexsat.plots import stages, style
 from flexsat.plots.openloop import (
     plot_energy,
     plot_root_deformation,
@@ -153,16 +155,6 @@ def _recorded(values: np.ndarray) -> bool:
 def _settled(what: str, t: float) -> str:
     """When ``what`` holds for good, from a settling time (NaN: not by the end)."""
     return "not settled by the end of the run" if math.isnan(t) else f"{what} from t = {t:.4g} s"
-
-
-def _figure_legend(fig: Figure, axes, ncols: int | None = None) -> None:
-    """One legend below the axes with every distinct label of ``axes``, in order."""
-    seen: dict[str, object] = {}
-    for ax in np.ravel(axes):
-        for handle, label in zip(*ax.get_legend_handles_labels(), strict=True):
-            seen.setdefault(label, handle)
-    if seen:
-        style.figure_legend(fig, list(seen.values()), list(seen), ncols or min(len(seen), 6))
 
 
 def plot_slew_root_deformation(ds: xr.Dataset) -> Figure:
@@ -530,7 +522,7 @@ def plot_phase_plane(ds: xr.Dataset) -> Figure:
         for row in range(2):
             axes[row, k].set_xlabel(f"q_v,e,{a} [-]")
             axes[row, k].set_ylabel(f"ω_e,{a} [rad/s]")
-    _figure_legend(fig, axes[:, 0], ncols=4)
+    style.axes_legend(fig, axes[:, 0], ncols=4)
     if lines is not None:
         extend = "max" if t_colour < t[-1] else "neither"
         label = "time t [s]" + (" (later: end colour)" if extend == "max" else "")
@@ -584,7 +576,7 @@ def plot_sliding_variables(ds: xr.Dataset) -> Figure:
             ax.axvline(inside, color="0.3", linestyle=":", linewidth=1.2)
         settled = _settled("inside the boundary layer for good", inside)
         ax.set_title(f"s_{style.AXES[k]}: {settled}; final {s[-1, k]:.3g} rad/s", fontsize=10)
-    _figure_legend(fig, axes)
+    style.axes_legend(fig, axes)
     style.finish_time_axis(axes, t)
     scale = "symlog, linear within ±Φ/1000"
     style.suptitle(fig, ds, f"Sliding variables s = ω_e + Λ q_v,e ({_law_name(ds)}; {scale})")
@@ -747,7 +739,7 @@ def plot_disturbances(ds: xr.Dataset) -> Figure:
         if surface is not None:
             title += f" (robust-gain floor JK_min = {surface.jk_min:.4g} N m)"
         ax.set_title(title, fontsize=10)
-    _figure_legend(fig, axes, ncols=4)
+    style.axes_legend(fig, axes, ncols=4)
     style.finish_time_axis(axes, t)
     style.suptitle(fig, ds, "Disturbance torques of the actuator model (frame B)")
     return fig
@@ -797,7 +789,7 @@ def plot_torque_limits(ds: xr.Dataset) -> Figure:
         ax.set_title(f"axis {a}: peak |τ_cmd| = {np.nanmax(np.abs(cmd[:, k])):.4g} N m, "
                      f"|τ_applied| = {np.nanmax(np.abs(applied[:, k])):.4g} N m",
                      fontsize=10)  # fmt: skip
-    _figure_legend(fig, axes, ncols=4)
+    style.axes_legend(fig, axes, ncols=4)
     style.finish_time_axis(axes, t)
     verdict = "PASS" if r3 else "FAIL"
     style.suptitle(
@@ -856,7 +848,7 @@ def plot_torque_breakdown(ds: xr.Dataset) -> Figure:
         )
         ax.set_ylabel(f"τ_{a} [N m]")
         ax.set_title(f"axis {a}", fontsize=10)
-    _figure_legend(fig, axes, ncols=5)
+    style.axes_legend(fig, axes, ncols=5)
     style.finish_time_axis(axes, t)
     style.suptitle(fig, ds, f"Breakdown of the commanded torque ({_law_name(ds)})")
     return fig
@@ -901,7 +893,7 @@ def plot_flex_torque(ds: xr.Dataset) -> Figure:
         ax.set_title(f"axis {a}: peak |τ_flex| = {np.nanmax(np.abs(flex[:, k])):.3g} N m, "
                      f"peak |τ_net| = {np.nanmax(np.abs(net[:, k])):.3g} N m",
                      fontsize=10)  # fmt: skip
-    _figure_legend(fig, axes)
+    style.axes_legend(fig, axes)
     style.finish_time_axis(axes, t)
     style.suptitle(fig, ds, "Flexible torque against net torque on the hub (frame B)")
     return fig
@@ -933,10 +925,12 @@ _SURFACE_FIGURES = ("sliding_variables", "adaptation")
 
 
 def slew_figure_names(ds: xr.Dataset) -> tuple[str, ...]:
-    """The figures a run has something to show in, in the order of :data:`SLEW_FIGURES`.
+    """The figures a run has something to show in: :data:`SLEW_FIGURES`, then its stages'.
 
     A law without a sliding surface (PD, a plain-Python controller) records no
-    sliding variable, slope or robust gain: its run has no figure of them.
+    sliding variable, slope or robust gain: its run has no figure of them. Each
+    loop stage that recorded something adds its figure, named after the stage
+    (:func:`flexsat.plots.stages.stage_figure_names`).
 
     Parameters
     ----------
@@ -949,25 +943,27 @@ def slew_figure_names(ds: xr.Dataset) -> tuple[str, ...]:
         The figure names.
     """
     has_surface = _surface(ds) is not None and "sliding_variable" in ds
-    return tuple(n for n in SLEW_FIGURES if has_surface or n not in _SURFACE_FIGURES)
+    own = tuple(n for n in SLEW_FIGURES if has_surface or n not in _SURFACE_FIGURES)
+    return own + stages.stage_figure_names(ds)
 
 
 def plot_slew(ds: xr.Dataset, name: str) -> Figure:
-    """The slew figure ``name`` (one of :data:`SLEW_FIGURES`) of a closed-loop run.
+    """The slew figure ``name`` (one of :func:`slew_figure_names`) of a closed-loop run.
 
     Parameters
     ----------
     ds : xarray.Dataset
         A slew's dataset.
     name : str
-        One of :data:`SLEW_FIGURES`.
+        One of :data:`SLEW_FIGURES` or a flown stage's name.
 
     Returns
     -------
     Figure
         The figure.
     """
-    return _MAKERS[name](ds)
+    maker = _MAKERS.get(name)
+    return maker(ds) if maker is not None else stages.plot_stage(ds, name)
 
 
 def write_slew_figures(ds: xr.Dataset, out_dir: str | Path, *, dpi: int = 120) -> list[Path]:
@@ -981,7 +977,9 @@ def write_slew_figures(ds: xr.Dataset, out_dir: str | Path, *, dpi: int = 120) -
     ``root_deformation.png`` and ``tip_displacement.png``
     (:func:`flexsat.plots.openloop.plot_root_deformation`,
     :func:`~flexsat.plots.openloop.plot_tip_displacement`), ``flex_torque.png``
-    and ``energy.png`` (:func:`flexsat.plots.openloop.plot_energy`).
+    and ``energy.png`` (:func:`flexsat.plots.openloop.plot_energy`), then one
+    ``<stage>.png`` per loop stage that recorded something
+    (:mod:`flexsat.plots.stages`).
 
     Parameters
     ----------
@@ -999,4 +997,4 @@ def write_slew_figures(ds: xr.Dataset, out_dir: str | Path, *, dpi: int = 120) -
     """
     _scenario(ds)  # fail early on a dataset that is not a slew
     names = slew_figure_names(ds)
-    return style.write_figures(out_dir, names, lambda name: _MAKERS[name](ds), dpi=dpi)
+    return style.write_figures(out_dir, names, lambda name: plot_slew(ds, name), dpi=dpi)

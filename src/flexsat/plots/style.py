@@ -6,7 +6,8 @@ run, a slew, a campaign and a comparison look alike. Figures are created directl
 changes the global backend.
 
 - :func:`figure`: a figure of fixed margins and its 2-D array of axes.
-- :func:`figure_legend`: one legend below the axes, the margin grown to hold it.
+- :func:`figure_legend`: one legend below the axes, the margin grown to hold it;
+  :func:`axes_legend`, the same of every distinct label the axes carry.
 - :func:`time_s`: the time coordinate of a result dataset [s].
 - :func:`suptitle`: the figure title, the run's title below it and a failure notice.
 - :func:`line`, :func:`envelope`: a time series, thinned to a min/max envelope when long.
@@ -37,6 +38,7 @@ __all__ = [
     "BAND",
     "EULER",
     "MAX_LINE_POINTS",
+    "axes_legend",
     "envelope",
     "figure",
     "figure_legend",
@@ -149,6 +151,26 @@ def figure_legend(fig: Figure, handles: list, labels: list[str], ncols: int) -> 
         spec = ax.get_subplotspec()
         if spec is not None and spec.get_gridspec() is grid:
             ax.set_position(spec.get_position(fig))
+
+
+def axes_legend(fig: Figure, axes, ncols: int | None = None) -> None:
+    """:func:`figure_legend` of every distinct label of ``axes``, in the order drawn.
+
+    Parameters
+    ----------
+    fig : Figure
+        A figure from :func:`figure`.
+    axes : grid of Axes
+        The axes whose labelled artists the legend lists.
+    ncols : int, optional
+        Legend columns; default as many as labels, at most 6.
+    """
+    seen: dict[str, object] = {}
+    for ax in np.ravel(axes):
+        for handle, label in zip(*ax.get_legend_handles_labels(), strict=True):
+            seen.setdefault(label, handle)
+    if seen:
+        figure_legend(fig, list(seen.values()), list(seen), ncols or min(len(seen), 6))
 
 
 def time_s(ds: xr.Dataset) -> np.ndarray:

@@ -89,7 +89,8 @@ class Result:
             slew: ``attitude``, ``quaternion``, ``pointing``, ``phase_plane``, the
             sliding-surface figures when the law has one, ``disturbances``,
             ``torque_limits``, ``torque_breakdown``, ``root_deformation``,
-            ``tip_displacement``, ``flex_torque``, ``energy``).
+            ``tip_displacement``, ``flex_torque``, ``energy``, then one per loop
+            stage that records something, named after it: ``mekf``, ``wheels``...).
         analysis : flexsat.analysis.modal.ModalAnalysis, optional
             For the modal lines of the open-loop figures; default: computed from
             the stored config when the figure needs it.

@@ -9,7 +9,9 @@ goes unstable, with the figure of the pointing and jitter figures against delay;
 drive (:func:`flexsat.dynamics.appendages.sadm.with_sadm`), the ideal loop with
 the drive holding its angle beside the drive turning at :data:`SADM_RATE_DEG_S`
 (``docs/control.md``, "Solar-array drive (SADM)"). Writes
-``avionics/avionics.json`` and ``avionics/delay_boundary.png``. The runs of (a)
+``avionics/avionics.json``, ``avionics/delay_boundary.png`` and the avionics
+run's ``avionics/mekf.png`` and ``avionics/wheels.png`` (the estimation error
+inside its covariance; the wheels' momentum and limit). The runs of (a)
 and (b) and the two of (c) are independent: they fly in forked processes side by
 side (:func:`flexsat.parallel.forked_map`).
 """
@@ -25,15 +27,28 @@ from flexsat.config.models import AppendageConfig, SatelliteConfig
 from flexsat.dynamics.plant import Plant
 from flexsat.simulate import SlewScenario, run_slew
 
-__all__ = ["AVIONICS", "DELAYS_S", "QUICK_DELAYS_S", "SADM_DRIVE", "SADM_RATE_DEG_S",
-           "avionics_study", "delayed", "render_avionics", "sadm_plant", "sadm_runs",
-           "sadm_study"]
+__all__ = [
+    "AVIONICS",
+    "AVIONICS_FIGURES",
+    "DELAYS_S",
+    "QUICK_DELAYS_S",
+    "SADM_DRIVE",
+    "SADM_RATE_DEG_S",
+    "avionics_study",
+    "delayed",
+    "render_avionics",
+    "sadm_plant",
+    "sadm_runs",
+    "sadm_study",
+]
 
 AVIONICS = {
     "sensor_stages": [{"kind": "gyro"}, {"kind": "star_tracker"}, {"kind": "mekf"}],
     "actuator": {"kind": "wheels"},
 }
 """The realistic chain: the stages' default (documented) settings."""
+AVIONICS_FIGURES = ("mekf", "wheels")
+"""Stage figures of the avionics run in the report (:mod:`flexsat.plots.stages`)."""
 DELAYS_S = (0.0, 0.01, 0.02, 0.05, 0.1, 0.2, 0.3, 0.5, 0.8)
 QUICK_DELAYS_S = (0.05, 0.5)
 _KEYS = ("r1_pass", "r2_pass", "r3_pass", "ape_deg", "rpe_deg", "max_rate_error_deg_s",
@@ -74,11 +89,6 @@ def _run(plant, fields: dict, duration_s: float | None):
     if duration_s is not None:
         fields = {**fields, "duration_s": duration_s}
     return run_slew(plant, SlewScenario.model_validate(fields), progress=False).dataset
-
-
-def _metrics(plant, fields: dict, duration_s: float | None) -> dict:
-    metrics = slew_metrics(_run(plant, fields, duration_s))
-    return {key: metrics[key] for key in _KEYS}
 
 
 def sadm_study(plant, duration_s: float | None = None) -> dict:
@@ -215,18 +225,23 @@ def avionics_study(plant, out: str | Path, quick: bool = False,
     control_dt = SlewScenario().control_dt_s
     periods = [round(delay / control_dt) for delay in (QUICK_DELAYS_S if quick else DELAYS_S)]
     driven, drive_runs = _sadm_runs(plant)
-    # (on the driven satellite, fields): the items are pickled to the forks, the
-    # satellites are not (the forks inherit them)
-    runs = [(False, fields) for fields in ({}, AVIONICS, *(delayed(n) for n in periods))]
-    runs += [(True, fields) for fields in drive_runs]
+    # (how, fields): the items are pickled to the forks, the satellites are not (the
+    # forks inherit them); the avionics run also draws its stages' figures
+    runs = [("metrics", {}), ("figures", AVIONICS)]
+    runs += [("metrics", delayed(n)) for n in periods] + [("drive", f) for f in drive_runs]
 
-    def fly(run: tuple) -> dict:
-        on_drive, fields = run
-        if on_drive:
-            return _sadm_run(driven, fields, duration_s)
-        return _metrics(plant, fields, duration_s)
+    def fly(run: tuple) -> tuple[dict, list[Path]]:
+        how, fields = run
+        if how == "drive":
+            return _sadm_run(driven, fields, duration_s), []
+        ds = _run(plant, fields, duration_s)
+        metrics = slew_metrics(ds)
+        figures = _stage_figures(ds, out) if how == "figures" else []
+        return {key: metrics[key] for key in _KEYS}, figures
 
-    ideal, avionics, *swept, holding, turning = forked_map(fly, runs)
+    flown = forked_map(fly, runs)
+    (ideal, _), (avionics, stage_figures), *swept, (holding, _), (turning, _) = flown
+    swept = [metrics for metrics, _ in swept]
     side_by_side = {"ideal": ideal, "avionics": avionics}
     sweep = []
     for n, row in zip(periods, swept, strict=True):
@@ -252,7 +267,18 @@ def avionics_study(plant, out: str | Path, quick: bool = False,
 
     json_path = write_json(out / "avionics.json", payload)
     figure = _delay_figure(sweep, out / "delay_boundary.png")
-    return {"json": json_path, "figures": [figure]}
+    return {"json": json_path, "figures": [figure, *stage_figures]}
+
+
+def _stage_figures(ds, out: Path) -> list[Path]:
+    """The figures of the stages of the avionics run that show what the ideal loop
+    cannot: the estimation error inside its covariance, and the wheels
+    (:mod:`flexsat.plots.stages`)."""
+    from flexsat.plots.stages import plot_stage
+    from flexsat.plots.style import save_figure
+
+    return [save_figure(plot_stage(ds, name), out / f"{name}.png", dpi=110)
+            for name in AVIONICS_FIGURES]  # fmt: skip
 
 
 def _delay_figure(sweep: list[dict], path: Path) -> Path:

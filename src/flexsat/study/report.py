@@ -525,7 +525,10 @@ def _avionics(root: Path, outputs: dict, context: dict) -> str:
     return "".join([
         "<p>The thesis's slew with a gyro, a star tracker, the MEKF and four reaction "
         "wheels beside the ideal loop, then the ideal loop with a computational delay "
-        "(docs/control.md, 'Avionics in the loop').</p>",
+        "(docs/control.md, 'Avionics in the loop'). The figures: the stability boundary "
+        "against delay, then the avionics run's attitude estimation (the MEKF's error "
+        "inside its ±3σ, its NEES against the χ² interval) and its wheels (momentum, "
+        "the fullest wheel against its limit).</p>",
         _table(["metric", "ideal", "avionics"], side, "Ideal loop and realistic avionics"),
         _table(["delay [s]", "R1", "R2", "APE [deg]", "max rate error [deg/s]", "unstable"],
                sweep, "Sweep over the computational delay"),
