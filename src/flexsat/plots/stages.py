@@ -40,6 +40,7 @@ from flexsat.control.stages.registry import (
     SENSORS,
     StageSpec,
 )
+from flexsat.control.stages.wheels import SATURATED_RATIO
 from flexsat.plots import style
 
 __all__ = [
@@ -70,7 +71,6 @@ value reaches :data:`_SMALLEST_SHOWN` is used."""
 _SMALLEST_SHOWN = 0.01
 NEES_PROBABILITY = 0.95
 """Probability of the two-sided χ² interval drawn around the NEES."""
-_SATURATED = 0.999  # the wheels' saturation report threshold, |h_i| / (I_s Omega_max)
 
 
 def flown_stages(ds: xr.Dataset) -> tuple[StageSpec, ...]:
@@ -347,7 +347,7 @@ def _first_saturations(ds: xr.Dataset) -> str:
     (:func:`flexsat.analysis.requirements.actuator_saturation_times`, R3's)."""
     times = actuator_saturation_times(ds)
     if not times:
-        return f"no wheel reached {100 * _SATURATED:.1f} % of its limit"
+        return f"no wheel reached {100 * SATURATED_RATIO:.1f} % of its limit"
     return "saturated: " + ", ".join(f"wheel {unit} at t = {t:.4g} s" for unit, t in times.items())
 
 

@@ -46,7 +46,7 @@ from flexsat.control.stages.registry import (
     StageSpec,
 )
 
-__all__ = ["MAX_WHEELS", "WHEELS", "WheelsConfig", "wheel_axes"]
+__all__ = ["MAX_WHEELS", "SATURATED_RATIO", "WHEELS", "WheelsConfig", "wheel_axes"]
 
 MAX_WHEELS = 6
 """Most wheels in one cluster (the stage's state is sized for them)."""
@@ -64,7 +64,8 @@ _SIZE = _INV_IS + 5
 # u_i at N + i, command u_cmd,i at 2 N + i (held: zero rate), motor work at 3 N,
 # friction loss at 3 N + 1
 _RPM = 2.0 * np.pi / 60.0  # [rad/s per rpm]
-_SATURATED = 0.999  # |h_i| / (I_s Omega_max) reported as saturated
+SATURATED_RATIO = 0.999
+"""|h_i| / (I_s Omega_max) at and above which a wheel is reported saturated."""
 
 NonNegative = Annotated[float, Field(ge=0.0, allow_inf_nan=False)]
 
@@ -274,7 +275,7 @@ def wheels_step(tau_cmd, t, dt, params, state, tau_applied, record):
         hz += p[_A + 2 * MAX_WHEELS + i] * h
         h2 += h * h
         h_abs = max(h_abs, abs(h))
-        if abs(h) >= _SATURATED * p[_HMAX]:
+        if abs(h) >= SATURATED_RATIO * p[_HMAX]:
             saturated += 2.0**i
     tau_applied[0], tau_applied[1], tau_applied[2] = 0.0, 0.0, 0.0
     record[0], record[1], record[2] = hx, hy, hz
