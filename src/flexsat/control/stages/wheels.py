@@ -65,7 +65,7 @@ _SIZE = _INV_IS + 5
 # friction loss at 3 N + 1
 _RPM = 2.0 * np.pi / 60.0  # [rad/s per rpm]
 SATURATED_RATIO = 0.999
-"""|h_i| / (I_s Omega_max) at and above which a wheel is reported saturated."""
+"""``abs(h_i) / (I_s Omega_max)`` at and above which a wheel is reported saturated."""
 
 NonNegative = Annotated[float, Field(ge=0.0, allow_inf_nan=False)]
 
