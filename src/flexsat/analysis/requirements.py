@@ -171,6 +171,7 @@ def relative_performance_error(t: np.ndarray, error: np.ndarray, duration_s: flo
     one (a shorter last window counts too); in each window the error vector's mean
     is taken and the RPE is the largest distance of a record from its window's
     mean. It measures the pointing stability over ``duration_s``, without the bias.
+    A window holding a NaN record (a failed run's last state) is passed over.
 
     Parameters
     ----------
@@ -191,11 +192,14 @@ def relative_performance_error(t: np.ndarray, error: np.ndarray, duration_s: flo
     if t.size == 0:
         return float("nan")
     index = np.floor((t - t[0]) / duration_s + _TIME_TOL).astype(np.int64)
-    worst = 0.0
-    for k in np.unique(index):
-        inside = error[index == k]
-        worst = max(worst, float(np.linalg.norm(inside - inside.mean(axis=0), axis=1).max()))
-    return worst
+    # the records are in time order: each window is a run of rows, so one reduceat per
+    # quantity serves every window (a loop over windows cost ~50 us each, ~1.5 ms a case)
+    starts = np.flatnonzero(np.diff(index, prepend=index[0] - 1))
+    counts = np.diff(starts, append=t.size)
+    means = np.add.reduceat(error, starts, axis=0) / counts[:, None]
+    distance = np.linalg.norm(error - np.repeat(means, counts, axis=0), axis=1)
+    worst = np.maximum.reduceat(distance, starts)  # NaN for a window holding a NaN
+    return float(np.fmax.reduce(worst, initial=0.0))  # such a window is passed over
 
 
 def actuator_saturation_times(ds: xr.Dataset) -> dict[str, float]:
