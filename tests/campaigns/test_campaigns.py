@@ -217,6 +217,9 @@ BAD_CAMPAIGNS = [
     ('[[cases]]\nid = "a"\nplant = [{ path = "hub.mass_kg", value = -5.0 }]\n', "hub.mass_kg: Input should be greater than or equal to 0.0001"),
     ('[random]\nn = -3\n', "random.n"),
     ('[base]\ndt_s = -1.0\n', "dt_s"),
+    # initial states the satellite cannot take, refused before any case flies
+    ('[[cases]]\nid = "a"\nscenario = [{ path = "initial.appendages", value = [{ name = "boom" }] }]\n', "case 'a' (scenario): initial.appendages: "),
+    ('[[cases]]\nid = "a"\nplant = [{ path = "appendages[*].locked_dofs", value = ["eta_x"] }]\nscenario = [{ path = "initial.appendages", value = [{ name = "panel_1", eta_rate_m_s = [0.1, 0.0, 0.0] }] }]\n', "its initial rate must be 0"),
 ]
 
 
@@ -228,6 +231,17 @@ def test_bad_campaign_files_are_refused_before_any_case_runs(tmp_path, body, fra
         resolve_cases(load_campaign(path), nominal())
     assert fragment in str(caught.value)
     assert not (tmp_path / "out").exists()
+
+
+def test_deployment_shock_on_modal_appendages_is_refused_before_any_case_runs():
+    # A modal appendage has no root deformation to set: every deployment-shock case
+    # would fail as it starts; the campaign is refused whole, naming the case.
+    from flexsat import Plant
+    from flexsat.linear.export import modal_satellite
+
+    satellite = modal_satellite(Plant.from_config(nominal()), n_modes=2)
+    with pytest.raises(ConfigError, match=r"case '.+' \(scenario\): .*no initial state to set"):
+        resolve_cases(load_campaign("deployment-shock"), satellite)
 
 
 def test_negative_case_count_is_refused():

@@ -448,9 +448,11 @@ class CaseStream:
             scenario = apply_modifiers(self._scenario_base, scenario_mods, rng, realised)
         except KeyError as exc:
             raise ConfigError(f"campaign case {case_id!r}: {exc.args[0]}") from None
-        validate_config(plant, source=f"campaign case {case_id!r} (plant)")
+        satellite = validate_config(plant, source=f"campaign case {case_id!r} (plant)")
         source = f"campaign case {case_id!r} (scenario)"
         model = validate_config(scenario, source=source, model=SlewScenario)
+        if model.initial.appendages:  # each entry fits its appendage (model, locked DOFs)
+            _check_initial_state(satellite, model, source)
         timing = (model.duration_s, model.dt_s, model.record_dt_s)
         if timing not in self._sized:  # the records must fit in a worker
             try:
@@ -460,6 +462,19 @@ class CaseStream:
                 raise ConfigError(f"campaign {name}, case {case_id!r}: {exc}") from None
             self._sized.add(timing)
         return ResolvedCase(case_id, root, index, plant, scenario, realised)
+
+
+def _check_initial_state(satellite: SatelliteConfig, scenario: SlewScenario, source: str) -> None:
+    """Refuse, before any case runs, a scenario's initial appendage state the satellite
+    cannot take (an appendage it lacks, a model with no initial state to set, a rate on
+    a locked coordinate): otherwise every such case would fail as it starts to fly."""
+    from flexsat.dynamics.plant import Plant
+    from flexsat.simulate.openloop import initial_state
+
+    try:
+        initial_state(Plant.from_config(satellite), scenario)
+    except ConfigError as exc:
+        raise ConfigError(f"{source}: {exc}") from None
 
 
 def sobol_problem(sobol: SobolCases) -> dict:
