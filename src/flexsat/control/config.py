@@ -1,4 +1,4 @@
-"""Validated parameters of the disturbance torques the static actuator stage adds."""
+"""Validated parameters of the disturbance torques the actuator stages add."""
 
 from __future__ import annotations
 
@@ -39,9 +39,12 @@ class DisturbanceConfig(_Frozen):
     def packed(self, actuator) -> np.ndarray:
         """Actuator gain, environment, sloshing ratio and frequency, residual, T_max.
 
-        ``actuator`` gives the gain ``G_act`` (3) and ``t_max_nm``.
+        ``actuator`` gives ``t_max_nm`` and the gain ``G_act`` (3), 1 for an actuator
+        without one (the wheels: their motors deliver the command through their own
+        response). The draws of ``mode = "random"`` come in the same order whatever
+        the actuator, so the external torques are the same for every actuator.
         """
-        gain = np.array(actuator.gain, dtype=float)
+        gain = np.array(getattr(actuator, "gain", (1.0, 1.0, 1.0)), dtype=float)
         env = np.array(self.environment_nm, dtype=float)
         res = np.array(self.residual_nm, dtype=float)
         ratio = self.sloshing_ratio

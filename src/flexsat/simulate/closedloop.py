@@ -312,7 +312,7 @@ def finish_slew(run: PreparedSlew, status: int, done: int, rows: int, wall: floa
     target = target_quaternion(scenario.target_euler_deg)
     attrs["target_quaternion"] = target.tolist()
     # gain (3), environment (3), sloshing ratio and Hz, residual (3), T_max
-    attrs["realised_disturbances"] = data.actuator_params[len(layout.actuators) - 1].tolist()
+    attrs["realised_disturbances"] = scenario.disturbances.packed(scenario.actuator).tolist()
     at = layout.plant  # where each piece of the plant state lives
     ta = ("time", "axis")
 

@@ -24,6 +24,12 @@ Coulomb sign smoothed over omega_c). The motor work sum u_i Omega_i and the
 friction loss sum f_i Omega_i are integrated as states: with no other torque,
 E(t) - E(0) = W_motor - W_friction.
 
+The scenario's disturbance torques act on the hub as they do with the static
+actuator, the wheels' held output at each control instant: environment + residual +
+sloshing ratio * tau_cmd * sin(2 pi f t) (``[disturbances]``, the same realised
+values), without the static actuator's gain G_act and clip (external torques, not the
+actuator's output).
+
 At every control instant the body-torque command is allocated by the
 pseudo-inverse, u_cmd = -A^+ tau_cmd - k_null (I - A^+ A)(h - I_s Omega_bias),
 A = [a_1 ... a_N] (3 x N): the null-space term drives the wheels towards their
@@ -32,7 +38,7 @@ bias speed without torquing the hub; each u_cmd,i is clipped to the motor limit.
 
 from __future__ import annotations
 
-from math import copysign, exp
+from math import copysign, exp, pi, sin
 from typing import Annotated, Literal
 
 import numpy as np
@@ -45,13 +51,18 @@ from flexsat.control.stages.registry import (
     ActuatorStageConfig,
     StageSpec,
 )
+from flexsat.control.stages.static_actuator import PACKED as DISTURBANCES
 
 __all__ = ["MAX_WHEELS", "SATURATED_RATIO", "WHEELS", "WheelsConfig", "wheel_axes"]
 
 MAX_WHEELS = 6
 """Most wheels in one cluster (the stage's state is sized for them)."""
-_N, _IS, _UMAX, _WMAX, _CV, _CC, _WC, _TAU, _KNULL, _WBIAS, _W0 = range(11)
-_A = 11  # A, row-major (3, MAX_WHEELS)
+# the disturbances first, as the static actuator packs them (DisturbanceConfig.packed)
+_ENV, _RATIO, _HZ, _RES = (DISTURBANCES[k] for k in ("environment_nm", "sloshing_ratio",
+                                                     "sloshing_hz", "residual_nm"))
+_D = DISTURBANCES["t_max_nm"] + 1  # then the wheels'
+_N, _IS, _UMAX, _WMAX, _CV, _CC, _WC, _TAU, _KNULL, _WBIAS, _W0 = range(_D, _D + 11)
+_A = _D + 11  # A, row-major (3, MAX_WHEELS)
 _PINV = _A + 3 * MAX_WHEELS  # A^+, row-major (MAX_WHEELS, 3)
 _NULL = _PINV + 3 * MAX_WHEELS  # I - A^+ A, row-major (MAX_WHEELS, MAX_WHEELS)
 # derived constants the derivative reads (multiplications instead of divisions):
@@ -167,7 +178,9 @@ class WheelsConfig(ActuatorStageConfig):
         derived = [1.0 / self.spin_inertia_kg_m2, 1.0 / self.motor_time_constant_s,
                    1.0 / self.coulomb_smoothing_rad_s, self.spin_inertia_kg_m2 * head[3],
                    self.spin_inertia_kg_m2 * head[10]]  # fmt: skip
-        return np.concatenate([head, A.ravel(), pinv.ravel(), null.ravel(), derived])
+        disturbances = scenario.disturbances.packed(self)  # gain 1: not read
+        return np.concatenate([disturbances, head, A.ravel(), pinv.ravel(), null.ravel(),
+                               derived])  # fmt: skip
 
 
 @njit(cache=True, inline="always")
@@ -255,8 +268,8 @@ def wheels_derivative(x, n_dof, t, omega, params, state, state_dot, wrench):
 
 @njit(cache=True)  # compiled with ACTUATOR_SIGNATURE on first use
 def wheels_step(tau_cmd, t, dt, params, state, tau_applied, record):
-    """Allocate the body torque to the motors (module docstring); nothing held on the
-    hub: the wheels act through their derivative."""
+    """Allocate the body torque to the motors (module docstring); held on the hub: the
+    disturbance torques (the wheels act through their derivative)."""
     p, s = params, state
     n = int(p[_N])
     bias = p[_IS] * p[_WBIAS]
@@ -277,7 +290,9 @@ def wheels_step(tau_cmd, t, dt, params, state, tau_applied, record):
         h_abs = max(h_abs, abs(h))
         if abs(h) >= SATURATED_RATIO * p[_HMAX]:
             saturated += 2.0**i
-    tau_applied[0], tau_applied[1], tau_applied[2] = 0.0, 0.0, 0.0
+    slosh = p[_RATIO] * sin(2.0 * pi * p[_HZ] * t)
+    for a in range(3):
+        tau_applied[a] = p[_ENV + a] + slosh * tau_cmd[a] + p[_RES + a]
     record[0], record[1], record[2] = hx, hy, hz
     record[3] = 0.5 * h2 / p[_IS]  # the divisions once, not per wheel
     record[4] = s[3 * n]
