@@ -168,7 +168,9 @@ def test_actuator_stage_replaces_the_static_one(stages, nominal_plant):
     assert ds["actuator_scale"].attrs["units"] == "1"
     from flexsat.plots.slew import plot_disturbances
 
-    plot_disturbances(ds)  # says there is no static disturbance model to draw
+    fig = plot_disturbances(ds)  # a user's actuator that does not apply them: a note
+    (note,) = fig.axes[0].texts
+    assert "does not apply the scenario's disturbances" in note.get_text()
 
 
 def test_a_continuous_stage_integrates_the_body_rate_the_loop_hands_it(stages, nominal_plant):

@@ -192,3 +192,41 @@ def test_rejects_a_dataset_without_a_slew_scenario(slew_ds) -> None:
     bare.attrs = {k: v for k, v in slew_ds.attrs.items() if k != "scenario"}
     with pytest.raises(ValueError, match="scenario"):
         plot_pointing(bare)
+
+
+def _line(ax, label: str, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The record indices a labelled line draws (long series are thinned for drawing)
+    and its values."""
+    (line,) = [ln for ln in ax.get_lines() if ln.get_label() == label]
+    index = np.searchsorted(t, np.asarray(line.get_xdata(), dtype=float))
+    np.testing.assert_array_equal(t[index], line.get_xdata())
+    return index, np.asarray(line.get_ydata(), dtype=float)
+
+
+def test_disturbance_figure_draws_the_realised_torques(slew_ds, slew_plant) -> None:
+    # Static actuator (the thesis's, disturbances at maximum): the black line is the
+    # recorded tau_applied - tau_cmd, the dashed one 0.005 N m, as realised.
+    ax = plot_disturbances(slew_ds).axes[0]
+    recorded = slew_ds["tau_applied"].values[:, 0] - slew_ds["tau_cmd"].values[:, 0]
+    index, drawn = _line(ax, "total τ_applied − τ_cmd", slew_ds["time"].values)
+    np.testing.assert_array_equal(drawn, recorded[index])
+    assert _hlines(ax)[0] == 0.005
+    # Wheels, one random draw: the drawn constant is the realised one (within the
+    # +-0.005 N m bound, not the bound), the total on the hub the sum of the constant
+    # and the sloshing terms (the wheels' own reaction is not a disturbance), exactly.
+    ds = run_slew(slew_plant, SlewScenario.model_validate({
+        "duration_s": 2.0, "actuator": {"kind": "wheels"},
+        "disturbances": {"mode": "random", "seed": 3}})).dataset  # fmt: skip
+    realised = ds.attrs["realised_disturbances"]
+    fig = plot_disturbances(ds)
+    for k, ax in enumerate(fig.axes[:3]):
+        constant = realised[3 + k] + realised[8 + k]
+        assert _hlines(ax)[0] == constant and abs(constant) < 0.005
+        label = next(ln.get_label() for ln in ax.get_lines()
+                     if ln.get_label().startswith("sloshing"))  # fmt: skip
+        t = ds["time"].values
+        slosh_index, slosh = _line(ax, label, t)
+        index, total = _line(ax, "total on the hub", t)
+        np.testing.assert_array_equal(index, slosh_index)
+        np.testing.assert_array_equal(total, constant + slosh)
+        assert not any("shortfall" in ln.get_label() for ln in ax.get_lines())

@@ -674,15 +674,19 @@ def plot_adaptation(ds: xr.Dataset) -> Figure:
 
 
 def plot_disturbances(ds: xr.Dataset) -> Figure:
-    """Disturbance torques of the actuator model per body axis [N m].
+    """Disturbance torques the actuator applies per body axis [N m].
 
-    The model of :mod:`flexsat.control.stages.static_actuator`, with the scenario's
-    parameters: the constant environment + residual torque, the sloshing torque
-    ratio * tau_cmd * sin(2 pi f t) and the actuator-gain shortfall
-    -(1 - G_act) tau_cmd (the torque the actuators fail to deliver, signed as it
-    acts on the hub). Their recorded sum, tau_applied - tau_cmd (which also holds
-    any clipping at T_max), is drawn in black. The panel titles compare the peak
-    with JK_min, the robust gain's floor.
+    The scenario's ``[disturbances]`` as the run realised them
+    (``attrs["realised_disturbances"]``, the layout of
+    :data:`flexsat.control.stages.static_actuator.PACKED`): the constant environment
+    + residual torque, the sloshing torque ratio * tau_cmd * sin(2 pi f t) and, for
+    the static actuator, the gain shortfall -(1 - G_act) tau_cmd (the torque the
+    actuators fail to deliver, signed as it acts on the hub). In black their sum: for
+    the static actuator the recorded tau_applied - tau_cmd (which also holds any
+    clipping at T_max); for an actuator that applies them as external torques (the
+    wheels, whose tau_applied also holds their own reaction) the sum of the terms.
+    The panel titles compare the peak with JK_min, the robust gain's floor. An
+    actuator that does not apply them (``applies_disturbances``) gets a note.
 
     Parameters
     ----------
@@ -693,21 +697,35 @@ def plot_disturbances(ds: xr.Dataset) -> Figure:
     -------
     matplotlib.figure.Figure
     """
+    from flexsat.control.stages.static_actuator import PACKED
+
     scenario = _scenario(ds)
     surface = _surface(ds)
-    dist, act = scenario.disturbances, scenario.actuator
+    act = scenario.actuator
     t = style.time_s(ds)
-    if not hasattr(act, "gain"):  # an actuator stage other than the static gain model
+    title = "Disturbance torques applied with the actuator (frame B)"
+    if not act.applies_disturbances:
         fig, axes = style.figure(1, 1, size=(11.0, 4.0))
-        _no_data(axes[0, 0], f"the {act.kind} actuator stage adds no static disturbance model")
-        style.suptitle(fig, ds, "Disturbance torques of the actuator model (frame B)")
+        _no_data(axes[0, 0], f"the {act.kind} actuator does not apply the scenario's "
+                             "disturbances")  # fmt: skip
+        style.suptitle(fig, ds, title)
         return fig
+    realised = np.asarray(ds.attrs["realised_disturbances"], dtype=float)
+
+    def packed(name, size=3):
+        return realised[PACKED[name]:PACKED[name] + size]
+
+    ratio, hz = packed("sloshing_ratio", 1)[0], packed("sloshing_hz", 1)[0]
+    gain = packed("gain")
     cmd = np.asarray(ds["tau_cmd"].values, dtype=float)
-    total = np.asarray(ds["tau_applied"].values, dtype=float) - cmd
-    slosh = dist.sloshing_ratio * cmd * np.sin(2.0 * np.pi * dist.sloshing_hz * t)[:, None]
-    shortfall = (np.asarray(act.gain) - 1.0) * cmd
-    constant = np.asarray(dist.environment_nm) + np.asarray(dist.residual_nm)
-    slosh_label = f"sloshing {dist.sloshing_ratio:.3g}·τ_cmd·sin(2π·{dist.sloshing_hz:.3g} Hz·t)"
+    slosh = ratio * cmd * np.sin(2.0 * np.pi * hz * t)[:, None]
+    constant = packed("environment_nm") + packed("residual_nm")
+    static = hasattr(act, "gain")  # the static actuator: its gain, and the recorded sum
+    if static:
+        total = np.asarray(ds["tau_applied"].values, dtype=float) - cmd
+    else:
+        total = constant + slosh
+    slosh_label = f"sloshing {ratio:.3g}·τ_cmd·sin(2π·{hz:.3g} Hz·t)"
     fig, axes = style.figure(3, 1, size=(11.0, 9.0))
     for k in range(3):
         ax = axes[k, 0]
@@ -715,33 +733,22 @@ def plot_disturbances(ds: xr.Dataset) -> Figure:
         ax.axhline(constant[k], color="tab:green", linestyle="--", linewidth=1.3,
                    label="environment + residual (constant)")  # fmt: skip
         style.line(ax, t, slosh[:, k], color="tab:blue", linewidth=0.9, label=slosh_label)
-        style.line(
-            ax,
-            t,
-            shortfall[:, k],
-            color="tab:orange",
-            linewidth=1.0,
-            label="actuator-gain shortfall −(1 − G)·τ_cmd",
-        )
-        style.line(
-            ax,
-            t,
-            total[:, k],
-            color="black",
-            linewidth=0.9,
-            alpha=0.8,
-            label="total τ_applied − τ_cmd",
-        )
+        if static:
+            style.line(ax, t, (gain[k] - 1.0) * cmd[:, k], color="tab:orange", linewidth=1.0,
+                       label="actuator-gain shortfall −(1 − G)·τ_cmd")  # fmt: skip
+        style.line(ax, t, total[:, k], color="black", linewidth=0.9, alpha=0.8,
+                   label="total τ_applied − τ_cmd" if static else "total on the hub")  # fmt: skip
         ax.set_ylabel(f"d_{a} [N m]")
         peak = float(np.nanmax(np.abs(total[:, k]))) if _recorded(total[:, k]) else math.nan
-        title = (f"axis {a}: constant {constant[k]:.3g} N m, G_{a} = {act.gain[k]:.3g}; "
-                 f"peak |d_{a}| = {peak:.3g} N m")  # fmt: skip
+        heading = f"axis {a}: constant {constant[k]:.3g} N m, "
+        heading += f"G_{a} = {gain[k]:.3g}; " if static else ""
+        heading += f"peak |d_{a}| = {peak:.3g} N m"
         if surface is not None:
-            title += f" (robust-gain floor JK_min = {surface.jk_min:.4g} N m)"
-        ax.set_title(title, fontsize=10)
+            heading += f" (robust-gain floor JK_min = {surface.jk_min:.4g} N m)"
+        ax.set_title(heading, fontsize=10)
     style.axes_legend(fig, axes, ncols=4)
     style.finish_time_axis(axes, t)
-    style.suptitle(fig, ds, "Disturbance torques of the actuator model (frame B)")
+    style.suptitle(fig, ds, title)
     return fig
 
 

@@ -524,7 +524,8 @@ def _avionics(root: Path, outputs: dict, context: dict) -> str:
     side, sweep, sadm, sentence = render_avionics(root, outputs, cell)
     return "".join([
         "<p>The thesis's slew with a gyro, a star tracker, the MEKF and four reaction "
-        "wheels beside the ideal loop, then the ideal loop with a computational delay "
+        "wheels beside the ideal loop, both against the thesis's disturbances at their "
+        "maximum, then the ideal loop with a computational delay "
         "(docs/control.md, 'Avionics in the loop'). The figures: the stability boundary "
         "against delay, then the avionics run's attitude estimation (the MEKF's error "
         "inside its ±3σ, its NEES against the χ² interval) and its wheels (momentum, "

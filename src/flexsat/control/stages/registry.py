@@ -87,7 +87,7 @@ and sees the integrated entries in ``state``.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Annotated, Any, Literal
+from typing import Annotated, Any, ClassVar, Literal
 
 import numpy as np
 from numba import njit, types
@@ -192,7 +192,14 @@ class StageConfig(_Frozen):
 
 
 class ActuatorStageConfig(StageConfig):
-    """Base of every actuator's model: the limits the laws and requirement R3 read."""
+    """Base of every actuator's model: the limits the laws and requirement R3 read.
+
+    ``applies_disturbances`` (class attribute, default False): whether the actuator,
+    as the final ``[actuator]``, applies the scenario's ``[disturbances]`` (the
+    static actuator and the wheels do); the disturbance figure draws them only then.
+    """
+
+    applies_disturbances: ClassVar[bool] = False
 
     t_max_nm: Positive = Field(2.0, description="hardware saturation per axis [N m]")
     reduction_factor: Annotated[float, Field(gt=0.0, le=1.0)] = Field(

@@ -31,6 +31,8 @@ _GAIN, _ENV, _RATIO, _HZ, _RES, _TMAX = PACKED.values()
 class ActuatorConfig(ActuatorStageConfig):
     """Per-axis actuator limits and gain (thesis sec. 5.1.1, R3)."""
 
+    applies_disturbances = True  # [disturbances] act with it
+
     kind: Literal["static"] = Field("static", description="an actuator with static limits")
     gain: tuple[
         Annotated[float, Field(gt=0.0, le=2.0)],

@@ -110,6 +110,8 @@ class WheelsConfig(ActuatorStageConfig):
     """A reaction-wheel cluster (module docstring); ``t_max_nm`` is the body-torque
     limit the law clips its command to."""
 
+    applies_disturbances = True  # [disturbances] act with it
+
     kind: Literal["wheels"] = Field("wheels", description="the stage's registered name")
     preset: Literal["orthogonal3", "pyramid4"] = Field(
         "pyramid4", description="spin-axis layout when ``axes`` is not given"
