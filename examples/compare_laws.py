@@ -37,9 +37,16 @@ for law in law_names():
 # -----------
 
 keys = ("final_pointing_error_deg", "settling_time_s", "r1_pass", "r2_pass", "r3_pass")
+
+
+def cell(value) -> str:
+    """A number to four significant digits, exponent kept; a verdict as it is."""
+    return f"{value:>26.4g}" if isinstance(value, float) else f"{value!s:>26s}"
+
+
 print(f"{'law':6s}" + "".join(f"{k:>26s}" for k in keys))
 for law, m in metrics.items():
-    print(f"{law:6s}" + "".join(f"{m[k]!s:>26.10s}" for k in keys))
+    print(f"{law:6s}" + "".join(cell(m[k]) for k in keys))
 
 # %%
 # Side by side
