@@ -1,6 +1,6 @@
 """Benchmark: does a worst-case search find worse than Monte Carlo on the thesis set?
 
-On the reduced model (root translations locked, 10 ms), flies the 24 critical corners
+On the reduced model (root translations locked, 20 ms), flies the 24 critical corners
 (+ nominal, montecarlo-critical), ``--random`` random Monte Carlo draws
 (montecarlo-random) and a seeded differential-evolution search over the same box
 (target frequencies 0.8-1.2, hub and panel inertia 0.8-1.2, SADM 0-90 deg, damping

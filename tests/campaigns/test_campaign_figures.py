@@ -121,3 +121,31 @@ def test_statistics_figures_are_written(store, tmp_path):
     assert [p.stem for p in paths] == list(STATISTICS_FIGURES)
     for path in paths:
         assert path.read_bytes()[:8] == PNG_MAGIC
+
+
+def test_tornado_has_one_bar_per_parameter_at_its_rank_correlation(tmp_path):
+    # 16 random cases of 2 s: a scaled target frequency is stored as its factor and its
+    # value in Hz, which rank alike: one bar, the physical value. Each bar is scipy's
+    # Spearman correlation of that column with the metric over the cases that have
+    # both (the same computation, by another path: equal to 1e-12).
+    from scipy.stats import spearmanr
+
+    from flexsat.campaigns.statistics import parameter_table
+    from flexsat.plots.campaign_statistics import plot_tornado
+
+    store = tmp_path / "random"
+    run_campaign(_short("montecarlo-random", 2.0), nominal(), store, n_random=15, workers=1,
+                 progress=False)  # fmt: skip
+    ax = plot_tornado(store).axes[0]
+    labels = [tick.get_text() for tick in ax.get_yticklabels()]
+    stems = [label.rsplit(" [", 1)[0] for label in labels]
+    assert labels and len(stems) == len(set(stems))
+    assert any(label.endswith(" [Hz]") for label in labels)
+    table = CampaignStore(store).table().set_index("case_id")
+    metric = table["metrics.final_pointing_error_deg"].astype(float)
+    parameters = parameter_table(CampaignStore(store).rows()).set_index("case_id")
+    for label, bar in zip(labels, ax.patches, strict=True):
+        x = pd.to_numeric(parameters[label], errors="coerce").reindex(metric.index)
+        keep = x.notna() & metric.notna()
+        expected = spearmanr(x[keep], metric[keep]).statistic
+        assert bar.get_width() == pytest.approx(expected, abs=1e-12)

@@ -83,7 +83,7 @@ def cases_needed(probability: float, confidence: float = 0.95, failures: int = 0
 
     The smallest n whose one-sided Clopper–Pearson lower bound with ``failures``
     failing cases reaches ``probability``: with no failure, the smallest n with
-    probability^n <= 1 - confidence (n = 1108 for 99.73 % at 95 %).
+    probability^n <= 1 - confidence (n = 1109 for 99.73 % at 95 %).
 
     Parameters
     ----------

@@ -74,7 +74,7 @@ class _Campaign:
     def title(self, fig: Figure, what: str) -> None:
         fig.suptitle(
             f"{what}\ncampaign {self.name!r}: {len(self.histories)} successful cases "
-            f"(band: min–max), line: case {self.nominal!r}",
+            f"(bands: min–max and 5–95 %), line: case {self.nominal!r}",
             fontsize=11,
         )
 

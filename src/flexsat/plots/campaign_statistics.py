@@ -110,9 +110,14 @@ def plot_metric_cdfs(store_dir: str | Path) -> Figure:
 
 
 def _parameters(store: CampaignStore) -> pd.DataFrame:
+    """The dispersed parameters by case: physical values, and the scale factor only of
+    a parameter without one (a factor and its value rank the same: one column each)."""
     table = parameter_table(store.rows()).set_index("case_id")
     numeric = table.apply(pd.to_numeric, errors="coerce")
-    return numeric.loc[:, numeric.nunique() > 1]
+    numeric = numeric.loc[:, numeric.nunique() > 1]
+    physical = {c.rsplit(" [", 1)[0] for c in numeric.columns if not c.endswith(" [factor]")}
+    return numeric[[c for c in numeric.columns
+                    if not c.endswith(" [factor]") or c.removesuffix(" [factor]") not in physical]]
 
 
 def plot_parameter_scatter(store_dir: str | Path, metric: str = DEFAULT_METRIC) -> Figure:
@@ -133,9 +138,7 @@ def plot_parameter_scatter(store_dir: str | Path, metric: str = DEFAULT_METRIC) 
     store = CampaignStore(store_dir)
     parameters, metrics = _parameters(store), _metrics(store)
     column = f"metrics.{metric}"
-    physical = {c.rsplit(" [", 1)[0] for c in parameters.columns if not c.endswith(" [factor]")}
-    shown = [c for c in parameters.columns  # physical values, factors where there are none
-             if not c.endswith(" [factor]") or c.removesuffix(" [factor]") not in physical]
+    shown = list(parameters.columns)
     fig, axes = _grid(max(1, len(shown)))
     y = metrics[column] if column in metrics else pd.Series(dtype=float)
     for ax, p in zip(axes, shown, strict=False):
@@ -150,8 +153,8 @@ def plot_parameter_scatter(store_dir: str | Path, metric: str = DEFAULT_METRIC) 
 
 
 def plot_tornado(store_dir: str | Path, metric: str = DEFAULT_METRIC) -> Figure:
-    """Tornado chart: Spearman rank correlation of ``metric`` with each parameter,
-    sorted by magnitude.
+    """Tornado chart: Spearman rank correlation of ``metric`` with each parameter (its
+    physical value where known), sorted by magnitude.
 
     Parameters
     ----------
