@@ -46,6 +46,16 @@ def test_a_resumed_search_recomputes_nothing(tmp_path):
     assert again["ran"] == 0 and again["case_id"] == first["case_id"]
 
 
+def test_the_ensemble_runner_gives_the_search_of_the_pool(tmp_path):
+    # Every backend stores the same rows bit for bit, so the optimizer sees the same
+    # values and takes the same path: the same evaluations and the same worst case.
+    pool = run_campaign(_search(), nominal(), tmp_path / "pool", workers=1, progress=False)
+    ensemble = run_campaign(_search(), nominal(), tmp_path / "ensemble", workers=2,
+                            runner="ensemble", progress=False)  # fmt: skip
+    keys = ("case_id", "value", "parameters", "cases", "generations")
+    assert {k: ensemble[k] for k in keys} == {k: pool[k] for k in keys}
+
+
 def test_a_search_runs_alone():
     with pytest.raises(ValueError, match="runs alone"):
         validate_config({**_search().model_dump(mode="json"), "random": {"n": 3}},

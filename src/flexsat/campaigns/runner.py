@@ -337,7 +337,9 @@ def run_campaign(
     Returns
     -------
     dict
-        ``cases``, ``ran`` (this call), ``failed``, ``wall_time_s``, the store paths.
+        ``cases``, ``ran`` (this call), ``failed``, ``wall_time_s``, the store paths; for a
+        ``[worst_case]`` search, what :func:`~flexsat.campaigns.worstcase.run_worst_case`
+        returns (the worst case found).
 
     Raises
     ------
@@ -350,13 +352,14 @@ def run_campaign(
     FlexsatError
         When the store cannot be written (full disk...), after stopping the workers.
     """
+    if runner not in RUNNERS:
+        raise ConfigError(f"runner: {runner!r} is not one of {', '.join(RUNNERS)}")
     if definition.worst_case is not None:  # a search, not a fixed set of cases
         from flexsat.campaigns.worstcase import run_worst_case
 
         return run_worst_case(definition, definition.worst_case, satellite, out,
-                              workers=workers, resume=resume)  # fmt: skip
-    if runner not in RUNNERS:
-        raise ConfigError(f"runner: {runner!r} is not one of {', '.join(RUNNERS)}")
+                              workers=workers, resume=resume, scheduler=scheduler,
+                              dask_local=dask_local, runner=runner)  # fmt: skip
     store = CampaignStore(out)
     if store.root.exists() and not store.root.is_dir():
         raise ConfigError(f"--out {store.root}: exists and is not a folder")

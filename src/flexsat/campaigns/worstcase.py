@@ -41,6 +41,9 @@ def run_worst_case(
     out: str | Path,
     workers: int | None = 1,
     resume: bool = False,
+    scheduler: str | None = None,
+    dask_local: int | None = None,
+    runner: str = "pool",
 ) -> dict:
     """Search the dispersion box for the case that maximizes ``search.metric``.
 
@@ -55,9 +58,15 @@ def run_worst_case(
     out : path
         The store (one case per evaluation).
     workers : int, optional
-        Local processes evaluating a generation.
+        Local processes (or the ensemble's threads) evaluating a generation.
     resume : bool
         Reuse the evaluations already stored (same inputs), run the rest.
+    scheduler : str, optional
+        Address of a running Dask scheduler that evaluates the generations.
+    dask_local : int, optional
+        Evaluate them on a Dask LocalCluster of this many workers.
+    runner : {"pool", "ensemble"}
+        Local runs only, as for :func:`~flexsat.campaigns.runner.run_campaign`.
 
     Returns
     -------
@@ -81,8 +90,8 @@ def run_worst_case(
     start = time.perf_counter()
     values: dict[str, float] = {}
 
-    with _backend(workers, None, None) as execute, store.opened(fingerprint, definition.name,
-                                                                 resume):  # fmt: skip
+    with _backend(workers, scheduler, dask_local, runner) as execute, store.opened(
+            fingerprint, definition.name, resume):  # fmt: skip
         def evaluate(_, population) -> list[float]:
             cases = []
             for x in population:
