@@ -259,3 +259,19 @@ def test_ctrl_c_ends_a_command_with_one_line_and_code_130(tmp_path):
     assert process.returncode == 130
     assert stderr.endswith("error: interrupted\n")
     assert "Traceback" not in stderr
+
+
+def test_campaign_prints_what_a_worst_case_search_found(tmp_path):
+    # The summary's worst-case lines rank the final pointing error; a search also
+    # prints its own result, by the metric it searched, as worst_case.json holds it.
+    path = tmp_path / "worst.toml"
+    path.write_text(
+        'name = "worst"\n[base]\nduration_s = 0.5\n'
+        '[worst_case]\nmetric = "peak_tip_displacement_m"\nseed = 3\nmaxiter = 1\n'
+        'popsize = 3\nparameters = [{ path = "hub.mass_kg", bounds = [120.0, 180.0] }]\n'
+    )
+    result = run("campaign", str(path), "--workers", "1", "--out", str(tmp_path / "s"))
+    found = json.loads((tmp_path / "s" / "worst_case.json").read_text())
+    assert result.returncode == 0, result.stderr
+    line = f"worst-case search: {found['case_id']}  {found['metric']} = {found['value']:.4g}"
+    assert line in " ".join(result.stdout.split("\n"))

@@ -600,6 +600,10 @@ def campaign(
     _console.print(table)
     for worst in summary["worst_cases"]:
         _console.print(f"  worst: {worst['case_id']}  {worst['final_pointing_error_deg']:.4g} deg")
+    if "worst_case" in summary:  # a search: what it found, by the metric it searched
+        found = summary["worst_case"]
+        _console.print(f"  worst-case search: {found['case_id']}  {found['metric']} = "
+                       f"{found['value']:.4g} (worst_case.json)")  # fmt: skip
     _console.print(f"wrote {summary['parquet']} and {summary['csv']}")
     for path in summary["figures"]:
         _console.print(f"wrote {path}")
