@@ -104,6 +104,24 @@ def test_root_deformation_draws_every_appendage(openloop_ds) -> None:
     assert 0.01 < np.nanmax(np.abs(rho_z)) < 1.0
 
 
+def test_root_deformation_leaves_out_an_appendage_without_a_root_joint(openloop_plant) -> None:
+    # panel_2 as modal data: no root joint, its eta and rho records are NaN; it is
+    # named in the title and not drawn (nor listed in the legend).
+    from flexsat.config import validate_config
+    from flexsat.linear.export import modal_satellite
+
+    modal = modal_satellite(openloop_plant, n_modes=2).model_dump()
+    mixed = openloop_plant.config.model_dump()
+    mixed["appendages"][1] = modal["appendages"][1]
+    plant = Plant.from_config(validate_config(mixed))
+    ds = run_openloop(plant, OpenLoopScenario(duration_s=2.0)).dataset
+    assert np.isnan(ds["rho"].values[:, 1]).all()
+    fig = plot_root_deformation(ds)
+    labels = {line.get_label() for line in fig.axes[0].get_lines()}
+    assert labels == {"panel_1"}
+    assert "; no root joint: panel_2\n" in fig.get_suptitle()
+
+
 def test_tip_displacement_in_millimetres(openloop_ds) -> None:
     fig = plot_tip_displacement(openloop_ds)
     assert len([ax for ax in fig.axes if ax.get_lines()]) == openloop_ds.sizes["appendage"]

@@ -411,7 +411,8 @@ def plot_root_deformation(ds: xr.Dataset) -> Figure:
     Left column: the ZYX root rotations rho_x (flapping), rho_y (torsion), rho_z
     (in-plane bending) [deg]; right column: the root translations eta_x, eta_y,
     eta_z [m]. One line per appendage (colour and dash differ, so coinciding
-    lines of a symmetric satellite both stay visible).
+    lines of a symmetric satellite both stay visible); an appendage without a root
+    joint (a modal one: its records are NaN) is named in the title, not drawn.
 
     Parameters
     ----------
@@ -427,10 +428,13 @@ def plot_root_deformation(ds: xr.Dataset) -> Figure:
     eta = np.asarray(ds["eta"].values)
     eta_units = ds["eta"].attrs.get("units", "m")
     names = _appendage_names(ds)
+    jointed = [j for j in range(len(names))
+               if np.isfinite(rho[:, j]).any() or np.isfinite(eta[:, j]).any()]  # fmt: skip
     fig, axes = style.figure(3, 2, size=(13.0, 9.0))
     _shade_torque(axes, ds)
     for k in range(3):
-        for j, name in enumerate(names):
+        for j in jointed:
+            name = names[j]
             look = {"color": f"C{j % 10}", "linestyle": _APPENDAGE_STYLES[j % 4],
                      "linewidth": 1.0, "label": name}  # fmt: skip
             style.line(axes[k, 0], t, rho[:, j, k], **look)
@@ -443,7 +447,11 @@ def plot_root_deformation(ds: xr.Dataset) -> Figure:
     items = [*handles, *_torque_patches(ds)]
     style.figure_legend(fig, items, [item.get_label() for item in items], len(handles) + 1)
     style.finish_time_axis(axes, t)
-    style.suptitle(fig, ds, "Appendage root-joint deformations (mount frame)")
+    title = "Appendage root-joint deformations (mount frame)"
+    if len(jointed) < len(names):
+        unjointed = ", ".join(n for j, n in enumerate(names) if j not in jointed)
+        title += f"; no root joint: {unjointed}"
+    style.suptitle(fig, ds, title)
     return fig
 
 
