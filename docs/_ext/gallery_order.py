@@ -7,12 +7,15 @@ from __future__ import annotations
 READING_ORDER = (
     "own_satellite.py",
     "three_panels.py",
+    "higher_modes.py",
     "openloop_validation.py",
     "slew_requirements.py",
     "compare_laws.py",
     "compiled_law.py",
     "python_controller.py",
+    "avionics.py",
     "sensitivity_campaign.py",
+    "montecarlo_statistics.py",
     "replay_case.py",
     "linear_design.py",
 )
