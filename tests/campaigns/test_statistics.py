@@ -112,3 +112,25 @@ def test_rank_correlations_find_the_monotone_parameter():
     table = rank_correlations(x, y)
     assert table.loc["p", "m"] == pytest.approx(1.0)
     assert abs(table.loc["q", "m"]) < 0.5
+
+
+def test_a_chains_parameter_columns_say_which_values_are_factors():
+    # On a chain the thesis's paths are derived (its joints, beam and mount change):
+    # the damping ratio and the SADM angle are set values, physical columns in their
+    # units; a frequency factor scales beam stiffnesses and keeps a factor column only.
+    from flexsat.config import load_config, preset_path
+
+    stream = CaseStream(load_campaign("montecarlo-random"), load_config(preset_path("chain")),
+                        n_random=3)  # fmt: skip
+    cases = list(stream)
+    rows = [{"case_id": c.case_id, "parameters": c.parameters,
+             "inputs": {"plant": c.plant, "scenario": c.scenario}} for c in cases]  # fmt: skip
+    table = parameter_table(rows).set_index("case_id")
+    path = "appendages[0]"
+    assert f"{path}.damping_ratio [-]" in table and f"{path}.damping_ratio [factor]" not in table
+    assert f"{path}.sadm_angle_deg [deg]" in table
+    assert f"{path}.target_frequencies_hz.flapping [factor]" in table
+    assert f"{path}.target_frequencies_hz.flapping [Hz]" not in table
+    case = cases[1]
+    assert table.loc[case.case_id, f"{path}.damping_ratio [-]"] == (
+        case.plant["appendages"][0]["joint"]["damping_ratio"])  # fmt: skip

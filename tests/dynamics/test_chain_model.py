@@ -95,3 +95,82 @@ def test_the_chain_equation_table_resolves():
         assert references, row
         for reference in references:
             _resolve(reference)
+
+
+# A corner of the thesis's Monte Carlo set: every appendage path its campaigns vary.
+THESIS_DISPERSION = [
+    Modifier(path="appendages[*].damping_ratio", value=0.01),
+    Modifier(path="appendages[*].target_frequencies_hz.flapping", op="scale", value=1.2),
+    Modifier(path="appendages[*].target_frequencies_hz.in_plane", op="scale", value=0.8),
+    Modifier(path="appendages[*].target_frequencies_hz.torsion", op="scale", value=1.1),
+    Modifier(path="appendages[*].sadm_angle_deg", value=30.0),
+    Modifier(path="appendages[*].inertia", value=0.8),
+]
+
+
+def test_the_thesis_dispersions_change_a_chain_as_they_change_the_plate():
+    # Independent formulation: the plate takes these paths in its own fields; its twin,
+    # the one-segment chain on a 6-DOF joint tuned to the plate's targets, through the
+    # chain's derived paths (joint damping ratio, per-DOF target frequencies of each
+    # kind, the mount turned about the span, the mass). Before the change the two are
+    # the same satellite to round-off (tests/dynamics/test_chain_plate.py); so must they
+    # be after it: tuned stiffness and damping to 1e-14 (eqs. 2.14-2.15 from the same
+    # M(0) entries), M(q) and q_ddot at random states to 1e-13 (about 500 ulp, the bound
+    # of test_chain_plate.py for two orders of the same sums; measured 1.3e-15). The
+    # mount turned about X instead of the span (Y) is off by 0.19, a wrong family or a
+    # damping left per DOF by O(1).
+    from tests.conftest import nominal_dict
+    from tests.dynamics.chain_satellites import thesis_chain_dict
+
+    plate, chain = (
+        Plant.from_config(validate_config(
+            apply_modifiers(data, THESIS_DISPERSION, np.random.default_rng(0), {})))
+        for data in (nominal_dict(), thesis_chain_dict())
+    )  # fmt: skip
+    assert plate.config.appendages[0].sadm_angle_deg == 30.0
+    np.testing.assert_allclose(chain.stiffness, plate.stiffness, rtol=1e-14)
+    np.testing.assert_allclose(chain.damping, plate.damping, rtol=1e-14)
+    rng = np.random.default_rng(20261204)
+    for _ in range(10):
+        q, qd = 0.3 * rng.standard_normal((2, plate.n_dof))
+        for new, ref in ((chain.mass_matrix(q), plate.mass_matrix(q)),
+                         (chain.accelerations(q, qd), plate.accelerations(q, qd))):  # fmt: skip
+            assert np.abs(new - ref).max() <= 1e-13 * np.abs(ref).max()
+
+
+def _clamped_modes(plant: Plant) -> tuple[np.ndarray, list[str]]:
+    """Clamped-root frequencies [Hz] of the plant's appendage coordinates (the hub held)
+    and the joint DOF (rx, ry, rz) that holds most of each mode's kinetic energy."""
+    from scipy.linalg import eigh
+
+    flex = plant.layout.flexible
+    M = plant.mass_matrix()[flex, flex]
+    w2, phi = eigh(plant.stiffness_matrix()[flex, flex], M)
+    dofs = np.array([name.split(".")[-1].split("_")[1] for name in plant.dof_names()[flex]])
+    energy = phi * (M @ phi)  # each coordinate's share of each mode's kinetic energy
+    kinds = [max(("rx", "ry", "rz"), key=lambda d: energy[dofs == d, k].sum())
+             for k in range(len(w2))]  # fmt: skip
+    return np.sqrt(w2) / (2.0 * np.pi), kinds
+
+
+@pytest.mark.parametrize(("kind", "dof"), [("flapping", "rx"), ("in_plane", "rz"),
+                                           ("torsion", "ry")])  # fmt: skip
+def test_a_frequency_factor_moves_every_clamped_mode_of_its_kind(kind, dof):
+    # The chain preset: two 8-segment beam chains along +-Y (flapwise = rx, in-plane =
+    # rz, torsion = ry). A factor s on target_frequencies_hz.<kind> multiplies that beam
+    # stiffness by s^2. A straight chain's flapwise, in-plane and torsion motions do not
+    # couple at q = 0, so K phi = w^2 M phi (hub held) gives every mode of that kind
+    # times s and leaves the others: all 48 frequencies against that prediction to
+    # 1e-10 relative (measured 4e-13 to 1e-12: eigh's round-off on a 48 x 48 problem
+    # whose frequencies span three decades; any coupling between the kinds would move
+    # them by 1e-3 or more). The plate has one mode per kind, and a factor on its
+    # target moves that mode by s alike.
+    data = tomllib.loads(preset_path("chain").read_text())
+    before, kinds = _clamped_modes(Plant.from_config(validate_config(data)))
+    scaled = apply_modifiers(
+        data, [Modifier(path=f"appendages[*].target_frequencies_hz.{kind}", op="scale",
+                        value=1.2)], np.random.default_rng(0), {})  # fmt: skip
+    after, _ = _clamped_modes(Plant.from_config(validate_config(scaled)))
+    expected = np.sort(np.where(np.array(kinds) == dof, 1.2, 1.0) * before)
+    assert kinds.count(dof) == 16  # 8 segments x 2 panels
+    np.testing.assert_allclose(after, expected, rtol=1e-10)

@@ -11,6 +11,7 @@ from flexsat.config import nominal
 from flexsat.dynamics.plant import Plant
 from flexsat.study.avionics import (
     AVIONICS_FIGURES,
+    NO_DRIVE,
     SADM_RATE_DEG_S,
     avionics_study,
     render_avionics,
@@ -91,3 +92,19 @@ def test_the_avionics_runs_stage_figures_are_written(study):
     assert names == ["delay_boundary.png", *(f"{name}.png" for name in AVIONICS_FIGURES)]
     for path in written["figures"]:
         assert path.parent == out and path.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_a_satellite_without_plates_reports_the_drive_not_applicable(tmp_path):
+    # The drive is built for thesis plates; a satellite of chains runs (a) and (b) and
+    # says why (c) is absent instead of failing the whole part (its two panels here are
+    # the plates as one-segment chains; 1 s runs: only the payload's shape is tested).
+    from tests.dynamics.chain_satellites import thesis_chain_config
+
+    written = avionics_study(Plant.from_config(thesis_chain_config()), tmp_path, quick=True,
+                             duration_s=1.0)  # fmt: skip
+    data = json.loads(written["json"].read_text())
+    assert data["sadm"] == {"rate_deg_s": SADM_RATE_DEG_S, "not_applicable": NO_DRIVE}
+    assert len(data["delay_sweep"]) == 2 and data["side_by_side"]["avionics"]["status"] == "ok"
+    outputs = {"json": written["json"].relative_to(tmp_path), "figures": []}
+    _, _, sadm, sentence = render_avionics(tmp_path, outputs, lambda rel, *path: path)
+    assert sadm == [] and sentence.endswith(f"Arrays turning (SADM): {NO_DRIVE}.")

@@ -3,10 +3,13 @@
 A modifier names a path in the plain-dict form of a config (``hub.mass_kg``,
 ``appendages[*].target_frequencies_hz.flapping``, ``initial.rate_deg_s[2]``; ``[*]``
 means every element) and either sets or scales the value there, with a fixed
-number or one drawn from a distribution. Two derived paths exist: ``hub.inertia``
-(scales the hub's inertia tensor, turning a cylinder into an explicit inertia) and
-``appendages[*].inertia`` (scales a panel's mass and so its inertia; the joints are
-re-tuned to keep their target frequencies, as the thesis does).
+number or one drawn from a distribution. Derived paths are computed rather than
+read: ``hub.inertia`` (scales the hub's inertia tensor, turning a cylinder into an
+explicit inertia), ``appendages[*].inertia`` (scales a panel's mass and so its
+inertia; the joints are re-tuned to keep their target frequencies, as the thesis
+does), and each appendage model's own (:class:`~flexsat.dynamics.appendages.DerivedPath`):
+a chain takes the plate's ``damping_ratio``, ``target_frequencies_hz.<kind>`` and
+``sadm_angle_deg``, so the thesis's campaigns disperse it too.
 """
 
 from __future__ import annotations
@@ -19,9 +22,9 @@ from pydantic import Field, model_validator
 from scipy import special
 
 from flexsat.config.models import HubConfig, _Frozen
-from flexsat.dynamics.appendages import appendage_model
+from flexsat.dynamics.appendages import DerivedPath, appendage_model
 
-__all__ = ["Modifier", "apply_modifiers", "truncnormal_ppf"]
+__all__ = ["Modifier", "apply_modifiers", "derived_path", "truncnormal_ppf"]
 
 _APPENDAGE = re.compile(r"appendages\[\d+\]")
 _TOKEN = re.compile(r"([A-Za-z_][A-Za-z0-9_]*)|\[(\*|\d+)\]")
@@ -166,9 +169,12 @@ def apply_modifiers(
     for modifier in modifiers:
         for concrete, parent, key in _targets(data, modifier.path):
             value = modifier.draw(rng)
-            derived = _derived(concrete.rsplit(".", 1)[0], parent)
-            if key in derived:
-                derived[key](parent, value)
+            derived = derived_path(concrete, parent, key)
+            if derived is not None:
+                if modifier.op not in derived.ops:
+                    raise KeyError(f"{concrete} takes op = {' or '.join(map(repr, derived.ops))}"
+                                   f" on this appendage model, not {modifier.op!r}")  # fmt: skip
+                derived.apply(parent, value)
             elif modifier.op == "scale":
                 parent[key] = _scaled(parent[key], value)
             else:
@@ -194,13 +200,35 @@ def _scaled(current: Any, factor: float) -> Any:
     return current * factor
 
 
-def _derived(prefix: str, node: Any) -> dict:
+def _derived(prefix: str, node: Any) -> dict[str, DerivedPath]:
     """Derived paths under ``prefix``: ``hub.inertia``, and each appendage model's own."""
     if prefix == "hub":
-        return {"inertia": _scale_hub_inertia}
+        return {"inertia": DerivedPath(_scale_hub_inertia)}
     if _APPENDAGE.fullmatch(prefix) and isinstance(node, dict):
         return appendage_model(node.get("model", "plate")).modifiers
     return {}
+
+
+def derived_path(concrete: str, parent: Any, key: Any) -> DerivedPath | None:
+    """The derived path a target of :func:`_targets` names, or None for a config field.
+
+    Parameters
+    ----------
+    concrete : str
+        The target's concrete path (``appendages[0].target_frequencies_hz.flapping``).
+    parent : dict or list
+        The container the target sits in (for a derived path, the table it changes).
+    key : str or int
+        The target's key in ``parent`` (for a derived path, its possibly dotted name).
+
+    Returns
+    -------
+    DerivedPath or None
+        What computes the path, when ``parent`` has no field ``key``.
+    """
+    if not isinstance(parent, dict) or key in parent:
+        return None
+    return _derived(concrete[: -len(key) - 1], parent).get(key)
 
 
 def _scale_hub_inertia(hub: dict, factor: float) -> None:
@@ -221,10 +249,15 @@ def _targets(data: dict, path: str):
         following = []
         for prefix, node in nodes:
             if name:
-                if not isinstance(node, dict) or (
-                    name not in node and name not in _derived(prefix, node)
-                ):
-                    raise KeyError(f"no {name!r} at {prefix or 'the top level'} of {path!r}")
+                if not isinstance(node, dict):
+                    raise KeyError(f"{prefix!r} has no fields, in {path!r}")
+                if name not in node:  # a derived path, its name the rest of the path
+                    rest = [part for part, _ in tokens[k:]]
+                    dotted = ".".join(rest) if all(rest) else None
+                    if dotted not in _derived(prefix, node):
+                        raise KeyError(_missing(name, prefix, node, path))
+                    yield f"{prefix}.{dotted}" if prefix else dotted, node, dotted
+                    continue
                 concrete = f"{prefix}.{name}" if prefix else name
                 if last:
                     yield concrete, node, name
@@ -242,3 +275,29 @@ def _targets(data: dict, path: str):
                     else:
                         following.append((f"{prefix}[{i}]", node[i]))
         nodes = following
+
+
+def _missing(name: str, prefix: str, node: dict, path: str) -> str:
+    """The message for a path that names no field: what the table offers instead."""
+    where = prefix or "the top level"
+    derived = sorted(_derived(prefix, node))
+    if _APPENDAGE.fullmatch(prefix):
+        model = node.get("model", "plate")
+        fields = sorted(_leaves(node))
+        return (f"no {name!r} at {where} (a {model!r} appendage) of {path!r}: its paths are "
+                f"{', '.join(fields + derived)}")  # fmt: skip
+    return f"no {name!r} at {where} of {path!r}"
+
+
+def _leaves(table: dict) -> list[str]:
+    """The paths of a table's numbers, one level of nesting deep (for :func:`_missing`)."""
+    out = []
+    for key, value in table.items():
+        if isinstance(value, dict):
+            out += [f"{key}.{sub}" for sub, leaf in value.items() if isinstance(leaf, int | float)]
+        elif isinstance(value, list | tuple):
+            if value and all(isinstance(leaf, int | float) for leaf in value):
+                out.append(f"{key}[i]")
+        elif isinstance(value, int | float) and not isinstance(value, bool):
+            out.append(key)
+    return out

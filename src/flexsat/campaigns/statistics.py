@@ -22,7 +22,7 @@ import numpy as np
 import pandas as pd
 from scipy import stats
 
-from flexsat.campaigns.modifiers import _targets
+from flexsat.campaigns.modifiers import _targets, derived_path
 
 __all__ = [
     "PERCENTILES",
@@ -237,7 +237,7 @@ def parameter_table(rows: list[dict]) -> pd.DataFrame:
         record = {"case_id": row["case_id"]}
         inputs = row.get("inputs") or {}
         for path, value in (row.get("parameters") or {}).items():
-            physical = _value_at(inputs, path)
+            physical = _value_at(inputs, path, value)
             if physical is None or physical != value:
                 record[f"{path} [factor]"] = value
             if physical is not None:
@@ -246,7 +246,8 @@ def parameter_table(rows: list[dict]) -> pd.DataFrame:
     return pd.DataFrame(records)
 
 
-def _value_at(inputs: dict, path: str):
+def _value_at(inputs: dict, path: str, realised):
+    """The physical value at ``path`` in a case's inputs, or None (a factor)."""
     for part in ("plant", "scenario"):
         data = inputs.get(part)
         if not isinstance(data, dict):
@@ -256,7 +257,10 @@ def _value_at(inputs: dict, path: str):
         except KeyError:
             continue
         if len(hits) == 1:
-            _, parent, key = hits[0]
+            concrete, parent, key = hits[0]
+            derived = derived_path(concrete, parent, key)
+            if derived is not None:  # computed: the realised value is physical or a factor
+                return None if derived.factor else realised
             try:
                 value = parent[key]
             except (KeyError, IndexError, TypeError):

@@ -31,6 +31,7 @@ __all__ = [
     "AVIONICS",
     "AVIONICS_FIGURES",
     "DELAYS_S",
+    "NO_DRIVE",
     "QUICK_DELAYS_S",
     "SADM_DRIVE",
     "SADM_RATE_DEG_S",
@@ -63,6 +64,9 @@ mass; its loop's natural frequency, stiff against the array's modes (0.25-0.8 Hz
 as a geared drive is, and damping ratio."""
 _SADM_KEYS = ("array_angle_deg", "peak_drive_torque_nm", "peak_tracking_error_deg",
               "attitude_difference_deg")  # fmt: skip
+NO_DRIVE = ("not applicable: the satellite has no thesis plate to put on a drive (the drive "
+            "is built for plates; a chain or modal appendage keeps its mount fixed)")  # fmt: skip
+"""What (c) reports for a satellite without plates."""
 UNSTABLE_POINTING_DEG = 1.0
 """A delayed run is called unstable when it diverged (stopped) or ends farther than
 this from the target (the nominal slew ends within 0.003 deg)."""
@@ -108,10 +112,12 @@ def sadm_study(plant, duration_s: float | None = None) -> dict:
         ``turning``, and of the turning run the array angle reached
         ``array_angle_deg``, the peak drive torque ``peak_drive_torque_nm``, the
         peak tracking error ``peak_tracking_error_deg`` and the largest attitude
-        difference from the holding run ``attitude_difference_deg``.
+        difference from the holding run ``attitude_difference_deg``; for a satellite
+        without plates, ``rate_deg_s`` and ``not_applicable`` (:data:`NO_DRIVE`).
     """
     driven, runs = _sadm_runs(plant)
     return _sadm_summary(*(_sadm_run(driven, fields, duration_s) for fields in runs))
+
 
 
 def sadm_plant(config: SatelliteConfig) -> Plant:
@@ -146,12 +152,14 @@ def sadm_runs(config: SatelliteConfig) -> list[dict]:
     -------
     list of dict
         The fields of the holding run (rate 0) and of the turning run
-        (:data:`SADM_RATE_DEG_S`) [-].
+        (:data:`SADM_RATE_DEG_S`), or none for a satellite without plates [-].
     """
     from flexsat.dynamics.appendages.sadm import DRIVE_COORDINATE
 
     drive = SADM_DRIVE
     plates = [a for a in config.appendages if isinstance(a, AppendageConfig)]
+    if not plates:
+        return []
     inertia = drive["rotor_inertia_kg_m2"] + max(a.centroidal_inertia()[1, 1] for a in plates)
     omega_n = 2.0 * np.pi * drive["frequency_hz"]
     runs = []
@@ -163,9 +171,11 @@ def sadm_runs(config: SatelliteConfig) -> list[dict]:
     return runs
 
 
-def _sadm_runs(plant) -> tuple[Plant, list[dict]]:
-    """The driven satellite and the scenario fields of (c)'s runs, holding then turning."""
-    return sadm_plant(plant.config), sadm_runs(plant.config)
+def _sadm_runs(plant) -> tuple[Plant | None, list[dict]]:
+    """The driven satellite and the scenario fields of (c)'s runs, holding then turning
+    (none, and no satellite, without plates)."""
+    runs = sadm_runs(plant.config)
+    return (sadm_plant(plant.config) if runs else None), runs
 
 
 def _sadm_run(driven, fields: dict, duration_s: float | None) -> dict:
@@ -185,8 +195,11 @@ def _sadm_run(driven, fields: dict, duration_s: float | None) -> dict:
     }
 
 
-def _sadm_summary(holding: dict, turning: dict) -> dict:
-    """:func:`sadm_study`'s payload from its two runs (:func:`_sadm_run`)."""
+def _sadm_summary(holding: dict | None = None, turning: dict | None = None) -> dict:
+    """:func:`sadm_study`'s payload from its two runs (:func:`_sadm_run`); without
+    them (no plates), what (c) reports instead."""
+    if holding is None:
+        return {"rate_deg_s": SADM_RATE_DEG_S, "not_applicable": NO_DRIVE}
     overlap = np.abs(np.sum(turning["quaternion"] * holding["quaternion"], axis=1))
     difference = 2.0 * np.arccos(np.minimum(1.0, overlap))  # angle between the attitudes
     return {
@@ -240,8 +253,9 @@ def avionics_study(plant, out: str | Path, quick: bool = False,
         return {key: metrics[key] for key in _KEYS}, figures
 
     flown = forked_map(fly, runs)
-    (ideal, _), (avionics, stage_figures), *swept, (holding, _), (turning, _) = flown
-    swept = [metrics for metrics, _ in swept]
+    (ideal, _), (avionics, stage_figures), *rest = flown
+    swept = [metrics for metrics, _ in rest[: len(periods)]]
+    driven_runs = [metrics for metrics, _ in rest[len(periods):]]
     side_by_side = {"ideal": ideal, "avionics": avionics}
     sweep = []
     for n, row in zip(periods, swept, strict=True):
@@ -260,7 +274,7 @@ def avionics_study(plant, out: str | Path, quick: bool = False,
         "r1_lost_at_delay_s": first("r1_pass", False),
         "r2_lost_at_delay_s": first("r2_pass", False),
         "unstable_at_delay_s": first("unstable", True),
-        "sadm": _sadm_summary(holding, turning),
+        "sadm": _sadm_summary(*driven_runs),
         "quick": quick,
     }
     from flexsat.study.outputs import write_json
@@ -320,7 +334,7 @@ def render_avionics(root: Path, outputs: dict, cell) -> tuple[list, list, list, 
     Returns
     -------
     metrics, sweep, sadm : list
-        The table rows.
+        The table rows (``sadm`` empty when the satellite has no plate to drive).
     boundaries : str
         The sentence.
     """
@@ -335,18 +349,22 @@ def render_avionics(root: Path, outputs: dict, cell) -> tuple[list, list, list, 
               cell(rel, "delay_sweep", i, "max_rate_error_deg_s"),
               cell(rel, "delay_sweep", i, "unstable")]
              for i in range(len(data["delay_sweep"]))]  # fmt: skip
+    driven = "not_applicable" not in data["sadm"]
     sadm = [[key, cell(rel, "sadm", "holding", key), cell(rel, "sadm", "turning", key)]
-            for key in _KEYS]  # fmt: skip
-    sadm += [[key, "", cell(rel, "sadm", key)] for key in _SADM_KEYS]
+            for key in _KEYS] if driven else []  # fmt: skip
+    sadm += [[key, "", cell(rel, "sadm", key)] for key in _SADM_KEYS] if driven else []
 
     def fmt(value):
         return "beyond the sweep" if value is None else f"{value:g} s"
 
     sentence = (f"R1 is lost at a delay of {fmt(data['r1_lost_at_delay_s'])}, R2 at "
                 f"{fmt(data['r2_lost_at_delay_s'])}; the loop is unstable from "
-                f"{fmt(data['unstable_at_delay_s'])}. Arrays turning at "
-                f"{data['sadm']['rate_deg_s']:g} deg/s (SADM, one turn per low-orbit "
-                f"revolution) move the attitude by at most "
-                f"{data['sadm']['attitude_difference_deg']:.2g} deg from the arrays "
-                f"held.")  # fmt: skip
+                f"{fmt(data['unstable_at_delay_s'])}. ")  # fmt: skip
+    if driven:
+        sentence += (f"Arrays turning at {data['sadm']['rate_deg_s']:g} deg/s (SADM, one "
+                     f"turn per low-orbit revolution) move the attitude by at most "
+                     f"{data['sadm']['attitude_difference_deg']:.2g} deg from the arrays "
+                     f"held.")  # fmt: skip
+    else:
+        sentence += f"Arrays turning (SADM): {data['sadm']['not_applicable']}."
     return side, sweep, sadm, sentence

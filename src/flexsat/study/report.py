@@ -534,7 +534,7 @@ def _avionics(root: Path, outputs: dict, context: dict) -> str:
         _table(["delay [s]", "R1", "R2", "APE [deg]", "max rate error [deg/s]", "unstable"],
                sweep, "Sweep over the computational delay"),
         _table(["metric", "arrays held", "arrays turning"], sadm,
-               "Ideal loop, plates on a solar-array drive: held and turning"),
+               "Ideal loop, plates on a solar-array drive: held and turning") if sadm else "",
         f"<p>{_esc(sentence)}</p>",
         _figures(root, outputs["figures"]),
     ])  # fmt: skip

@@ -11,6 +11,7 @@ from flexsat.dynamics.appendages.contract import (
     AppendageKernels,
     AppendageModel,
     Coordinate,
+    DerivedPath,
     RigidBody,
 )
 from flexsat.dynamics.appendages.modal import ModalModel
@@ -30,6 +31,7 @@ __all__ = [
     "AppendageModel",
     "ChainModel",
     "Coordinate",
+    "DerivedPath",
     "ModalModel",
     "PlateModel",
     "RigidBody",

@@ -16,12 +16,19 @@ docs/model.md, 'Chain appendages'.
 
 from __future__ import annotations
 
+import warnings
 from typing import ClassVar
 
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from flexsat.dynamics.appendages.chain_config import AXES, CHORD_THICKNESS, DOF_NAMES, ChainConfig
+from flexsat.dynamics.appendages.chain_config import (
+    AXES,
+    CHORD_THICKNESS,
+    DOF_NAMES,
+    ChainConfig,
+    dof_kind,
+)
 from flexsat.dynamics.appendages.chain_kernels import (
     G_C,
     G_COM,
@@ -52,6 +59,7 @@ from flexsat.dynamics.appendages.contract import (
     AppendageKernels,
     AppendageModel,
     Coordinate,
+    DerivedPath,
     RigidBody,
 )
 
@@ -76,6 +84,64 @@ def _scale_mass(table: dict, factor: float) -> None:
     table[field] = table[field] * factor
 
 
+def _joint_tables(table: dict) -> list[dict]:
+    """Every joint table of a chain's plain-dict table: each listed segment's, or the
+    uniform chain's ``joint`` and ``root_joint``."""
+    if table.get("segment_list") is not None:
+        return [segment["joint"] for segment in table["segment_list"]]
+    return [table[field] for field in ("joint", "root_joint") if table.get(field) is not None]
+
+
+def _set_damping_ratio(table: dict, ratio: float) -> None:
+    """Campaign path ``appendages[*].damping_ratio`` on a chain: the damping ratio of
+    every free DOF of every joint (eq. 2.15), in place of any damping given per DOF."""
+    for joint in _joint_tables(table):
+        joint["damping_ratio"] = ratio
+        joint["damping"] = None
+
+
+_BEAM_PROPERTY = {"flapping": "EI_flap_N_m2", "in_plane": "EI_in_plane_N_m2", "torsion": "GJ_N_m2"}
+
+
+def _frequency_scaler(kind: str):
+    """Campaign path ``appendages[*].target_frequencies_hz.<kind>`` on a chain, a factor
+    s on the frequencies of that kind: every joint stiffness of the kind (from the beam
+    table, per DOF, or tuned to a per-joint target frequency) times s^2. The clamped
+    chain's modes of that kind then all move by s exactly, as the plate's one mode of
+    that kind does when its target is scaled: a straight chain's flapwise, in-plane and
+    torsion motions do not couple at first order (docs/campaigns.md, 'Modifier paths on
+    any appendage model')."""
+
+    def scale(table: dict, factor: float) -> None:
+        span = table.get("span_direction", "+y")
+        if table.get("beam") is not None and table["beam"].get(_BEAM_PROPERTY[kind]) is not None:
+            table["beam"][_BEAM_PROPERTY[kind]] *= factor**2
+        for joint in _joint_tables(table):
+            for field, power in (("stiffness", 2), ("target_frequencies_hz", 1)):
+                for dof, value in (joint.get(field) or {}).items():
+                    if dof_kind(span, dof) == kind:
+                        joint[field][dof] = value * factor**power
+
+    return scale
+
+
+def _set_sadm_angle(table: dict, angle_deg: float) -> None:
+    """Campaign path ``appendages[*].sadm_angle_deg`` on a chain: the mount turned by
+    the angle about its span axis, from the mount the config gives (the plate's SADM
+    angle turns its mount about +Y_M, its span axis, the same way)."""
+    mount = ChainConfig.model_validate(table).mount_rotation()
+    axis = np.zeros(3)
+    axis[AXES[table.get("span_direction", "+y")[1]]] = 1.0
+    turned = mount @ Rotation.from_rotvec(np.radians(angle_deg) * axis).as_matrix()
+    if table.get("mount_matrix") is not None:
+        table["mount_matrix"] = turned.tolist()
+    else:
+        with warnings.catch_warnings():  # at 90 deg about Y the ZYX angles are a family
+            warnings.simplefilter("ignore", UserWarning)  # of which scipy picks one: exact
+            angles = Rotation.from_matrix(turned).as_euler("ZYX", degrees=True)
+        table["mount_zyx_deg"] = np.round(angles, 9).tolist()  # 45, not 45.00000000000003
+
+
 class ChainModel(AppendageModel):
     """Serial chain of rigid segments on elastic joints (:class:`ChainConfig`)."""
 
@@ -83,7 +149,13 @@ class ChainModel(AppendageModel):
     config_class = ChainConfig
     kernels = AppendageKernels(pass1, pass2, mass_matrix, bias_forces, observe, joint_wrench, tips)
     transmits_inertia = True
-    modifiers: ClassVar[dict] = {"inertia": _scale_mass}
+    modifiers: ClassVar[dict] = {
+        "inertia": DerivedPath(_scale_mass),
+        "damping_ratio": DerivedPath(_set_damping_ratio, ops=("set",), factor=False),
+        "sadm_angle_deg": DerivedPath(_set_sadm_angle, ops=("set",), factor=False),
+        **{f"target_frequencies_hz.{kind}": DerivedPath(_frequency_scaler(kind), ops=("scale",))
+           for kind in _BEAM_PROPERTY},
+    }  # fmt: skip
     work_size = WSEG
 
     # -- layout ---------------------------------------------------------------------------

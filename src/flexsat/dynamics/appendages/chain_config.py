@@ -46,6 +46,7 @@ __all__ = [
     "JointConfig",
     "Segment",
     "SegmentConfig",
+    "dof_kind",
 ]
 
 DOF_NAMES = ("x", "y", "z", "rx", "ry", "rz")
@@ -242,6 +243,29 @@ CHORD_THICKNESS = {"x": ("y", "z"), "y": ("x", "z"), "z": ("x", "y")}
 """(chord, thickness) axes of each span axis."""
 
 
+def dof_kind(span_direction: str, dof: str) -> str:
+    """The modal kind of a joint DOF of a chain whose span runs along ``span_direction``.
+
+    Parameters
+    ----------
+    span_direction : str
+        ``+x``, ``-x``, ``+y``, ``-y``, ``+z`` or ``-z`` [-].
+    dof : str
+        A joint DOF, one of :data:`DOF_NAMES` [-].
+
+    Returns
+    -------
+    str
+        ``flapping`` (rotation about the chord axis), ``in_plane`` (about the
+        thickness axis), ``torsion`` (about the span) or ``translation`` [-].
+    """
+    if not _is_rotation(dof):
+        return "translation"
+    span = span_direction[1]
+    chord, thickness = CHORD_THICKNESS[span]
+    return {chord: "flapping", thickness: "in_plane", span: "torsion"}[dof[1]]
+
+
 class ChainConfig(_Frozen):
     """A chain appendage: N rigid segments in series, each on an elastic joint.
 
@@ -327,11 +351,7 @@ class ChainConfig(_Frozen):
 
     def dof_kind(self, dof: str) -> str:
         """The modal kind of a joint DOF: flapping, in_plane, torsion or translation."""
-        if not _is_rotation(dof):
-            return "translation"
-        span = self.span_direction[1]
-        chord, thickness = CHORD_THICKNESS[span]
-        return {chord: "flapping", thickness: "in_plane", span: "torsion"}[dof[1]]
+        return dof_kind(self.span_direction, dof)
 
     def _beam_stiffness(self, joint: JointConfig, factor: float) -> dict:
         """Stiffness per free DOF from the beam table: factor * (EI, GJ, EA) / l."""

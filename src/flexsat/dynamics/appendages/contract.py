@@ -69,6 +69,7 @@ __all__ = [
     "AppendageKernels",
     "AppendageModel",
     "Coordinate",
+    "DerivedPath",
     "RigidBody",
 ]
 
@@ -127,6 +128,32 @@ wrench comes from ``qdd`` has their effect there already and ignores ``Q``."""
 TIPS_SIGNATURE = types.void(_v, _i, _m, _m)
 """``tips(q, members, params, out)``: write row ``members[j, 0]`` of ``out`` (n, 3): the
 tip displacement from the undeformed place, mount frame [m]."""
+
+
+class DerivedPath(NamedTuple):
+    """A campaign modifier path that an appendage model computes instead of reading a
+    config field (``appendages[*].<name>``, the name possibly dotted).
+
+    It lets one campaign file disperse any appendage model: the thesis's dispersions
+    (``damping_ratio``, ``target_frequencies_hz.flapping``, ``sadm_angle_deg``, ...)
+    are the plate's own fields, and a chain maps them to its joints, its beam table
+    and its mount (docs/campaigns.md, 'Modifier paths on any appendage model').
+
+    Attributes
+    ----------
+    apply : callable
+        ``apply(table, value)`` changes the appendage's plain-dict table in place [-].
+    ops : tuple of str
+        The modifier ops it takes, ``"set"`` and/or ``"scale"`` [-].
+    factor : bool
+        True when the value is a scale factor (the campaign tables then label its
+        column ``[factor]``); False when it is the physical value, in the unit its
+        name states [-].
+    """
+
+    apply: Callable[[dict, float], None]
+    ops: tuple[str, ...] = ("set", "scale")
+    factor: bool = True
 
 
 class AppendageKernels(NamedTuple):
@@ -230,9 +257,9 @@ class AppendageModel(ABC):
         Columns of the scratch rows ``work`` that pass 1 may leave for pass 2 (see
         :meth:`work_columns` for a scratch that grows with the appendage).
     modifiers : dict
-        Derived campaign modifier paths beyond the config's own fields: name ->
-        function(table, value) that changes the appendage's plain-dict table in place
-        (``appendages[*].<name>``).
+        Derived campaign modifier paths beyond the config's own fields: name (dotted
+        for a nested path) -> :class:`DerivedPath` (``appendages[*].<name>``). A
+        config field of the same name takes precedence.
     """
 
     name: ClassVar[str]
@@ -240,7 +267,7 @@ class AppendageModel(ABC):
     kernels: ClassVar[AppendageKernels]
     transmits_inertia: ClassVar[bool] = False
     holds_locked: ClassVar[bool] = False
-    modifiers: ClassVar[dict[str, Callable[[dict, float], None]]] = {}
+    modifiers: ClassVar[dict[str, DerivedPath]] = {}
     work_size: ClassVar[int] = 0
 
     @abstractmethod

@@ -53,6 +53,7 @@ from flexsat.dynamics.appendages.contract import (
     AppendageKernels,
     AppendageModel,
     Coordinate,
+    DerivedPath,
     RigidBody,
 )
 from flexsat.dynamics.linalg3 import (
@@ -760,7 +761,7 @@ class PlateModel(AppendageModel):
     kernels = AppendageKernels(pass1, pass2, mass_matrix, bias_forces, observe, joint_wrench, tips)
     transmits_inertia = False
     holds_locked = True
-    modifiers: ClassVar[dict] = {"inertia": _scale_mass}
+    modifiers: ClassVar[dict] = {"inertia": DerivedPath(_scale_mass)}
     work_size = WORK_SIZE
 
     def coordinates(self, config: AppendageConfig) -> tuple[Coordinate, ...]:
