@@ -27,8 +27,10 @@ def plot_controller_comparison(datasets: dict[str, xr.Dataset]) -> Figure:
     Parameters
     ----------
     datasets : dict of str to xarray.Dataset
-        Closed-loop result datasets keyed by the law's label (e.g. ``"asmc"``), all of
-        the same slew; the requirements drawn are those of the first one's scenario.
+        Closed-loop result datasets keyed by the law's name (e.g. ``"asmc"``, drawn
+        as the law's label, "ASMC") or by a label of the caller's (drawn as given:
+        ``"asmc, k = 2"``), all of the same slew; the requirements drawn are those of
+        the first one's scenario.
 
     Returns
     -------
@@ -110,5 +112,9 @@ def write_comparison_figure(
 
 
 def _label(key: str, ds) -> str:
-    """The law's display name the run recorded (the key upper-cased for older results)."""
+    """The law's display name the run recorded when the key is the law's own name (the
+    key upper-cased for older results); the caller's key otherwise, so that two runs of
+    one law (``"asmc, k = 1"``, ``"asmc, k = 2"``) keep their own names."""
+    if key != ds.attrs.get("controller", key):
+        return key
     return str(ds.attrs.get("controller_label", key.upper()))
