@@ -60,3 +60,13 @@ def test_a_search_runs_alone():
     with pytest.raises(ValueError, match="runs alone"):
         validate_config({**_search().model_dump(mode="json"), "random": {"n": 3}},
                         model=CampaignDefinition)  # fmt: skip
+
+
+def test_a_window_metric_of_runs_that_end_before_the_window_is_explained(tmp_path):
+    # 0.5 s runs end long before the 90-120 s observation window: ape_deg is NaN in
+    # every evaluation, and the message says why instead of suggesting ape_deg.
+    from flexsat.errors import ConfigError
+
+    with pytest.raises(ConfigError, match="need runs that reach the end of the requirements"):
+        run_campaign(_search(metric="ape_deg", maxiter=1), nominal(), tmp_path, workers=1,
+                     progress=False)  # fmt: skip

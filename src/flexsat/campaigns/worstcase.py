@@ -117,7 +117,10 @@ def run_worst_case(
     if not values:
         raise ConfigError(
             f"worst_case.metric {search.metric!r}: no evaluation gave a finite value (a "
-            "numeric slew metric such as final_pointing_error_deg, ape_deg, rpe_deg)"
+            "numeric slew metric such as final_pointing_error_deg or "
+            "peak_tip_displacement_m; ape_deg, rpe_deg and max_rate_error_deg_s need runs "
+            "that reach the end of the requirements' observation window, 120 s for the "
+            "thesis's)"
         )
     worst = max(values, key=values.get)
     summary = {
