@@ -255,6 +255,32 @@ def test_campaign_scales_act_on_every_mode(nominal):
         validate_config(data)
 
 
+def test_the_thesis_damping_path_sets_every_modes_ratio(nominal):
+    # The thesis's campaigns set appendages[*].damping_ratio (zeta = 0 is their critical
+    # case); on a modal appendage it sets every mode's ratio, any damping_scale undone:
+    # the plant's modal damping is then 2 zeta omega_k (eq. 2.15 per mode), to round-off.
+    # Its frequency paths have no meaning for modes from a file: refused, naming the
+    # modal paths instead.
+    from flexsat.campaigns.modifiers import Modifier, apply_modifiers
+
+    table = copy.deepcopy(_table(nominal))
+    data = nominal_dict()
+    data["appendages"] = [{"name": "wing", "model": "modal", "mount_point_m": [0, 0.8, 0],
+                           "data": table, "damping_scale": 2.0}]  # fmt: skip
+    base = validate_config(data).model_dump()
+    rng = np.random.default_rng(0)
+    realised: dict = {}
+    out = apply_modifiers(base, [Modifier(path="appendages[*].damping_ratio", value=0.02)],
+                          rng, realised)  # fmt: skip
+    plant = Plant.from_config(validate_config(out))
+    omega = 2 * np.pi * np.array(table["frequencies_hz"])
+    np.testing.assert_allclose(plant.damping, 2 * 0.02 * omega, rtol=1e-14)
+    assert realised == {"appendages[0].damping_ratio": 0.02}
+    with pytest.raises(KeyError, match=r"a 'modal' appendage.*frequency_scale"):
+        apply_modifiers(base, [Modifier(path="appendages[*].target_frequencies_hz.flapping",
+                                        op="scale", value=1.2)], rng, {})  # fmt: skip
+
+
 # -- exact round trip: a chain exported with all its modes -------------------------------
 
 

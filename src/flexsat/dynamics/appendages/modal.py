@@ -33,7 +33,7 @@ linear in n.
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Annotated, Any, Literal
+from typing import Annotated, Any, ClassVar, Literal
 
 import numpy as np
 from numba import njit
@@ -66,6 +66,7 @@ from flexsat.dynamics.appendages.contract import (
     AppendageKernels,
     AppendageModel,
     Coordinate,
+    DerivedPath,
     RigidBody,
 )
 from flexsat.dynamics.linalg3 import (
@@ -429,6 +430,17 @@ def tips(q, members, params, out):
         out[i, 0], out[i, 1], out[i, 2] = d
 
 
+def _set_damping_ratio(table: dict, ratio: float) -> None:
+    """Campaign path ``appendages[*].damping_ratio`` on a modal appendage: the damping
+    ratio of every mode (``damping_scale`` back to 1), as the plate's ``damping_ratio``
+    sets its joints'. The data is in the table once the config is validated (a file's
+    content is read into ``data``)."""
+    if table.get("data") is None:
+        raise KeyError("damping_ratio: the modal data is not in the config (validate it first)")
+    table["data"]["damping_ratios"] = [ratio] * len(table["data"]["damping_ratios"])
+    table["damping_scale"] = 1.0
+
+
 class ModalModel(AppendageModel):
     """A hybrid-coordinate appendage (:class:`ModalAppendageConfig`) rigidly mounted."""
 
@@ -436,6 +448,9 @@ class ModalModel(AppendageModel):
     config_class = ModalAppendageConfig
     kernels = AppendageKernels(pass1, pass2, mass_matrix, bias_forces, observe, joint_wrench, tips)
     transmits_inertia = True
+    modifiers: ClassVar[dict] = {
+        "damping_ratio": DerivedPath(_set_damping_ratio, ops=("set",), factor=False),
+    }
 
     def coordinates(self, config: ModalAppendageConfig) -> tuple[Coordinate, ...]:
         return tuple(Coordinate(f"q{k + 1}", "kg^0.5 m") for k in range(config.data.n_modes))
