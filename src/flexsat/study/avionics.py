@@ -350,9 +350,11 @@ def render_avionics(root: Path, outputs: dict, cell) -> tuple[list, list, list, 
               cell(rel, "delay_sweep", i, "unstable")]
              for i in range(len(data["delay_sweep"]))]  # fmt: skip
     driven = "not_applicable" not in data["sadm"]
-    sadm = [[key, cell(rel, "sadm", "holding", key), cell(rel, "sadm", "turning", key)]
-            for key in _KEYS] if driven else []  # fmt: skip
-    sadm += [[key, "", cell(rel, "sadm", key)] for key in _SADM_KEYS] if driven else []
+    sadm = []
+    if driven:
+        sadm = [[key, cell(rel, "sadm", "holding", key), cell(rel, "sadm", "turning", key)]
+                for key in _KEYS]  # fmt: skip
+        sadm += [[key, "", cell(rel, "sadm", key)] for key in _SADM_KEYS]
 
     def fmt(value):
         return "beyond the sweep" if value is None else f"{value:g} s"
