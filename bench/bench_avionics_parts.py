@@ -6,7 +6,7 @@ meant to separate. This one times the pieces in compiled loops of ``--calls`` ca
 each and keeps the minimum over ``--batches`` batches, which preemption only
 lengthens. Within one run the pieces are comparable; from one run to the next the
 whole machine's speed can still move (by up to 20 % on the 2-core virtual machine
-of ``docs/performance.md``, 'The coupled step's pieces'), so compare runs by their
+of ``CHANGELOG.md``, "The coupled step's pieces"), so compare runs by their
 ratios, and repeat:
 
 - one RK4 step of the nominal plant (``rk4_step``), the ideal loop's step;

@@ -222,6 +222,38 @@ def targets(results: dict) -> list[tuple[str, str, bool | None, str]]:
     return rows
 
 
+DOCS = Path(__file__).resolve().parents[1] / "docs" / "performance.md"
+BEGIN = "<!-- targets: written by bench/run_all.py; do not edit by hand -->"
+END = "<!-- end of targets -->"
+
+
+def _cell(text: str) -> str:
+    """A table cell of Markdown: rich's colour markup dropped, pipes escaped."""
+    for markup in ("[green]", "[/green]", "[red]", "[/red]"):
+        text = text.replace(markup, "")
+    return text.replace("|", "\\|")
+
+
+def write_targets(rows: list[tuple[str, str, bool | None, str]], machine: str) -> None:
+    """Replace the table between the markers of docs/performance.md, 'Targets'."""
+    lines = [
+        BEGIN,
+        f"Last full run: {time.strftime('%Y-%m-%d')}. {machine}.",
+        "",
+        "| target | measured | verdict | note |",
+        "| --- | --- | --- | --- |",
+        *(
+            f"| {_cell(t)} | {_cell(v)} | {_cell(_verdict(ok))} | {_cell(note)} |"
+            for t, v, ok, note in rows
+        ),
+        END,
+    ]
+    text = DOCS.read_text(encoding="utf-8")
+    head, rest = text.split(BEGIN, 1)
+    tail = rest.split(END, 1)[1]
+    DOCS.write_text(head + "\n".join(lines) + tail, encoding="utf-8")
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument(
@@ -255,13 +287,19 @@ def main(argv: list[str] | None = None) -> int:
     table = Table(title="Performance targets (nominal satellite, RK4 dt = 1 ms, one core)")
     for column in ("target", "measured", "verdict", "note"):
         table.add_column(column, justify="right" if column == "measured" else "left")
-    for target, value, ok, note in targets(results):
+    rows = targets(results)
+    for target, value, ok, note in rows:
         table.add_row(target, value, _verdict(ok), note)
     console.print(table)
     console.print(
         f"Machine: {cpu_model()}, {os.cpu_count()} logical CPUs; load average at the end "
         f"{_load()}; all benchmarks {time.perf_counter() - start:.0f} s."
     )
+    if not args.names and not failed:
+        write_targets(rows, f"{machine}; at the end {_load()}")
+        console.print(f"The targets table is written to {DOCS.name}, 'Targets'.")
+    else:
+        console.print(f"A partial run: {DOCS.name} is left as it is.")
     if failed:
         console.print(f"[red]failed: {', '.join(failed)}[/red]")
     return 1 if failed else 0

@@ -22,6 +22,8 @@ DOCS = ROOT / "docs"
 EQUATIONS_PER_CHAPTER = {2: 50, 3: 10, 4: 30, 5: 10}
 REFERENCE = re.compile(r"`(flexsat(?:\.\w+)*:\w+(?:\.\w+)*)`")
 CITATION = re.compile(r"docs/(\w+\.md)`?, (?:'([^']+)'|\"([^\"]+)\")")
+# The history of measurements, cited the same way: "CHANGELOG.md, 'Heading'".
+CHANGELOG_CITATION = re.compile(r"(?<![/\w])CHANGELOG\.md`*, (?:'([^']+)'|\"([^\"]+)\")")
 
 
 def _table_rows() -> list[list[str]]:
@@ -77,12 +79,16 @@ def test_every_row_names_code_or_says_why_not():
 
 
 def _headings(page: str) -> set[str]:
-    text = (DOCS / page).read_text(encoding="utf-8")
+    return _headings_of(DOCS / page)
+
+
+def _headings_of(path: Path) -> set[str]:
+    text = path.read_text(encoding="utf-8")
     return {line.lstrip("#").strip() for line in text.splitlines() if line.startswith("#")}
 
 
 def _cited_files() -> list[Path]:
-    files = [ROOT / "README.md", *DOCS.glob("*.md")]
+    files = [ROOT / "README.md", ROOT / "CHANGELOG.md", *DOCS.glob("*.md")]
     for folder in ("src", "tests", "bench", "examples"):
         files += [p for p in (ROOT / folder).rglob("*") if p.suffix in (".py", ".toml", ".md")]
     return [p for p in files if p != Path(__file__).resolve()]
@@ -100,3 +106,7 @@ def test_docs_citations_name_existing_sections(path):
         heading = single or double
         assert (DOCS / page).is_file(), f"{path}: docs/{page} does not exist"
         assert heading in _headings(page), f"{path}: no section {heading!r} in docs/{page}"
+    changelog = _headings_of(ROOT / "CHANGELOG.md")
+    for single, double in CHANGELOG_CITATION.findall(flat):
+        heading = single or double
+        assert heading in changelog, f"{path}: no entry {heading!r} in CHANGELOG.md"

@@ -18,7 +18,7 @@ def dask_setup(worker) -> None:
     compiled code, xarray, pydantic's models) spends about 0.5 s of its exit in that
     collection, walking millions of objects it is about to drop with the process, and
     the campaign waits for it: a two-worker cluster took 0.80–0.87 s to close, and
-    0.11–0.12 s with the collection skipped (docs/performance.md, 'Exits without
+    0.11–0.12 s with the collection skipped (CHANGELOG.md, 'Exits without
     the last collection'). Objects freed by reference counting are still finalized; only
     cyclic garbage (none of it holding a file or a lock a campaign writes through:
     a worker only returns rows) is left to the operating system.

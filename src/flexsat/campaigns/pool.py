@@ -18,7 +18,7 @@ Workers are forked where that is safe: on Linux, from a parent that runs no thre
 but its main one. A forked worker starts with the parent's imported modules and
 loaded machine code (copy-on-write), instead of importing flexsat and loading the
 compiled code from numba's disk cache, about 2.5 s of each worker's start
-(docs/performance.md, 'Forked workers'). A thread's locks would be copied held, so
+(CHANGELOG.md, 'Forked workers'). A thread's locks would be copied held, so
 a parent with other threads (a Jupyter kernel, a Dask client, a test runner's
 worker) and other systems (macOS's system libraries are not fork-safe) use
 ``spawn``: a fresh interpreter that shares nothing with the parent. A forked worker
@@ -45,7 +45,7 @@ __all__ = ["DEPTH", "LocalPool", "safe_start_method"]
 DEPTH = 2
 """Items given to a worker at a time: the one it runs and the next. With one, a
 worker waited for the parent to store its result and resolve the next case, about a
-tenth of a reduced campaign case (docs/performance.md, 'A reduced case at 20 ms')."""
+tenth of a reduced campaign case (CHANGELOG.md, 'A reduced case at 20 ms')."""
 
 _GRACE_S = 1.0  # time given to a worker to exit on SIGTERM before SIGKILL
 _ATTEMPTS = 2  # runs of an item whose worker died before it is given up

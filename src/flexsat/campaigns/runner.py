@@ -575,7 +575,7 @@ QUIET_DASK = {
 """Dask settings of a campaign's cluster and client. Dask's defaults feed its
 dashboard, which a campaign does not start: an idle LocalCluster of 2 workers took
 3.5 CPU-s per 30 s on its own (12 % of a core), 1.0 CPU-s with these
-(docs/performance.md, 'Dask: a quiet cluster')."""
+(CHANGELOG.md, 'Dask: a quiet cluster')."""
 
 
 @contextlib.contextmanager
@@ -612,7 +612,7 @@ DASK_BATCH = 32
 worker's event loop) is paid once per batch. Batches shrink as fewer than
 ``4 * DASK_BATCH`` cases per worker thread remain to submit (:func:`_dask_batch`).
 1000 reduced cases on a LocalCluster of two workers took 34.2–37.6 s with 8 per task,
-30.8 s with 32 (docs/performance.md, 'Workers that start sooner')."""
+30.8 s with 32 (CHANGELOG.md, 'Workers that start sooner')."""
 
 
 def _dask_batch(remaining: int, threads: int) -> int:

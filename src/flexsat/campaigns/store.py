@@ -356,7 +356,7 @@ def _write_netcdf3(path: str, data: dict, described: dict, attrs: dict) -> None:
     A campaign writes one small history per case, in its main process, while the
     workers fly the next ones: xarray's ``to_netcdf`` (HDF5 through netCDF4) took
     about 17 ms of that process's CPU per history, scipy's NetCDF-3 writer about
-    1.2 ms (docs/performance.md, 'Histories in NetCDF-3'). Text attributes are
+    1.2 ms (CHANGELOG.md, 'Histories in NetCDF-3'). Text attributes are
     stored as UTF-8 bytes (NetCDF-3 characters), which the readers decode.
     """
     from scipy.io import netcdf_file

@@ -808,7 +808,7 @@ def main() -> None:
     # The command's process ends with it: skip the interpreter's last garbage
     # collection, which walks every object flexsat loaded (numba's types, xarray,
     # pydantic's models) for 0.4-0.6 s. Files are closed where they are written, and
-    # objects freed by reference counting are still finalized (docs/performance.md,
+    # objects freed by reference counting are still finalized (CHANGELOG.md,
     # 'Exits without the last collection').
     atexit.register(gc.freeze)
     signal.signal(signal.SIGINT, _on_ctrl_c)

@@ -24,8 +24,8 @@ compiled with ``error_model="numpy"``: a float division by zero would give inf/n
 (which the RK4 loops report as a non-finite state) instead of raising, so no zero
 test guards each division. No divisor can be zero: masses are validated positive and
 ``cos(pitch)`` is checked against ``_MIN_COS`` before any ``euler_rate_matrix_inv``.
-Results are bit-for-bit those of the default error model; one q_ddot evaluation is
-about 10 % faster (docs/performance.md).
+Results are bit-for-bit those of the default error model, without a branch per
+division (docs/performance.md, 'Why it is fast').
 """
 
 from __future__ import annotations
@@ -111,8 +111,8 @@ def _solve_hub(packed, force_B, torque_B):
     elimination on 3 x 3 blocks: X = P^-1 B, y = P^-1 F, then the Schur complement
     (D - C X) omega_dot = T - C y and a = y - X omega_dot. The matrix is symmetric
     positive definite, so P and the Schur complement are too and both 3 x 3 inverses
-    (:func:`~flexsat.dynamics.linalg3.inverse3`) exist. Straight-line code: about
-    twice as fast as a 6 x 6 Gaussian elimination's loops (docs/performance.md).
+    (:func:`~flexsat.dynamics.linalg3.inverse3`) exist. Straight-line code on
+    3 x 3 blocks instead of a 6 x 6 Gaussian elimination's loops.
     """
     hub = packed.hub
     m = packed.hub_mass

@@ -127,7 +127,8 @@ class progress_bar:
 _BYTES_PER_RECORD_PER_DOF = 48.0
 _BYTES_PER_RECORD = 320.0
 _COPIES = 3.0
-_SECONDS_PER_STEP_PER_DOF = 0.25e-6  # 3.4-3.9 us per RK4 step at 18 DOF (docs/performance.md)
+# a conservative RK4 cost per step and DOF, for the announced estimate only (bench_scaling.py)
+_SECONDS_PER_STEP_PER_DOF = 0.25e-6
 LONG_RUN_S = 600.0
 """Runs estimated to take longer than this [s] are announced with their estimate."""
 

@@ -80,8 +80,8 @@ def chain_wrench(x, n, t, cs, derivatives, params, flow):
     from ``flow.omega``, computed here from the cosines and sines ``cs`` the plant's
     derivative takes too: at every RK4 stage they are computed once for both.
     Inlined where it is called, with element loops instead of slice assignments: the
-    RK4 stages evaluate it four times per step, and this form costs about 0.25 us per
-    step less (measured, ``docs/performance.md``). The stages are called by literal
+    RK4 stages evaluate it four times per step (``CHANGELOG.md``, "After the
+    reference-counting change (avionics chain)"). The stages are called by literal
     index (:func:`_derive`).
 
     Parameters
@@ -133,7 +133,7 @@ def _derive(i, x, n, t, derivatives, params, flow):
     """Stage ``i``'s derivative. Inlined, a literal ``i`` makes every tuple access
     static: indexing the padded tuples with a loop variable copies each tuple to the
     stack on every access, about 0.2 us per coupled step with one continuous stage
-    (docs/performance.md, 'Stages by literal index')."""
+    (CHANGELOG.md, 'Stages by literal index')."""
     return derivatives[i](x, n, t, flow.omega, params[i], flow.eval_views[i],
                           flow.dot_views[i], flow.wrench)  # fmt: skip
 
@@ -201,8 +201,7 @@ def rk4_coupled_step(x, t, dt, n, Q, scratch, derivatives, params, flow, packed,
     for j in range(size):
         stage[j] = x[j] + 0.5 * dt * k1[j]
     # The chain's rate at each RK4 stage is flow.dot; it is folded into the next stage's
-    # state and the weighted sum at once (no copy per stage: measured about 0.15 us per
-    # step less, docs/performance.md), in the order the plant's sum is taken.
+    # state and the weighted sum at once (no copy per stage), in the order the plant's sum is taken.
     for j in range(m):
         acc[j] = dot[j]
         ce[j] = c[j] + 0.5 * dt * dot[j]

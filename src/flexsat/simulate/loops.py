@@ -274,7 +274,7 @@ def _sense(i, x, n, t, stages, d):
     """Sensing stage ``i``. Inlined, a literal ``i`` makes every tuple access static:
     indexing the padded tuples with a loop variable copies each tuple to the stack on
     every access, which inside the loop cost about as much as the call itself
-    (docs/performance.md, 'Stages by literal index')."""
+    (CHANGELOG.md, 'Stages by literal index')."""
     return stages.sensor[i](x, n, t, d.sensor_params[i], d.sensor_state[i], d.q_meas,
                             d.omega_meas, d.sensor_record[i])  # fmt: skip
 

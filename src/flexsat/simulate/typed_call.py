@@ -65,7 +65,7 @@ def typed_list(item):
     Built by this cached function, the list's methods are compiled into it:
     ``numba.typed.List()`` and its ``append`` called from Python are compiled for
     the item's type in every process, uncached (2.8 s before the first batch of
-    each campaign worker, docs/performance.md, 'Workers that start sooner').
+    each campaign worker, CHANGELOG.md, 'Workers that start sooner').
 
     Parameters
     ----------

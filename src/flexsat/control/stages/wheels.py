@@ -203,10 +203,11 @@ def _smooth_sign(z):
 
     Written out because the wheels' derivative evaluates it for every wheel at every
     RK4 stage, and the C library's tanh (a range reduction around ``expm1``) was
-    the largest item the wheels add to a step (``docs/performance.md``). Below
+    the largest item the wheels add to a step (``CHANGELOG.md``, "The friction's sign
+    from one exponential"). Below
     abs(z) = 0.55, Cephes' rational form z + z^3 P(z^2) / Q(z^2) (one division, 1 ulp
     of ``math.tanh`` there); above, with e = exp(-2 abs(z)),
-    tanh(z) = sign(z) (1 - e) / (1 + e): one exponential (4.8 against 9.2 ns per call);
+    tanh(z) = sign(z) (1 - e) / (1 + e): one exponential;
     from abs(z) = 22 both are exactly +-1. Within 2 ulp of ``math.tanh`` everywhere
     (``tests/control/test_wheels.py``); zero keeps its sign, NaN stays NaN.
     """
