@@ -225,7 +225,7 @@ def test_the_lanes_fly_their_own_short_runs_before_their_parts(monkeypatch):
                                    lanes=2, prepare={0: [0.01], 1: [0.3]})  # fmt: skip
     assert 0.3 <= prepared < 5.0
     assert recorded["first"]["outputs"]["flown"] == [(os.getpid(), 0.01)]
-    (pid, seconds), = recorded["second"]["outputs"]["flown"]
+    ((pid, seconds),) = recorded["second"]["outputs"]["flown"]
     assert pid != os.getpid() and seconds == 0.3
 
 
@@ -239,3 +239,23 @@ def test_the_stages_run_compiles_every_other_slews_stages_without_a_plant():
     pipeline._fly_short(ctx, "stages")
     assert "plant" not in ctx.results
     assert drive.signatures  # compiled (or loaded from the disk cache) by this process
+
+
+def test_parts_the_campaigns_cannot_fly_are_skipped_with_the_reason(tmp_path):
+    # A modal appendage has no target frequencies and no initial joint state: the
+    # thesis's campaigns vary both, so neither the campaigns nor the law comparison over
+    # them can fly it. Both are skipped, saying which campaign and why (the quick study
+    # of such a satellite then exits 0, not 1); on the nominal satellite both run.
+    from flexsat import Plant
+    from flexsat.linear.export import modal_satellite
+
+    modal = modal_satellite(Plant.from_config(nominal()), n_modes=3)
+    parts = {part.name: part for part in PARTS}
+    ctx = pipeline.StudyContext(modal, tmp_path, quick=True)
+    entry = pipeline._run_part(parts["laws"], ctx)
+    assert entry["status"] == "skipped", entry
+    assert entry["error"].startswith("not applicable: the sensitivity campaign cannot fly")
+    assert "target_frequencies_hz" in entry["error"]
+    full = pipeline.StudyContext(modal, tmp_path, quick=False)
+    assert pipeline._run_part(parts["campaigns"], full)["error"] == entry["error"]
+    assert pipeline._campaigns_fly(pipeline.StudyContext(nominal(), tmp_path)) is None

@@ -10,7 +10,7 @@ from html.parser import HTMLParser
 
 import pytest
 
-from flexsat.study import PARTS, format_value
+from flexsat.study import PARTS, format_value, pipeline
 
 
 class _Cells(HTMLParser):
@@ -110,3 +110,94 @@ def test_the_slew_states_how_r1_and_r2_are_judged(report):
     shown = {(c["data-source"], c["data-path"]) for c in parser.cells}
     for key in ("observation_window_s", "ape_deg", "rpe_deg", "rpe_window_s"):
         assert ("slew/asmc/metrics.json", key) in shown, key
+
+
+# -- satellites of several appendage models -------------------------------------------
+
+
+def _mixed_satellites() -> dict:
+    """The nominal satellite with its first plate replaced, by its twin as a chain, and
+    by its modal export (3 modes): each keeps the second plate beside it."""
+    from flexsat import Plant
+    from flexsat.config import validate_config
+    from flexsat.linear.export import modal_satellite
+    from tests.conftest import nominal_dict
+    from tests.dynamics.chain_satellites import plate_as_chain
+
+    chain = nominal_dict()
+    chain["appendages"][0] = plate_as_chain(chain["appendages"][0])
+    exported = modal_satellite(Plant.from_config(validate_config(nominal_dict())), n_modes=3)
+    modal = nominal_dict()
+    modal["appendages"][0] = exported.model_dump(mode="json")["appendages"][0]
+    return {"chain + plate": validate_config(chain), "modal + plate": validate_config(modal)}
+
+
+def _configuration_report(config, out) -> tuple[str, dict]:
+    """The configuration part of the study on ``config`` and its report: (html, the
+    manifest as the report left it)."""
+    from flexsat.study.report import write_report
+
+    out.mkdir()
+    part = next(p for p in PARTS if p.name == "configuration")
+    entry = pipeline._run_part(part, pipeline.StudyContext(config, out))
+    manifest = {"flexsat_version": "test", "created_utc": "now", "config_name": config.name,
+                "config_source": "a test", "quick": True, "parts": [entry]}  # fmt: skip
+    (out / "study.json").write_text(json.dumps(manifest))
+    write_report(out)
+    return (out / "report.html").read_text(), json.loads((out / "study.json").read_text())
+
+
+@pytest.mark.parametrize("kind", ["chain + plate", "modal + plate"])
+def test_the_configuration_of_mixed_appendage_models_is_drawn(tmp_path, kind):
+    # A parameter one model has and the other lacks (the chain's segment count, the modal
+    # appendage's mode-shape data) is a row with the value where the model has it and
+    # "—" where it does not; every value shown is the one configuration.json holds.
+    config = _mixed_satellites()[kind]
+    text, manifest = _configuration_report(config, tmp_path / "study")
+    assert "could not be drawn" not in text and "This part failed" not in text
+    assert manifest["parts"][0]["status"] == "ok"
+    parser = _Cells()
+    parser.feed(text)
+    data = json.loads((tmp_path / "study" / "configuration" / "configuration.json").read_text())
+    first, second = data["config"]["appendages"]
+    only_first = sorted(set(first) - set(second))
+    assert only_first  # the two models have parameters of their own
+    shown = {c["data-path"] for c in parser.cells}
+    for key in only_first:
+        rows = [p for p in shown if p.startswith(f"config/appendages/0/{key}")]
+        assert rows, key  # the first appendage's own parameters are shown ...
+        assert not any(p.startswith(f"config/appendages/1/{key}") for p in shown)
+    assert "<td class='absent'>—</td>" in text  # ... and marked absent for the plate
+    for cell in parser.cells:
+        assert json.loads(cell["data-value"]) == _lookup(data, cell["data-path"]), cell
+
+
+def test_a_section_that_cannot_be_drawn_fails_its_part(tmp_path):
+    # The configuration's JSON without its derived hub inertia: the section cannot be
+    # drawn, so the part is failed, in the report (badge, banner, error) and in
+    # study.json (status, error, traceback), never listed "ok".
+    from flexsat.study.report import write_report
+
+    config = _mixed_satellites()["chain + plate"]
+    out = tmp_path / "study"
+    _configuration_report(config, out)
+    path = out / "configuration" / "configuration.json"
+    data = json.loads(path.read_text())
+    del data["hub_inertia_kg_m2"]
+    path.write_text(json.dumps(data))
+    write_report(out)
+    entry = json.loads((out / "study.json").read_text())["parts"][0]
+    assert entry["status"] == "failed" and entry["report_failed"]
+    assert (
+        "configuration section could not be drawn: KeyError('hub_inertia_kg_m2')"
+        in (entry["error"])
+    )
+    assert "Traceback (most recent call last)" in entry["traceback"]
+    text = (out / "report.html").read_text()
+    assert "Failed parts: Configuration." in text
+    assert "<span class='badge failed'>failed</span>" in text
+    # Once the output is readable again, the part is drawn and ok again.
+    path.write_text(json.dumps({**data, "hub_inertia_kg_m2": [[1.0, 0, 0], [0, 1, 0], [0, 0, 1]]}))
+    write_report(out)
+    entry = json.loads((out / "study.json").read_text())["parts"][0]
+    assert entry["status"] == "ok" and entry["error"] is None and "report_failed" not in entry

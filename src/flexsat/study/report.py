@@ -7,7 +7,9 @@ those JSON files, never recomputed: each table cell that holds one carries
 ``data-source`` (the JSON file, relative to the study folder), ``data-path`` (the
 key path in it, ``/``-separated) and ``data-value`` (the value as JSON), so a reader
 or a test can trace it back. A part that failed shows its error and traceback in
-its section; the sections of the other parts are written as usual.
+its section; the sections of the other parts are written as usual. A section that
+cannot be drawn from its part's outputs fails that part: its error and traceback are
+shown there and written into ``study.json`` (``report_failed``: the report failed it).
 
 Sections follow the thesis: the configuration (section 3.1), the model's M(0) and
 rigid inertia (appendix B), the coupled modes (table 3.3), the open-loop validation
@@ -28,6 +30,7 @@ import base64
 import html
 import json
 import platform
+import traceback
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
@@ -184,12 +187,16 @@ def _configuration(root: Path, outputs: dict, context: dict) -> str:
     ]
     parts.append(_table(["hub parameter", "value"], hub_rows, "Hub (SI units; see key names)"))
     names = [a["name"] for a in config["appendages"]]
+    # Each model has its own parameters: a row per parameter any appendage has, "—"
+    # (:data:`_ABSENT`) in the columns of those whose model has no such parameter.
     rows = [
-        [".".join(path), *(src.cell("config", "appendages", i, *path) for i in range(len(names)))]
-        for path in _leaves(config["appendages"][0])
+        [".".join(path), *(_cell_if(src, "config", "appendages", i, *path)
+                           for i in range(len(names)))]
+        for path in _union(_leaves(a) for a in config["appendages"])
         if path != ("name",)
-    ]
-    parts.append(_table(["appendage parameter", *names], rows, "Appendages"))
+    ]  # fmt: skip
+    parts.append(_table(["appendage parameter", *names], rows,
+                        "Appendages (— : not a parameter of that appendage's model)"))  # fmt: skip
     parts.append(
         _table(
             ["", "value"],
@@ -197,19 +204,42 @@ def _configuration(root: Path, outputs: dict, context: dict) -> str:
             "Derived: hub inertia about the hub centre of mass",
         )
     )
+    keys = _union([(key,) for key in a if key not in ("name", "model")]
+                  for a in src.get("appendages"))  # fmt: skip
     derived = [
-        [key, *(src.cell("appendages", i, key) for i in range(len(names)))]
-        for key in ("mass_kg", "centroidal_inertia_kg_m2", "stiffness", "damping")
+        [key, *(_cell_if(src, "appendages", i, key) for i in range(len(names)))] for (key,) in keys
     ]
     parts.append(
         _table(
             ["derived", *names],
             derived,
-            "Derived per appendage: mass, centroidal inertia, joint stiffness and damping "
+            "Derived per appendage, as its model describes it (— : not a quantity of that "
+            "model); a plate's: mass, centroidal inertia, joint stiffness and damping "
             "(joint DOFs ρ_x, ρ_y, ρ_z [N m/rad, N m s/rad], η_x, η_y, η_z [N/m, N s/m])",
         )
     )
     return "".join(parts)
+
+
+_ABSENT = "<td class='absent'>—</td>"
+"""The cell of a parameter an appendage's model does not have."""
+
+
+def _union(paths_per_item) -> list[tuple]:
+    """The key paths of several items, each once, in the order they first appear."""
+    return list(dict.fromkeys(path for paths in paths_per_item for path in paths))
+
+
+def _cell_if(src: _Source, *path) -> str:
+    """``src.cell(*path)``, or :data:`_ABSENT` where ``path`` is not in the file (an
+    appendage whose model has no such parameter)."""
+    node = src.data
+    for key in path:
+        if (isinstance(node, dict) and key in node) or (isinstance(node, list) and key < len(node)):
+            node = node[key]
+        else:
+            return _ABSENT
+    return src.cell(*path)
 
 
 def _leaves(data: dict, prefix: tuple = ()) -> list[tuple]:
@@ -598,8 +628,27 @@ SECTIONS: list[Section] = [
 # -- page -----------------------------------------------------------------------------
 
 
+def _draw(root: Path, section: Section, entry: dict | None, context: dict) -> str | None:
+    """The body of ``section`` for a part that ran (None for one that failed or was
+    skipped). A section that cannot be drawn fails its part: the entry is marked failed
+    with the error and its traceback (the report's banner and ``study.json`` say so)
+    and the body shows the error."""
+    if entry is None or (entry["status"] != "ok" and not entry.get("report_failed")):
+        return None
+    try:
+        return section.draw(root, entry["outputs"], context)
+    except Exception as exc:  # the part is failed, the report still written
+        error = f"the report's {section.name} section could not be drawn: {exc!r}"
+        # an earlier section of the same part may have failed already: both errors kept
+        entry.update(status="failed", report_failed=True,
+                     error="; ".join(filter(None, [entry.get("error"), error])),
+                     traceback="".join(filter(None, [entry.get("traceback"),
+                                                     traceback.format_exc()])))  # fmt: skip
+        return f"<div class='error'><p>This section could not be drawn: {_esc(repr(exc))}</p></div>"
+
+
 def _section(root: Path, section: Section, number: int, entry: dict | None,
-             context: dict) -> str:  # fmt: skip
+             context: dict, body: str | None = None) -> str:  # fmt: skip
     name = section.name
     title = f"{number}. {_title(section, entry)}"
     anchor = f'<section id="{name}"><h2>{_esc(title)}</h2>'
@@ -616,15 +665,10 @@ def _section(root: Path, section: Section, number: int, entry: dict | None,
         return anchor + head + f"<p class='note'>{_esc(entry['error'])}</p></section>"
     if status == "failed":
         trace = f"<pre>{_esc(entry['traceback'])}</pre>" if entry.get("traceback") else ""
-        return (
-            anchor + head + f"<div class='error'><p>This part failed: {_esc(entry['error'])}"
-            f"</p>{trace}</div></section>"
-        )
-    try:
-        body = section.draw(root, entry["outputs"], context)
-    except Exception as exc:  # an unreadable output is shown, the report still written
-        body = f"<div class='error'><p>This section could not be drawn: {_esc(repr(exc))}</p></div>"
-    return anchor + head + body + "</section>"
+        failure = (f"<div class='error'><p>This part failed: {_esc(entry['error'])}</p>{trace}"
+                   "</div>")  # fmt: skip
+        return anchor + head + failure + (body or "") + "</section>"
+    return anchor + head + (body or "") + "</section>"
 
 
 def _title(section: Section, entry: dict | None) -> str:
@@ -665,9 +709,13 @@ def write_report(study_dir: str | Path) -> Path:
     """
     from flexsat.config import nominal
     from flexsat.config.models import SatelliteConfig
+    from flexsat.study.outputs import write_json
 
     root = Path(study_dir)
     manifest = json.loads((root / "study.json").read_text())
+    redrawn = [entry for entry in manifest["parts"] if entry.pop("report_failed", False)]
+    for entry in redrawn:  # failed by a section of an earlier report: drawn again
+        entry.update(status="ok", error=None, traceback=None)
     entries = {entry["name"]: entry for entry in manifest["parts"]}
     context = {"source": manifest["config_source"], "nominal": False}
     config_entry = entries.get("configuration")
@@ -679,9 +727,12 @@ def write_report(study_dir: str | Path) -> Path:
         for section in SECTIONS
         if (section.part or section.name) in entries
     ]
+    bodies = [_draw(root, section, entry, context) for section, entry in present]
+    if redrawn or any(entry.get("report_failed") for entry in manifest["parts"]):
+        write_json(root / "study.json", manifest)  # the parts a section failed
     sections = [
-        _section(root, section, k, entry, context)
-        for k, (section, entry) in enumerate(present, start=1)
+        _section(root, section, k, entry, context, body)
+        for k, ((section, entry), body) in enumerate(zip(present, bodies, strict=True), start=1)
     ]
     toc = "".join(
         f"<li><a href='#{section.name}'>{_esc(_title(section, entry))}</a></li>"
