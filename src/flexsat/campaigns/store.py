@@ -29,7 +29,6 @@ import json
 import os
 import re
 import socket
-import tempfile
 import time
 from collections.abc import Iterator
 from pathlib import Path
@@ -39,12 +38,11 @@ import pandas as pd
 import xarray as xr
 
 from flexsat.errors import ConfigError
+from flexsat.files import ensure_dir, open_lock, output_root, replacing, replacing_name
 from flexsat.jsonable import dumps
 
 __all__ = ["HISTORY_UNITS", "CampaignStore"]
 
-_UMASK = os.umask(0o022)
-os.umask(_UMASK)  # read once: every stored file gets the mode a plain open() would give
 _ROW_KEYS = ("case_id", "status", "metrics", "inputs_digest")
 _FINGERPRINT_PARTS = {
     "definition": "the campaign definition",
@@ -113,8 +111,11 @@ class CampaignStore:
             this one without ``resume``), or another process is running into it.
         """
         try:
-            self.cases_dir.mkdir(parents=True, exist_ok=True)
-            lock = open(self.root / "campaign.lock", "a+")
+            output_root(self.root)  # below it, a link in place of a folder is refused
+            ensure_dir(self.cases_dir)
+            if self.histories_dir.is_symlink():
+                ensure_dir(self.histories_dir)  # refused before anything is removed there
+            lock = open_lock(self.root / "campaign.lock")  # never through a link
         except OSError as exc:
             raise ConfigError(
                 f"cannot create the campaign store {self.root}: {exc.strerror or exc}"
@@ -218,22 +219,14 @@ class CampaignStore:
         (time, axis); the rest are (time,). Each carries ``units`` and
         ``description``; the file carries ``case_id``, ``status`` and ``title``.
         """
-        self.histories_dir.mkdir(parents=True, exist_ok=True)
         described = {name: {"units": unit, "description": _HISTORY_DESCRIPTIONS.get(name, "")}
                      for name, unit in HISTORY_UNITS.items()}  # fmt: skip
         described.update(data.get("channels", {}))
         path = self.histories_dir / f"{case_id}.nc"
-        fd, tmp = tempfile.mkstemp(dir=self.histories_dir, suffix=".partial")
-        os.close(fd)
-        os.chmod(tmp, 0o666 & ~_UMASK)
-        try:
+        with replacing_name(path) as tmp:
             _write_netcdf3(tmp, data, described, {
                 "case_id": case_id, "status": status,
                 "title": f"flexsat campaign case {case_id!r} (decimated history)"})  # fmt: skip
-            os.replace(tmp, path)
-        finally:
-            if os.path.exists(tmp):
-                os.remove(tmp)
         return path
 
     def histories(self) -> dict[str, xr.Dataset]:
@@ -283,11 +276,8 @@ class CampaignStore:
         (atomically); return the table written (:meth:`table`)."""
         frame = self.table()
         for path, writer in zip(self.tables, (frame.to_parquet, frame.to_csv), strict=True):
-            fd, tmp = tempfile.mkstemp(dir=self.root, suffix=".partial")
-            os.close(fd)
-            os.chmod(tmp, 0o666 & ~_UMASK)
-            writer(tmp, index=False)
-            os.replace(tmp, path)
+            with replacing_name(path) as tmp:
+                writer(tmp, index=False)
         return frame
 
 
@@ -391,10 +381,7 @@ def _utf8(text: str) -> bytes:
 
 
 def _write_atomic(path: Path, text: str) -> None:
-    fd, tmp = tempfile.mkstemp(dir=path.parent, suffix=".partial")
-    os.chmod(tmp, 0o666 & ~_UMASK)
-    with os.fdopen(fd, "w") as handle:
+    with replacing(path, "w") as handle:  # a link at path is replaced, never followed
         handle.write(text)
         handle.flush()
         os.fsync(handle.fileno())
-    os.replace(tmp, path)

@@ -18,14 +18,13 @@ from enum import StrEnum
 from pathlib import Path
 from typing import Annotated
 
-import numpy as np
 import typer
 from rich.console import Console
 from rich.markup import escape
-from rich.table import Table
 
 from flexsat import __version__
 from flexsat._compiled_cache import kernels_cached
+from flexsat.cli.tables import format_number, print_table
 from flexsat.errors import MAX_MESSAGE_CHARS, FlexsatError, shorten
 from flexsat.jsonable import dumps
 
@@ -124,22 +123,18 @@ def modal(
 
 
 def _print_modal(summary: dict) -> None:
-    table = Table(title=f"Coupled modes — {summary['config_name']}")
-    for column in ("mode", "f [Hz]", "kind", "symmetry", "hub DOF", "dominant DOFs"):
-        table.add_column(column)
-    for mode in summary["modes"]:
-        table.add_row(
-            str(mode["index"]),
-            f"{mode['frequency_hz']:.4g}",
-            mode["kind"],
-            mode["symmetry"],
-            mode["hub_dof"] or "-",
-            ", ".join(mode["dominant_dofs"][:3]),
-        )
-    _console.print(table)
-    j_tot = np.array(summary["rigid_inertia"])
-    _console.print("Rigid design inertia J_tot about the hub centre of mass [kg m^2]:")
-    _console.print(np.array2string(j_tot, precision=3, suppress_small=True))
+    rows = [
+        [mode["index"], mode["frequency_hz"], mode["kind"], mode["symmetry"],
+         mode["hub_dof"] or "-", ", ".join(mode["dominant_dofs"][:3])]
+        for mode in summary["modes"]
+    ]  # fmt: skip
+    header = ("mode", "f [Hz]", "kind", "symmetry", "hub DOF", "dominant DOFs")
+    print_table(_console, f"Coupled modes — {summary['config_name']}", header, rows,
+                right=(True, True, False, False, False, False))  # fmt: skip
+    j_tot = summary["rigid_inertia"]
+    rows = [[a, *row] for a, row in zip("xyz", j_tot, strict=True)]
+    print_table(_console, "Rigid design inertia J_tot about the hub centre of mass [kg m^2]",
+                ("", "x", "y", "z"), rows)  # fmt: skip
     for path in summary.get("files", []):
         _console.print(f"wrote {path}")
 
@@ -182,12 +177,10 @@ def linearize(
     if json_output:
         typer.echo(dumps(summary))
         return
-    table = Table(title=f"Linear model about {summary['about']} — {summary['config_name']}")
-    for column in ("mode", "f [Hz]", "damping ratio"):
-        table.add_column(column)
-    for k, mode in enumerate(summary["modes"], 1):
-        table.add_row(str(k), f"{mode['frequency_hz']:.5g}", f"{mode['damping_ratio']:.3g}")
-    _console.print(table)
+    rows = [[k, mode["frequency_hz"], mode["damping_ratio"]]
+            for k, mode in enumerate(summary["modes"], 1)]  # fmt: skip
+    print_table(_console, f"Linear model about {summary['about']} — {summary['config_name']}",
+                ("mode", "f [Hz]", "damping ratio"), rows)  # fmt: skip
     _console.print(
         f"{summary['n_states']} states, {len(summary['input_names'])} inputs, "
         f"{len(summary['output_names'])} outputs; Jacobian: {summary['jacobian']}"
@@ -195,7 +188,7 @@ def linearize(
     if "reduction" in summary:
         red = summary["reduction"]
         _console.print(f"{red['method']} truncation to {red['order']} states: error bound "
-                       f"{red['error_bound']:.3g}")  # fmt: skip
+                       f"{format_number(red['error_bound'])}")  # fmt: skip
     for path in summary.get("files", []):
         _console.print(f"wrote {path}")
 
@@ -233,25 +226,35 @@ def margins(
     if json_output:
         typer.echo(dumps(summary))
         return
-    table = Table(title=f"{summary['law'].upper()} loop margins — {summary['config_name']}")
-    for column in ("axis", "PM [deg]", "at [Hz]", "GM", "delay margin [s]", "at [Hz]"):
-        table.add_column(column)
-    for axis, m in summary["axes"].items():
-        gm = "inf" if math.isinf(m["gain_margin"]) else f"{m['gain_margin']:.3g}"
-        table.add_row(
-            axis, f"{m['phase_margin_deg']:.1f}", f"{m['gain_crossover_hz']:.3g}", gm,
-            f"{m['delay_margin_s']:.3g}", f"{m['delay_crossover_hz']:.3g}",
-        )  # fmt: skip
-    _console.print(table)
+    _print_margins(summary)
     if "family" in summary:
-        family = Table(title=f"Delay margin per case [s] — {campaign}")
-        for column in ("case", "x", "y", "z"):
-            family.add_column(column)
-        for case, axes in summary["family"].items():
-            family.add_row(case, *(f"{axes[a]['delay_margin_s']:.3g}" for a in "xyz"))
-        _console.print(family)
+        rows = [[case, *(axes[a]["delay_margin_s"] for a in "xyz")]
+                for case, axes in summary["family"].items()]  # fmt: skip
+        print_table(_console, f"Delay margin per case [s] — {campaign}",
+                    ("case", "x", "y", "z"), rows)  # fmt: skip
     for path in summary.get("files", []):
         _console.print(f"wrote {path}")
+
+
+def _print_margins(summary: dict) -> None:
+    """The margins of each axis: its crossovers, its flexible peaks, its limits."""
+    law, name, axes = summary["law"].upper(), summary["config_name"], summary["axes"]
+    rows = [
+        [axis, c["frequency_hz"], c["phase_margin_deg"], c["delay_margin_s"],
+         "yes" if c["frequency_hz"] == m["delay_crossover_hz"] else ""]
+        for axis, m in axes.items() for c in m["crossovers"]
+    ]  # fmt: skip
+    header = ("axis", "crossover [Hz]", "PM [deg]", "delay margin [s]", "sets it")
+    print_table(_console, f"{law} loop gain crossovers — {name}", header, rows)
+    rows = [[axis, p["mode_hz"], p["peak_hz"], p["peak_gain_db"], p["stabilized"]]
+            for axis, m in axes.items() for p in m["flexible_peaks"]]  # fmt: skip
+    header = ("axis", "mode [Hz]", "peak at [Hz]", "peak |L| [dB]", "stabilized")
+    print_table(_console, "Flexible modes in each loop (gain-stabilized: peak below 0 dB)",
+                header, rows)  # fmt: skip
+    rows = [[axis, m["phase_margin_deg"], m["gain_margin"], m["delay_margin_s"],
+             m["delay_crossover_hz"]] for axis, m in axes.items()]  # fmt: skip
+    header = ("axis", "PM [deg]", "GM [-]", "delay margin [s]", "set at [Hz]")
+    print_table(_console, f"{law} loop margins — {name}", header, rows)
 
 
 @app.command()
@@ -416,11 +419,13 @@ def animate(
     ] = 150,
 ) -> None:
     """3-D animation of a run: the satellite turning, its panels' deformation magnified."""
+    from flexsat.files import check_user_file
     from flexsat.plots.animation import result_plant, run_frames, write_animation
     from flexsat.simulate.result import Result
 
     if not result.exists():
         raise FlexsatError(f"{result}: file not found")
+    check_user_file(result, "RESULT", limit=None)  # a FIFO or a device is refused, not read
     try:
         run = Result.from_netcdf(result)
         plant = result_plant(run)
@@ -466,10 +471,12 @@ def plot(
     The run's kind (open loop or slew) and the law that flew it decide which
     figures exist: --list shows them.
     """
+    from flexsat.files import check_user_file
     from flexsat.simulate.result import Result
 
-    if not result.is_file():
+    if not result.exists():
         raise FlexsatError(f"RESULT {result}: no such file")
+    check_user_file(result, "RESULT", limit=None)  # a FIFO or a device is refused, not read
     try:
         loaded = Result.from_netcdf(result)
     except (OSError, ValueError) as exc:
@@ -554,8 +561,10 @@ def campaign(
         if not replay_args or len(replay_args) != 2:
             raise FlexsatError("usage: flexsat campaign replay STORE CASE_ID")
         store, case_id = replay_args
+        from flexsat.files import output_root
+
         result = replay_case(store, case_id)
-        target = Path(store) / "replays" / f"{case_id}.nc"
+        target = output_root(store) / "replays" / f"{case_id}.nc"  # a linked replays/ refused
         result.to_netcdf(target)
         metrics = result.metrics()  # R1-R3 from the case's stored scenario
         if json_output:
@@ -591,19 +600,17 @@ def campaign(
     if json_output:
         typer.echo(dumps(summary))
         return
-    table = Table(title=f"Campaign {definition.name}: {summary['cases']} cases")
-    table.add_column("metric", no_wrap=True)
-    table.add_column("value", justify="right")
-    for key in ("cases", "ran", "failed", "r1_pass_rate", "r2_pass_rate", "r3_pass_rate",
-                "worst_final_pointing_error_deg", "wall_time_s"):  # fmt: skip
-        table.add_row(key, _shown(summary[key]))
-    _console.print(table)
+    keys = ("cases", "ran", "failed", "r1_pass_rate", "r2_pass_rate", "r3_pass_rate",
+            "worst_final_pointing_error_deg", "wall_time_s")  # fmt: skip
+    print_table(_console, f"Campaign {definition.name}: {summary['cases']} cases",
+                ("metric", "value"), [[key, summary[key]] for key in keys])  # fmt: skip
     for worst in summary["worst_cases"]:
-        _console.print(f"  worst: {worst['case_id']}  {worst['final_pointing_error_deg']:.4g} deg")
+        _console.print(f"  worst: {worst['case_id']}  "
+                       f"{format_number(worst['final_pointing_error_deg'])} deg")  # fmt: skip
     if "worst_case" in summary:  # a search: what it found, by the metric it searched
         found = summary["worst_case"]
         _console.print(f"  worst-case search: {found['case_id']}  {found['metric']} = "
-                       f"{found['value']:.4g} (worst_case.json)")  # fmt: skip
+                       f"{format_number(found['value'])} (worst_case.json)")  # fmt: skip
     _console.print(f"wrote {summary['parquet']} and {summary['csv']}")
     for path in summary["figures"]:
         _console.print(f"wrote {path}")
@@ -683,14 +690,10 @@ def _fly(plant, scenario, out: Path | None, quiet: bool) -> tuple[dict, bool, st
 
 
 def _print_comparison(results: dict) -> None:
-    table = Table(title="Controller comparison (same slew, same plant, same disturbances)")
-    table.add_column("metric", no_wrap=True)
-    for kind in results:
-        table.add_column(_law_label(kind), justify="right")
     keys = [k for k in next(iter(results.values())) if k not in ("files", "controller")]
-    for key in keys:
-        table.add_row(key, *(_shown(results[kind][key]) for kind in results))
-    _console.print(table)
+    print_table(_console, "Controller comparison (same slew, same plant, same disturbances)",
+                ("metric", *(_law_label(kind) for kind in results)),
+                [[key, *(results[kind][key] for kind in results)] for key in keys])  # fmt: skip
 
 
 def _law_label(name: str) -> str:
@@ -699,28 +702,16 @@ def _law_label(name: str) -> str:
     return get_law(name).label
 
 
-def _shown(value) -> str:
-    if isinstance(value, list) and all(isinstance(v, float) for v in value):
-        return ", ".join(f"{v:.6g}" for v in value)
-    return f"{value:.6g}" if isinstance(value, float) else str(value)
-
-
 def _print_metrics(metrics: dict, title: str = "Open-loop run") -> None:
-    table = Table(title=title)
-    table.add_column("metric", no_wrap=True)
-    table.add_column("value", justify="right")
-    for key, value in metrics.items():
-        if key == "files":
-            continue
-        table.add_row(key, _shown(value))
-    _console.print(table)
+    rows = [[key, value] for key, value in metrics.items() if key != "files"]
+    print_table(_console, title, ("metric", "value"), rows)
     for path in metrics.get("files", []):
         _console.print(f"wrote {path}")
 
 
 @config_app.command("show")
 def config_show(config: ConfigOption = None, json_output: JsonOption = False) -> None:
-    """Validate a config and print it with the derived mass, inertia and joint tuning."""
+    """Validate a config and print it as tables, with the derived mass, inertia and joint tuning."""
     from flexsat.config import load_config
     from flexsat.dynamics.plant import Plant
     from flexsat.study.outputs import derived_properties
@@ -731,7 +722,46 @@ def config_show(config: ConfigOption = None, json_output: JsonOption = False) ->
     if json_output:
         typer.echo(json.dumps(payload))
     else:
-        _console.print_json(json.dumps(payload))
+        _print_config(payload)
+
+
+def _print_config(payload: dict) -> None:
+    """The config and what flexsat derives from it, as tables (SI units, see key names)."""
+    config, derived = payload["config"], payload["derived"]
+    top = {k: v for k, v in config.items() if k not in ("name", "appendages")}
+    print_table(_console, f"Satellite {config['name']}", ("parameter", "value"),
+                list(_flat(top).items()))  # fmt: skip
+    _print_per_appendage("Appendages (- : not a parameter of that appendage's model)",
+                         "parameter", config["appendages"])  # fmt: skip
+    inertia = derived["hub_inertia_kg_m2"]
+    rows = [[a, *row] for a, row in zip("xyz", inertia, strict=True)]
+    print_table(_console, "Derived: hub inertia about the hub centre of mass [kg m^2]",
+                ("", "x", "y", "z"), rows)  # fmt: skip
+    _print_per_appendage("Derived per appendage (joint DOFs in the order of the plant's "
+                         "coordinates; N m/rad, N m s/rad, N/m, N s/m)", "quantity",
+                         derived["appendages"])  # fmt: skip
+
+
+def _print_per_appendage(title: str, label: str, appendages: list[dict]) -> None:
+    flat = [_flat({k: v for k, v in a.items() if k != "name"}) for a in appendages]
+    keys = list(dict.fromkeys(key for item in flat for key in item))
+    rows = [[key, *(item.get(key, "-") for item in flat)] for key in keys]
+    print_table(_console, title, (label, *(a["name"] for a in appendages)), rows)
+
+
+def _flat(data: dict, prefix: str = "") -> dict:
+    """Leaf values of nested dicts (and lists of dicts) by dotted path."""
+    out: dict = {}
+    for key, value in data.items():
+        path = f"{prefix}{key}"
+        if isinstance(value, dict) and value:
+            out.update(_flat(value, f"{path}."))
+        elif isinstance(value, list) and value and all(isinstance(v, dict) for v in value):
+            for k, item in enumerate(value):
+                out.update(_flat(item, f"{path}[{k}]."))
+        else:
+            out[path] = value
+    return out
 
 
 @config_app.command("preset")
@@ -755,12 +785,9 @@ def config_preset(
     from flexsat.config import TEMPLATES, preset_path
 
     if list_templates:
-        table = Table(title="Templates (flexsat config preset NAME -o FILE)")
-        table.add_column("name", no_wrap=True)
-        table.add_column("what it is")
-        for key, what in TEMPLATES.items():
-            table.add_row(key, what)
-        _console.print(table)
+        print_table(_console, "Templates (flexsat config preset NAME -o FILE)",
+                    ("name", "what it is"), list(TEMPLATES.items()),
+                    right=(False, False))  # fmt: skip
         _console.print("The thesis's campaigns run by name: flexsat campaign "
                        + " | ".join(CAMPAIGN_PRESETS))  # fmt: skip
         return
@@ -768,7 +795,7 @@ def config_preset(
     if output is None:
         typer.echo(source.read_text())
         return
-    if output.exists():
+    if output.exists() or output.is_symlink():  # a dangling link is never written through
         raise FlexsatError(f"{output} exists; choose another file name")
     if not output.parent.is_dir():
         raise FlexsatError(f"-o {output}: the folder {output.parent} does not exist")

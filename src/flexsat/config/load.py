@@ -12,6 +12,7 @@ from pydantic import BaseModel, Tag, ValidationError
 
 from flexsat.config.models import SatelliteConfig
 from flexsat.errors import ConfigError, shorten
+from flexsat.files import read_user_file
 
 __all__ = [
     "PRESETS",
@@ -90,6 +91,9 @@ def load_config(path: str | Path | None = None) -> SatelliteConfig:
 def read_toml(path: str | Path, what: str = "config") -> dict[str, Any]:
     """Parse a TOML file, turning a missing, unreadable or malformed file into a ConfigError.
 
+    Only a regular file of at most :data:`flexsat.files.MAX_INPUT_BYTES` is read
+    (:func:`flexsat.files.read_user_file`): a FIFO, a device or a folder is refused.
+
     Parameters
     ----------
     path : path
@@ -103,11 +107,10 @@ def read_toml(path: str | Path, what: str = "config") -> dict[str, Any]:
         The parsed tables.
     """
     path = Path(path)
+    text = read_user_file(path, what)  # a regular file of at most MAX_INPUT_BYTES only
     try:
-        return tomllib.loads(path.read_text(encoding="utf-8"))
-    except FileNotFoundError:
-        raise ConfigError(f"{what} file not found: {path}") from None
-    except (OSError, UnicodeDecodeError) as exc:
+        return tomllib.loads(text.decode("utf-8"))
+    except UnicodeDecodeError as exc:
         raise ConfigError(f"cannot read {what} file {path}: {exc}") from None
     except tomllib.TOMLDecodeError as exc:
         raise ConfigError(f"{path}: not valid TOML: {exc}") from None

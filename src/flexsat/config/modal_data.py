@@ -20,6 +20,7 @@ import numpy as np
 from pydantic import AllowInfNan, BaseModel, ConfigDict, Field, Strict, model_validator
 
 from flexsat.errors import ConfigError
+from flexsat.files import check_user_file, read_user_file, replacing, write_text
 
 __all__ = [
     "FORMAT_VERSION",
@@ -261,19 +262,19 @@ def load_modal_data(path: str | Path) -> ModalData:
     Raises
     ------
     ConfigError
-        Missing or unreadable file, unknown suffix, or any invalid field (the message
-        names it).
+        Missing or unreadable file, not a regular file or larger than
+        :data:`flexsat.files.MAX_INPUT_BYTES`, unknown suffix, or any invalid field
+        (the message names it).
     """
     path = Path(path)
     suffix = path.suffix.lower()
     if suffix == ".toml":
         try:
-            data = tomllib.loads(path.read_text(encoding="utf-8"))
-        except FileNotFoundError:
-            raise ConfigError(f"modal data file not found: {path}") from None
+            data = tomllib.loads(read_user_file(path, "modal data").decode("utf-8"))
         except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError) as exc:
             raise ConfigError(f"cannot read modal data file {path}: {exc}") from None
     elif suffix == ".npz":
+        check_user_file(path, "modal data")  # a FIFO or a device is refused, not read
         try:
             with np.load(path, allow_pickle=False) as npz:
                 data = _from_arrays({k: npz[k] for k in npz.files})
@@ -305,9 +306,10 @@ def save_modal_data(data: ModalData, path: str | Path) -> Path:
     path = Path(path)
     suffix = path.suffix.lower()
     if suffix == ".npz":
-        np.savez(path, **data.to_arrays())
+        with replacing(path) as handle:  # a link at path is replaced, never followed
+            np.savez(handle, **data.to_arrays())
     elif suffix == ".toml":
-        path.write_text(_toml(data.model_dump()), encoding="utf-8")
+        write_text(path, _toml(data.model_dump()))
     else:
         raise ConfigError(f"modal data file {path}: the suffix must be .toml or .npz")
     return path

@@ -139,9 +139,12 @@ class LinearModel:
 
     def save_npz(self, path: str | Path) -> Path:
         """Write the model to a NumPy ``.npz`` (variables of :data:`MAT_VARIABLES`)."""
+        from flexsat.files import replacing
+
         path = Path(path)
         arrays = {k: np.asarray(v) for k, v in self.to_dict().items()}
-        np.savez(path, **arrays)
+        with replacing(path) as handle:  # a link at path is replaced, never followed
+            np.savez(handle, **arrays)
         return path
 
     def save_mat(self, path: str | Path) -> Path:
@@ -152,6 +155,8 @@ class LinearModel:
         """
         from scipy.io import savemat
 
+        from flexsat.files import replacing
+
         path = Path(path)
         data = {}
         for key, value in self.to_dict().items():
@@ -159,7 +164,8 @@ class LinearModel:
                 data[key] = np.array(value, dtype=object).reshape(-1, 1)
             else:
                 data[key] = np.asarray(value, dtype=float)
-        savemat(path, data, oned_as="column")
+        with replacing(path) as handle:  # a link at path is replaced, never followed
+            savemat(handle, data, oned_as="column")
         return path
 
 

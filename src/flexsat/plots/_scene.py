@@ -203,7 +203,7 @@ class CanvasPillowWriter(PillowWriter):
         palette = montage.quantize(colors=255, method=Image.Quantize.MEDIANCUT)
         indexed = [f.quantize(palette=palette, dither=Image.Dither.NONE) for f in frames]
         extra = {} if self.comment is None else {"comment": self.comment}
-        indexed[0].save(self.outfile, save_all=True, append_images=indexed[1:],
+        indexed[0].save(self.outfile, format="GIF", save_all=True, append_images=indexed[1:],
                         duration=int(1000 / self.fps), loop=0, **extra)  # fmt: skip
 
 

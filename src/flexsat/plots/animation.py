@@ -37,6 +37,7 @@ from matplotlib.figure import Figure
 
 from flexsat.dynamics.plant import Plant
 from flexsat.errors import FlexsatError
+from flexsat.files import ensure_dir, replacing_name
 from flexsat.parallel import figure_workers, forked_map
 from flexsat.plots._scene import (
     AXIS_COLOURS,
@@ -427,7 +428,7 @@ def write_animation(
         f"t = {frames.time[0]:.6g}..{frames.time[-1]:.6g} s"
     )
     writer = _writer(path, int(fps), comment)
-    path.parent.mkdir(parents=True, exist_ok=True)
+    ensure_dir(path.parent)
 
     shots = [frames.geometry(k) for k in range(len(frames))]
     width, height = round(_FIGSIZE_IN[0] * _DPI), round(_FIGSIZE_IN[1] * _DPI)
@@ -480,7 +481,9 @@ def write_animation(
     sheet = Figure(figsize=_FIGSIZE_IN, dpi=_DPI)  # what the writer sizes the movie by
     FigureCanvasAgg(sheet)
     try:
-        with writer.saving(sheet, str(path), dpi=_DPI):
+        # a new file moved onto path: a link there is replaced, never followed
+        with replacing_name(path, keep_suffix=True) as partial, \
+                writer.saving(sheet, partial, dpi=_DPI):  # fmt: skip
             for rgba in movie:
                 writer.add_rgba(rgba)
     except (OSError, subprocess.CalledProcessError) as exc:  # ffmpeg failed, the pipe broke

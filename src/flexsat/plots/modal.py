@@ -25,6 +25,7 @@ from PIL import Image
 
 from flexsat.analysis.modal import ModalAnalysis, Mode
 from flexsat.dynamics.plant import Plant
+from flexsat.files import ensure_dir, replacing, replacing_name
 from flexsat.plots import style
 from flexsat.plots._scene import CanvasPillowWriter, SatelliteDrawing, frame_view
 from flexsat.plots.geometry import SatelliteGeometry, satellite_geometry
@@ -416,7 +417,8 @@ def animate_mode(
     canvas.draw()
     background = canvas.copy_from_bbox(fig.bbox)
     writer = CanvasPillowWriter(fps=fps)
-    with writer.saving(fig, str(path), dpi=fig.dpi):
+    # new files moved onto path and still: a link there is replaced, never followed
+    with replacing_name(path) as partial, writer.saving(fig, partial, dpi=fig.dpi):
         for k, geom in enumerate(shots):
             canvas.restore_region(background)
             moving.update(geom)
@@ -428,8 +430,10 @@ def animate_mode(
             fig.draw_artist(clock)
             writer.grab_frame()
             if k == 0 and still is not None:
-                Image.frombuffer("RGBA", canvas.get_width_height(), canvas.buffer_rgba(),
-                                 "raw", "RGBA", 0, 1).convert("RGB").save(still)  # fmt: skip
+                image = Image.frombuffer("RGBA", canvas.get_width_height(),
+                                         canvas.buffer_rgba(), "raw", "RGBA", 0, 1)  # fmt: skip
+                with replacing(still) as handle:
+                    image.convert("RGB").save(handle, format="PNG")
     fig.clear()
     return path
 
@@ -505,8 +509,7 @@ def write_modal_figures(
     list of Path
         The files written, in the order above.
     """
-    out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
+    out = ensure_dir(out_dir)
     chosen = default_animated_modes(analysis) if mode_indices is None else list(mode_indices)
     for k in chosen:
         _shape(analysis, k)  # validate every index before writing anything

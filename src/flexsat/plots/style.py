@@ -30,6 +30,7 @@ from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 from matplotlib.ticker import LogLocator
 
+from flexsat.files import ensure_dir, replacing
 from flexsat.parallel import figure_workers, forked_map
 
 __all__ = [
@@ -306,7 +307,8 @@ def save_figure(fig: Figure, path: str | Path, *, dpi: int) -> Path:
     fig : Figure
         The figure; it is cleared afterwards to free its memory.
     path : str or Path
-        Target file; its folder is created if missing, an existing file replaced.
+        Target file; its folder is created if missing, an existing file (or a
+        symbolic link) replaced (:func:`flexsat.files.replacing`).
     dpi : int
         Resolution [dots per inch].
 
@@ -316,11 +318,12 @@ def save_figure(fig: Figure, path: str | Path, *, dpi: int) -> Path:
         The file written.
     """
     path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
+    fmt = path.suffix.lower().lstrip(".") or "png"
     # PNG at zlib level 1: a fraction of the default level's time for a slightly larger file
-    extra = {"pil_kwargs": {"compress_level": 1}} if path.suffix.lower() == ".png" else {}
+    extra = {"pil_kwargs": {"compress_level": 1}} if fmt == "png" else {}
     _log_ticks_in_view(fig)
-    fig.savefig(path, dpi=dpi, **extra)
+    with replacing(path) as handle:  # a link at path is replaced, never followed
+        fig.savefig(handle, format=fmt, dpi=dpi, **extra)
     _release(fig)
     return path
 
@@ -413,7 +416,6 @@ def write_figures(
     list of Path
         The files written, in the order of ``names``.
     """
-    out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
+    out = ensure_dir(out_dir)
     return forked_map(lambda name: save_figure(draw(name), out / f"{name}.png", dpi=dpi),
                       names, workers)  # fmt: skip

@@ -215,16 +215,18 @@ class Result:
 
     def to_netcdf(self, path: str | Path) -> Path:
         """Write the dataset to NetCDF (written to a temporary name, then moved)."""
+        from flexsat.files import ensure_dir, replacing_name
+
         path = Path(path)
-        path.parent.mkdir(parents=True, exist_ok=True)
-        if self.path is not None and path.resolve() == self.path.resolve():
+        ensure_dir(path.parent)
+        streamed = self.path is not None and not path.is_symlink()
+        if streamed and path.resolve() == self.path.resolve():
             return path  # a streamed run already written there
-        partial = path.with_suffix(path.suffix + ".partial")
-        if self.path is not None:  # a streamed run: copy its file, never load it whole
-            shutil.copyfile(self.path, partial)
-        else:
-            self.dataset.to_netcdf(partial)
-        partial.replace(path)
+        with replacing_name(path) as partial:  # a link at path is replaced, not followed
+            if self.path is not None:  # a streamed run: copy its file, never load it whole
+                shutil.copyfile(self.path, partial)
+            else:
+                self.dataset.to_netcdf(partial)
         return path
 
     @classmethod

@@ -13,12 +13,15 @@ when its metrics are computed.
 
 from __future__ import annotations
 
+import os
 import shutil
+import tempfile
 from pathlib import Path
 
 import xarray as xr
 
 from flexsat.errors import ConfigError
+from flexsat.files import ensure_dir
 
 __all__ = ["RecordStream", "check_disk_space"]
 
@@ -55,13 +58,13 @@ class RecordStream:
     Parameters
     ----------
     path : Path
-        The file (replaced if it exists); written under ``<path>.partial`` until
-        :meth:`finish` moves it there.
+        The file (replaced if it exists, a symbolic link there too: never followed);
+        written under a new temporary name beside it until :meth:`finish` moves it there.
     """
 
     def __init__(self, path: str | Path) -> None:
         self.path = Path(path)
-        self.partial = self.path.with_suffix(self.path.suffix + ".partial")
+        self.partial: Path | None = None  # a new temporary file beside path, at the first block
         self.records = 0
         self.energy0: float | None = None  # E(0) of the run, for every block's balance
         self._file = None  # the netCDF4 handle blocks after the first are appended through
@@ -69,7 +72,11 @@ class RecordStream:
     def append(self, block: xr.Dataset) -> None:
         """Append a block (a dataset of consecutive records after those written)."""
         if self.records == 0:
-            self.path.parent.mkdir(parents=True, exist_ok=True)
+            ensure_dir(self.path.parent)
+            fd, name = tempfile.mkstemp(dir=self.path.parent, prefix=f".{self.path.name}.",
+                                        suffix=".partial")  # fmt: skip
+            os.close(fd)
+            self.partial = Path(name)
             # HDF5 chunks of _CHUNK_RECORDS along time: the default along an unlimited
             # dimension is one record per chunk, 10-100 times slower to write and read.
             encoding = {

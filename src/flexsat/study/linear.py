@@ -14,7 +14,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from flexsat.errors import ConfigError
-from flexsat.study.outputs import write_json
+from flexsat.study.outputs import prepare_output_dir, write_json
 
 if TYPE_CHECKING:
     from flexsat.dynamics.plant import Plant
@@ -91,6 +91,24 @@ def _mode_table(model) -> list[dict]:
     ]
 
 
+def _matrices(model) -> dict:
+    """A, B, C, D (lists of rows, exact floats), x0, u0 and every signal's name and unit."""
+    return {
+        "state_names": list(model.state_names),
+        "state_units": list(model.state_units),
+        "input_names": list(model.input_names),
+        "input_units": list(model.input_units),
+        "output_names": list(model.output_names),
+        "output_units": list(model.output_units),
+        "A": model.A.tolist(),
+        "B": model.B.tolist(),
+        "C": model.C.tolist(),
+        "D": model.D.tolist(),
+        "x0": model.x0.tolist(),
+        "u0": model.u0.tolist(),
+    }
+
+
 def write_linearize(
     plant: Plant,
     about: str | np.ndarray = "rest",
@@ -122,8 +140,11 @@ def write_linearize(
     model : flexsat.linear.LinearModel
         The full model (outputs as requested).
     summary : dict
-        Sizes, names, equilibrium, modes (frequency, damping ratio), the reduction's
-        error bound, and ``files`` when ``out`` is given.
+        Sizes; the state-space model ``A``, ``B``, ``C``, ``D`` (lists of rows, SI,
+        the same numbers as ``model.npz``) with ``x0``, ``u0`` and the names and
+        units of the states, inputs and outputs; the equilibrium; the modes
+        (frequency, damping ratio); the reduction's error bound and reduced matrices;
+        and ``files`` when ``out`` is given.
     """
     from flexsat.linear import OUTPUT_GROUPS, linearize
     from flexsat.linear.frequency import effective_inertia, rigid_model
@@ -138,10 +159,7 @@ def write_linearize(
         "equilibrium_torque_nm": model.u0.tolist(),
         "jacobian": model.jacobian,
         "n_states": model.n_states,
-        "state_names": list(model.state_names),
-        "input_names": list(model.input_names),
-        "input_units": list(model.input_units),
-        "output_names": list(model.output_names),
+        **_matrices(model),
         "modes": _mode_table(model),
         "effective_inertia": {
             "frequencies_hz": f_eff.tolist(),
@@ -163,12 +181,12 @@ def write_linearize(
                 None if reduced.hankel_singular_values is None
                 else reduced.hankel_singular_values.tolist()
             ),
+            **_matrices(reduced.model),
         }  # fmt: skip
     if out is not None:
         from flexsat.plots.linear import write_linear_figures
 
-        out = Path(out)
-        out.mkdir(parents=True, exist_ok=True)
+        out = prepare_output_dir(out)
         files = [model.save_npz(out / "model.npz"), model.save_mat(out / "model.mat")]
         if reduced is not None:
             files += [reduced.model.save_npz(out / "reduced.npz")]
@@ -196,7 +214,10 @@ def write_margins(plant: Plant, scenario=None, out: Path | None = None) -> dict:
     Returns
     -------
     dict
-        The margins per axis.
+        ``axes``: per axis the margins of :class:`flexsat.linear.frequency.LoopMargins`
+        (every gain crossover with its phase and delay margins, the peak loop gain of
+        each flexible mode and whether it is gain- or phase-stabilized, the delay
+        margin and the crossover that sets it).
     """
     from flexsat.linear import linearize
     from flexsat.linear.frequency import (
@@ -211,7 +232,8 @@ def write_margins(plant: Plant, scenario=None, out: Path | None = None) -> dict:
     model = linearize(plant, outputs=["attitude", "rate"])
     K = law_gains(plant, law)
     loops = {axis: pd_loop(model, K, axis) for axis in "xyz"}
-    margins = {axis: loop_margins(loop) for axis, loop in loops.items()}
+    modes_hz = np.array([mode["frequency_hz"] for mode in _mode_table(model)])
+    margins = {axis: loop_margins(loop, modes_hz=modes_hz) for axis, loop in loops.items()}
     summary = {
         "config_name": plant.config.name,
         "law": law.kind,
@@ -221,7 +243,7 @@ def write_margins(plant: Plant, scenario=None, out: Path | None = None) -> dict:
     if out is not None:
         from flexsat.plots.linear import write_linear_figures
 
-        out = Path(out)
+        out = prepare_output_dir(out)
         effective = effective_inertia(plant)[:2]
         files = write_linear_figures(out, model, rigid_model(plant), effective, loops, margins)
         summary["files"] = [str(p) for p in [write_json(out / "margins.json", summary), *files]]
@@ -267,15 +289,17 @@ def family_margins(
         truth = Plant.from_config(SatelliteConfig.model_validate(case.plant))
         model = linearize(truth, outputs=["attitude", "rate"])
         loops[case.case_id] = {axis: pd_loop(model, K, axis) for axis in "xyz"}
+        modes_hz = np.array([mode["frequency_hz"] for mode in _mode_table(model)])
         table[case.case_id] = {
-            axis: loop_margins(loop).to_dict() for axis, loop in loops[case.case_id].items()
+            axis: loop_margins(loop, modes_hz=modes_hz).to_dict()
+            for axis, loop in loops[case.case_id].items()
         }
     summary = {"config_name": plant.config.name, "campaign": str(campaign), "cases": table}
     if out is not None:
         from flexsat.plots.linear import plot_loop_family
         from flexsat.plots.style import save_figure
 
-        out = Path(out)
+        out = prepare_output_dir(out)
         figure = save_figure(plot_loop_family(loops, table), out / "loop_family.png", dpi=110)
         json_path = write_json(out / "margins_family.json", summary)
         summary["files"] = [str(json_path), str(figure)]

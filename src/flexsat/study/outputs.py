@@ -14,6 +14,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from flexsat.errors import ConfigError
+from flexsat.files import ensure_dir, output_root, write_text
 from flexsat.jsonable import dumps
 
 if TYPE_CHECKING:  # the CLI imports this module at start-up: keep numba out of it
@@ -54,7 +55,7 @@ def prepare_output_dir(path: str | Path, option: str = "--out") -> Path:
     if path.exists() and not path.is_dir():
         raise ConfigError(f"{option} {path}: exists and is not a folder")
     try:
-        path.mkdir(parents=True, exist_ok=True)
+        output_root(path)  # a link below an enclosing output folder is refused
         with tempfile.TemporaryFile(dir=path):
             pass
     except OSError as exc:
@@ -63,7 +64,7 @@ def prepare_output_dir(path: str | Path, option: str = "--out") -> Path:
 
 
 def write_json(path: str | Path, payload: dict) -> Path:
-    """Write ``payload`` as strict, indented JSON (to a temporary name, then moved).
+    """Write ``payload`` as strict, indented JSON (:func:`flexsat.files.write_text`).
 
     Parameters
     ----------
@@ -77,12 +78,7 @@ def write_json(path: str | Path, payload: dict) -> Path:
     Path
         ``path``.
     """
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    partial = path.with_suffix(path.suffix + ".partial")
-    partial.write_text(dumps(payload, indent=2))
-    partial.replace(path)
-    return path
+    return write_text(path, dumps(payload, indent=2))
 
 
 def derived_properties(plant: Plant) -> dict:
@@ -238,7 +234,7 @@ def fly_slew(plant: Plant, scenario=None, out: Path | None = None, progress=None
 def _write_run(result, metrics: dict, out: Path, figures: Callable[[], list[Path]]) -> None:
     """result.nc (always, a failed run's history too), the figures if it succeeded, and
     metrics.json into ``out``; the written paths are added to ``metrics["files"]``."""
-    out.mkdir(parents=True, exist_ok=True)
+    ensure_dir(out)
     files = [result.to_netcdf(out / "result.nc")]
     metrics["files"] = [str(p) for p in [*files, out / "metrics.json"]]
     write_json(out / "metrics.json", metrics)  # first: a figure that fails loses no number

@@ -38,6 +38,7 @@ from pathlib import Path
 import numpy as np
 
 from flexsat.control.laws import get_law, law_names
+from flexsat.files import write_text
 from flexsat.study import thesis
 
 __all__ = ["SECTIONS", "Section", "format_value", "write_report"]
@@ -761,11 +762,7 @@ configuration from {_esc(manifest["config_source"])}{" · quick study" if manife
 (data-source and data-path on each cell). Units are SI unless a key or heading says
 otherwise.</p></footer><script>{_SCRIPT}</script></body></html>
 """
-    path = root / "report.html"
-    partial = path.with_suffix(".html.partial")
-    partial.write_text(page, encoding="utf-8")
-    partial.replace(path)
-    return path
+    return write_text(root / "report.html", page)  # a link there is replaced, never followed
 
 
 _CSS = """
