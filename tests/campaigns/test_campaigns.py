@@ -220,6 +220,20 @@ BAD_CAMPAIGNS = [
     # initial states the satellite cannot take, refused before any case flies
     ('[[cases]]\nid = "a"\nscenario = [{ path = "initial.appendages", value = [{ name = "boom" }] }]\n', "case 'a' (scenario): initial.appendages: "),
     ('[[cases]]\nid = "a"\nplant = [{ path = "appendages[*].locked_dofs", value = ["eta_x"] }]\nscenario = [{ path = "initial.appendages", value = [{ name = "panel_1", eta_rate_m_s = [0.1, 0.0, 0.0] }] }]\n', "its initial rate must be 0"),
+    # a modifier's value checked against its target before any case runs
+    ('[[cases]]\nid = "a"\nplant = [{ path = "hub.mass_kg", op = "scale", value = "x" }]\n', "hub.mass_kg: op = 'scale' takes a finite number as its factor (value), got 'x'"),
+    ('[[cases]]\nid = "a"\nplant = [{ path = "hub.inertia", op = "scale", value = "x" }]\n', "hub.inertia: op = 'scale' takes a finite number as its factor"),
+    ('[[cases]]\nid = "a"\nplant = [{ path = "hub.inertia", value = "x" }]\n', "modifier 'hub.inertia' (op = 'set'): hub.inertia takes a finite number (a scale factor"),
+    ('[[cases]]\nid = "a"\nplant = [{ path = "appendages[*].inertia", value = [1.0, 2.0] }]\n', "appendages[0].inertia takes a finite number"),
+    ('[[cases]]\nid = "a"\nplant = [{ path = "hub.mass_kg", uniform = [0.8, inf] }]\n', "uniform takes finite numbers"),
+    ('[[cases]]\nid = "a"\nplant = [{ path = "hub.mass_kg", op = "scale", uniform = [-1e308, 1e308] }]\n', "is wider than a float holds: high - low must be <= 1.798e+308"),
+    ('[[cases]]\nid = "a"\nplant = [{ path = "hub.mass_kg", normal = [1.0, 1e307] }]\n', "|mean| + 40 std must be <= 1.798e+308"),
+    ('[[cases]]\nid = "a"\nplant = [{ path = "appendages[0].name", op = "scale", value = 3 }]\n', "appendages[0].name is 'panel_1', not a number or a list of numbers"),
+    ('[worst_case]\nparameters = [{ path = "hub.mass_kg", bounds = [1.0, inf] }]\n', "bounds take finite numbers"),
+    # the search's metric at load, not after its cases ran; duplicate ids by name
+    ('[worst_case]\nmetric = "happiness"\nparameters = [{ path = "hub.mass_kg", bounds = [100.0, 200.0] }]\n', "worst_case.metric: 'happiness' is not a numeric slew metric; one of final_pointing_error_deg"),
+    ('[[cases]]\nid = "a"\n[[cases]]\nid = "a"\n', "duplicate case ids: 'a'"),
+    ('[random]\nn = 3\n[[cases]]\nid = "random-00002"\n', "duplicate case ids: 'random-00002'"),
 ]
 
 

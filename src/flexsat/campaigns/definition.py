@@ -16,9 +16,11 @@ same resolved cases, and a 1e6-case campaign starts at once with flat memory.
 
 from __future__ import annotations
 
+import collections
 import hashlib
 import itertools
 import json
+import math
 import re
 from collections.abc import Iterator
 from dataclasses import dataclass
@@ -27,9 +29,9 @@ from pathlib import Path
 from typing import Annotated, Literal
 
 import numpy as np
-from pydantic import Field, model_validator
+from pydantic import Field, field_validator, model_validator
 
-from flexsat.campaigns.modifiers import Modifier, apply_modifiers
+from flexsat.campaigns.modifiers import Modifier, ModifierError, apply_modifiers
 from flexsat.config.load import read_toml, validate_config
 from flexsat.config.models import SatelliteConfig, _Frozen
 from flexsat.errors import ConfigError
@@ -39,6 +41,7 @@ from flexsat.simulate.scenario import SlewScenario, check_multiples_of_dt
 __all__ = [
     "CAMPAIGN_PRESETS",
     "HEAD_CASES",
+    "SEARCH_METRICS",
     "CampaignDefinition",
     "CaseDigest",
     "CaseStream",
@@ -107,7 +110,11 @@ class Dispersed(_Frozen):
 
     @model_validator(mode="after")
     def _ordered(self) -> Dispersed:
-        if not self.bounds[0] < self.bounds[1]:
+        low, high = self.bounds
+        if not (math.isfinite(low) and math.isfinite(high) and math.isfinite(high - low)):
+            raise ValueError(f"{self.path}: bounds take finite numbers with high - low <= "
+                             f"{np.finfo(float).max:.4g}, got {list(self.bounds)}")  # fmt: skip
+        if not low < high:
             raise ValueError(f"{self.path}: bounds must satisfy low < high")
         return self
 
@@ -165,6 +172,16 @@ class SobolCases(_Frozen):
         return self
 
 
+SEARCH_METRICS = (
+    "final_pointing_error_deg", "final_rate_error_deg_s", "ape_deg", "rpe_deg",
+    "max_rate_error_deg_s", "settling_time_s", "r2_settling_time_s", "lambda_switch_time_s",
+    "peak_tip_displacement_m", "finite_until_s", "control_energy_j", "residual_elastic_energy_j",
+)  # fmt: skip
+"""The numeric slew metrics a worst-case search can maximize (a case row's scalar
+``metrics``: :func:`~flexsat.analysis.requirements.slew_metrics` and
+:func:`~flexsat.analysis.effort.effort_metrics`)."""
+
+
 class WorstCaseSearch(_Frozen):
     """Differential evolution over the parameters' box, maximizing ``metric``.
 
@@ -185,6 +202,14 @@ class WorstCaseSearch(_Frozen):
     popsize: Annotated[int, Field(ge=2, le=100)] = Field(
         5, description="population = popsize x number of parameters"
     )
+
+    @field_validator("metric")
+    @classmethod
+    def _searchable(cls, metric: str) -> str:
+        if metric not in SEARCH_METRICS:
+            raise ValueError(f"{metric!r} is not a numeric slew metric; one of "
+                             f"{', '.join(SEARCH_METRICS)}")  # fmt: skip
+        return metric
 
 
 class Reduced(_Frozen):
@@ -376,8 +401,13 @@ class CaseStream:
         ids = [spec[0] for spec in self._fixed]
         counts = {"random": self.n_random, "sobol": 0 if self._sobol is None else len(self._sobol)}
         clash = [i for i in ids if (m := _STREAMED_ID.fullmatch(i)) and int(m[2]) < counts[m[1]]]
-        if len(set(ids)) != len(ids) or clash:
-            raise ConfigError(f"campaign {definition.name}: duplicate case ids")
+        counted = collections.Counter(ids)
+        repeated = sorted({i for i, n in counted.items() if n > 1} | set(clash))
+        if repeated:
+            shown = ", ".join(map(repr, repeated[:5])) + (" ..." if len(repeated) > 5 else "")
+            raise ConfigError(f"campaign {definition.name}: duplicate case ids: {shown} (each "
+                              "case id once; random-NNNNN and sobol-NNNNN are the drawn "
+                              "cases' own)")  # fmt: skip
         self.head = [self.resolve(spec) for spec in self._fixed]
         n_head = min(self._n_streamed, max(1, HEAD_CASES - len(self.head)))
         self.head += [self.resolve(self._streamed_spec(i)) for i in range(n_head)]
@@ -446,7 +476,7 @@ class CaseStream:
         try:
             plant = apply_modifiers(self._plant_base, plant_mods, rng, realised)
             scenario = apply_modifiers(self._scenario_base, scenario_mods, rng, realised)
-        except KeyError as exc:
+        except (KeyError, ModifierError) as exc:
             raise ConfigError(f"campaign case {case_id!r}: {exc.args[0]}") from None
         satellite = validate_config(plant, source=f"campaign case {case_id!r} (plant)")
         source = f"campaign case {case_id!r} (scenario)"

@@ -14,6 +14,7 @@ a chain takes the plate's ``damping_ratio``, ``target_frequencies_hz.<kind>`` an
 
 from __future__ import annotations
 
+import math
 import re
 from typing import Annotated, Any, Literal
 
@@ -24,7 +25,29 @@ from scipy import special
 from flexsat.config.models import HubConfig, _Frozen
 from flexsat.dynamics.appendages import DerivedPath, appendage_model
 
-__all__ = ["Modifier", "apply_modifiers", "derived_path", "truncnormal_ppf"]
+__all__ = ["Modifier", "ModifierError", "apply_modifiers", "derived_path", "truncnormal_ppf"]
+
+_NORMAL_REACH = 40.0
+"""Standard deviations a normal draw is allowed to reach without overflowing a float:
+a draw beyond 40 std has probability below 1e-300, so mean +- 40 std bounds it."""
+
+
+class ModifierError(ValueError):
+    """A modifier whose value does not fit the field it targets (the caller names the case)."""
+
+
+def _is_number(value: Any) -> bool:
+    """A finite real number (an int or a float, not a boolean)."""
+    return (isinstance(value, int | float) and not isinstance(value, bool)
+            and math.isfinite(value))  # fmt: skip
+
+
+def _numeric(node: Any) -> bool:
+    """A number, or a (nested) non-empty list of numbers: what ``op = "scale"`` scales."""
+    if isinstance(node, list):
+        return bool(node) and all(_numeric(item) for item in node)
+    return isinstance(node, int | float) and not isinstance(node, bool)
+
 
 _APPENDAGE = re.compile(r"appendages\[\d+\]")
 _TOKEN = re.compile(r"([A-Za-z_][A-Za-z0-9_]*)|\[(\*|\d+)\]")
@@ -78,7 +101,29 @@ class Modifier(_Frozen):
             mean, std, low, high = self.truncnormal
             if not (std > 0 and low < high):
                 raise ValueError(f"{self.path}: truncnormal needs std > 0 and low < high")
+        self._finite_numbers()
         return self
+
+    def _finite_numbers(self) -> None:
+        """Refuse what no draw or scaling could turn into a number: non-finite
+        parameters, a range wider than a float holds, a factor that is not a number."""
+        for name in ("uniform", "normal", "truncnormal"):
+            numbers = getattr(self, name)
+            if numbers is not None and not all(math.isfinite(x) for x in numbers):
+                raise ValueError(f"{self.path}: {name} takes finite numbers (|x| <= "
+                                 f"{np.finfo(float).max:.4g}), got {list(numbers)}")  # fmt: skip
+        if self.uniform is not None and not math.isfinite(self.uniform[1] - self.uniform[0]):
+            raise ValueError(f"{self.path}: uniform = {list(self.uniform)} is wider than a float "
+                             f"holds: high - low must be <= {np.finfo(float).max:.4g}")  # fmt: skip
+        if self.normal is not None:
+            mean, std = self.normal
+            if not math.isfinite(abs(mean) + _NORMAL_REACH * std):
+                limit = np.finfo(float).max
+                raise ValueError(f"{self.path}: normal = {list(self.normal)}: |mean| + "
+                                 f"{_NORMAL_REACH:g} std must be <= {limit:.4g}")  # fmt: skip
+        if self.op == "scale" and self.value is not None and not _is_number(self.value):
+            raise ValueError(f"{self.path}: op = 'scale' takes a finite number as its factor "
+                             f"(value), got {_shown(self.value)}")  # fmt: skip
 
     def draw(self, rng: np.random.Generator) -> float | Any:
         """The number this modifier applies (constant, or one draw from ``rng``)."""
@@ -163,12 +208,17 @@ def apply_modifiers(
     ------
     KeyError
         If a path does not exist in ``data`` (the caller reports it).
+    ModifierError
+        If a value does not fit its target: a derived path (``hub.inertia``...) takes
+        a finite number, ``op = "scale"`` a numeric field (the caller reports it).
     """
     data = _copied(data)
     for modifier in modifiers:
         for concrete, parent, key in _targets(data, modifier.path):
             value = modifier.draw(rng)
             derived = derived_path(concrete, parent, key)
+            _check_fits(modifier, concrete, None if derived is not None else parent[key], derived,
+                        value)  # fmt: skip
             if derived is not None:
                 if modifier.op not in derived.ops:
                     raise KeyError(f"{concrete} takes op = {' or '.join(map(repr, derived.ops))}"
@@ -180,6 +230,27 @@ def apply_modifiers(
                 parent[key] = value
             realised[concrete] = value
     return data
+
+
+def _check_fits(modifier: Modifier, concrete: str, current: Any, derived: DerivedPath | None,
+                value: Any) -> None:  # fmt: skip
+    """Refuse a value its target cannot take, naming the modifier and what it takes."""
+    where = f"modifier {modifier.path!r} (op = {modifier.op!r})"
+    if derived is not None:
+        if not _is_number(value):
+            what = "a scale factor" if derived.factor else "its value"
+            raise ModifierError(f"{where}: {concrete} takes a finite number ({what}, |x| <= "
+                                f"{np.finfo(float).max:.4g}), got {_shown(value)}")  # fmt: skip
+    elif modifier.op == "scale" and not _numeric(current):
+        raise ModifierError(f"{where}: {concrete} is {_shown(current)}, not a number or a "
+                            "list of numbers: only numeric fields can be scaled (use op = "
+                            "'set')")  # fmt: skip
+
+
+def _shown(value: Any) -> str:
+    """A value for a message, cut to 60 characters."""
+    text = repr(value)
+    return text if len(text) <= 60 else text[:57] + "..."
 
 
 def _copied(node: Any) -> Any:
