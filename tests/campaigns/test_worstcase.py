@@ -30,6 +30,13 @@ def test_the_search_stores_every_evaluation_finds_the_largest_and_replays_it(tmp
     rows = {p.stem: json.loads(p.read_text()) for p in (tmp_path / "cases").glob("*.json")}
     assert len(rows) == summary["cases"]
     largest = max(rows, key=lambda c: rows[c]["metrics"]["final_pointing_error_deg"])
+    # the metrics a search may name (checked at load) are numbers of every row (None:
+    # NaN stored, e.g. the window metrics of a run shorter than the window)
+    from flexsat.campaigns.definition import SEARCH_METRICS
+
+    for row in rows.values():
+        assert all(isinstance(row["metrics"][key], float | None) for key in SEARCH_METRICS)
+        assert isinstance(row["metrics"]["final_pointing_error_deg"], float)
     assert summary["case_id"] == largest
     assert json.loads((tmp_path / "worst_case.json").read_text())["case_id"] == largest
     # replay: the same inputs give the same number (the same compiled run)
