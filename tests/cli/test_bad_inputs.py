@@ -242,6 +242,11 @@ SCENARIOS = [
     _scenario("negative joint authority", '[joint_actuator]\nkind = "rate_feedback"\ncoordinates = ["eta_ry"]\ngain = 1.0\nlimit = -0.1\n', "joint_actuator.limit", command="slew"),
     _scenario("unknown joint coordinate", '[joint_actuator]\nkind = "rate_feedback"\ncoordinates = ["rho_q"]\ngain = 1.0\nlimit = 0.1\n', "joint_actuator.coordinates: unknown coordinate 'rho_q'", command="slew"),
     _scenario("smooth lambda of zero time constant", '[controller]\nlambda_adaptation = "smooth"\nlambda_time_constant_s = 0.0\n', "controller.lambda_time_constant_s", command="slew"),
+    # The observation window R1/R2 are judged over must lie inside the run (it would fail them silently).
+    _scenario("window opens after the run", "duration_s = 2.0\n[requirements]\nsettling_deadline_s = 500.0\n", "duration_s = 2 s ends the run before its observation window opens (requirements.settling_deadline_s = 500 s)", command="slew"),
+    _scenario("window closes after the run", "duration_s = 20.0\n[requirements]\nsettling_deadline_s = 5.0\nwindow_end_s = 30.0\n", "requirements.window_end_s = 30 s is after the run ends (duration_s = 20 s)", command="slew"),
+    Bad("--duration before the default window", ["slew", "--duration", "30"], "--duration 30: duration_s = 30 s ends the run before its observation window opens (requirements.settling_deadline_s = 90 s)"),
+    Bad("--duration before the scenario's window", ["slew", "--scenario", "{tmp}/s.toml", "--duration", "4"], "give duration_s > 5 s or requirements.settling_deadline_s < 4 s", {"s.toml": "[requirements]\nsettling_deadline_s = 5.0\n"}),
     Bad("missing scenario file", ["openloop", "--scenario", "{tmp}/absent.toml"], "scenario file not found"),
 ]  # fmt: skip
 

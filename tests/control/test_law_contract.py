@@ -122,11 +122,13 @@ def test_user_law_diagnostics_are_in_the_result_with_units(pid_slew):
     assert "surface_lambda_min_rad_s" not in ds.attrs
 
 
-def test_cli_picks_up_the_registered_law(qpid):
+def test_cli_picks_up_the_registered_law(qpid, tmp_path):
     from flexsat.cli.main import app
 
-    result = CliRunner().invoke(app, ["slew", "--controller", "qpid", "--duration", "2",
-                                      "--json"])  # fmt: skip
+    short = tmp_path / "short.toml"  # a 2 s run holds its observation window
+    short.write_text("[requirements]\nsettling_deadline_s = 1.0\n")
+    result = CliRunner().invoke(app, ["slew", "--scenario", str(short), "--controller", "qpid",
+                                      "--duration", "2", "--json"])  # fmt: skip
     assert result.exit_code == 0, result.output
     metrics = json.loads(result.stdout.strip().splitlines()[-1])
     assert metrics["controller"] == "qpid"

@@ -343,10 +343,11 @@ def slew(
     from flexsat.control.laws import law_names
     from flexsat.dynamics.plant import Plant
     from flexsat.simulate import SlewScenario, load_slew
+    from flexsat.simulate.scenario import check_observation_window
 
     _announce_compilation()
     plant = Plant.from_config(load_config(config))
-    chosen = load_slew(scenario)
+    chosen = load_slew(scenario, check_window=duration is None)
     overrides: dict = {}
     if duration is not None:
         overrides["duration_s"] = duration
@@ -362,6 +363,8 @@ def slew(
             source=_options(given),
             model=SlewScenario,
         )
+    if duration is not None:  # the run the option leaves must still hold its window
+        check_observation_window(chosen, f"--duration {duration:g}")
     if controller == "all":
         kinds = law_names()
         runs = {

@@ -48,6 +48,7 @@ from flexsat.plots._scene import (
 )
 from flexsat.plots.geometry import SatelliteGeometry, satellite_geometry
 from flexsat.plots.modal import DEFAULT_PEAK_FRACTION
+from flexsat.plots.style import literal
 from flexsat.simulate.result import Result
 
 __all__ = [
@@ -297,10 +298,10 @@ def _shown(x: float) -> str:
 
 def _title(result: Result, frames: RunFrames) -> str:
     attrs = result.dataset.attrs
-    head = str(attrs.get("title", "flexsat run")).removeprefix("flexsat ")
+    head = literal(str(attrs.get("title", "flexsat run")).removeprefix("flexsat "))
     head = head[:1].upper() + head[1:]
     if attrs.get("controller"):
-        head += f", {attrs.get('controller_label', str(attrs['controller']).upper())}"
+        head += f", {literal(attrs.get('controller_label', str(attrs['controller']).upper()))}"
     head += f", {frames.time[-1] - frames.time[0]:.4g} s"
     if attrs.get("status", "ok") != "ok":
         head += f" (run failed at t = {float(attrs.get('failure_time_s', frames.time[-1])):.4g} s)"

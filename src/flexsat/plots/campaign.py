@@ -73,8 +73,9 @@ class _Campaign:
 
     def title(self, fig: Figure, what: str) -> None:
         fig.suptitle(
-            f"{what}\ncampaign {self.name!r}: {len(self.histories)} successful cases "
-            f"(bands: min–max and 5–95 %), line: case {self.nominal!r}",
+            f"{what}\ncampaign {style.literal(repr(self.name))}: {len(self.histories)} "
+            f"successful cases (bands: min–max and 5–95 %), line: case "
+            f"{style.literal(repr(self.nominal))}",
             fontsize=11,
         )
 
@@ -204,7 +205,7 @@ def _band_and_line(
         p5, p95 = style.positive(p5), style.positive(p95)
     ax.fill_between(t, p5, p95, color=colour, alpha=2 * _ENVELOPE_ALPHA, linewidth=0,
                     label="5–95 % of the cases")  # fmt: skip
-    ax.plot(t, line, color=colour, linewidth=1.1, label=f"{campaign.nominal}")
+    ax.plot(t, line, color=colour, linewidth=1.1, label=style.literal(campaign.nominal))
     if log:
         ax.set_yscale("log")
 
@@ -494,9 +495,9 @@ def plot_summary_table(store_dir: str | Path) -> Figure:
     top.set_title("Pass rates", fontsize=10)
     worst = [
         [
-            w["case_id"],
+            style.literal(w["case_id"]),
             f"{w['final_pointing_error_deg']:.4g}",
-            _parameters(rows.get(w["case_id"], {})),
+            style.literal(_parameters(rows.get(w["case_id"], {}))),
         ]
         for w in summary["worst_cases"]
     ]
@@ -516,7 +517,7 @@ def plot_summary_table(store_dir: str | Path) -> Figure:
     bottom.set_title("Five worst cases (largest final pointing error)", fontsize=10)
     marker = store.root / "campaign.json"
     name = json.loads(marker.read_text())["name"] if marker.exists() else store.root.name
-    fig.suptitle(f"Campaign {name!r}: summary", fontsize=11)
+    fig.suptitle(f"Campaign {style.literal(repr(name))}: summary", fontsize=11)
     return fig
 
 

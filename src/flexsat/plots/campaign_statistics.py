@@ -52,7 +52,7 @@ def _metrics(store: CampaignStore) -> pd.DataFrame:
 
 
 def _label(column: str) -> str:
-    return column.removeprefix("metrics.")
+    return style.literal(column.removeprefix("metrics."))
 
 
 def plot_metric_histograms(store_dir: str | Path) -> Figure:
@@ -144,7 +144,7 @@ def plot_parameter_scatter(store_dir: str | Path, metric: str = DEFAULT_METRIC) 
     for ax, p in zip(axes, shown, strict=False):
         x = parameters[p].reindex(y.index)
         ax.scatter(x, y, s=8, color="black", alpha=0.6)
-        ax.set_xlabel(p, fontsize=7)
+        ax.set_xlabel(style.literal(p), fontsize=7)
         ax.tick_params(labelsize=7)
     if not shown:
         axes[0].text(0.5, 0.5, "no dispersed parameter", ha="center", va="center")
@@ -181,7 +181,7 @@ def plot_tornado(store_dir: str | Path, metric: str = DEFAULT_METRIC) -> Figure:
         bars = bars.reindex(bars.abs().sort_values().index)
         ax.barh(range(bars.size), bars.to_numpy(), color=["tab:red" if v > 0 else "tab:blue"
                                                            for v in bars])  # fmt: skip
-        ax.set_yticks(range(bars.size), bars.index, fontsize=7)
+        ax.set_yticks(range(bars.size), [style.literal(p) for p in bars.index], fontsize=7)
     ax.axvline(0.0, color="black", linewidth=0.8)
     ax.set_xlim(-1.0, 1.0)
     ax.set_xlabel("Spearman rank correlation [-]")

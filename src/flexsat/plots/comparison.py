@@ -116,5 +116,5 @@ def _label(key: str, ds) -> str:
     key upper-cased for older results); the caller's key otherwise, so that two runs of
     one law (``"asmc, k = 1"``, ``"asmc, k = 2"``) keep their own names."""
     if key != ds.attrs.get("controller", key):
-        return key
-    return str(ds.attrs.get("controller_label", key.upper()))
+        return style.literal(key)
+    return style.literal(ds.attrs.get("controller_label", key.upper()))

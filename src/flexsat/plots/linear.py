@@ -361,7 +361,7 @@ def plot_loop_family(
         for case, case_loops in loops.items():
             L = case_loops[axis].frequency_response(f)[:, 0, 0]
             dm = margins[case][axis]["delay_margin_s"]
-            ax.loglog(f, np.abs(L), linewidth=0.8, label=f"{case}: DM {dm:.3g} s")
+            ax.loglog(f, np.abs(L), linewidth=0.8, label=f"{style.literal(case)}: DM {dm:.3g} s")
         ax.axhline(1.0, color="0.3", linewidth=0.8)
         ax.set_title(f"axis {axis}")
         ax.set_xlabel("frequency [Hz]")

@@ -123,7 +123,7 @@ def plot_interaction_map(analysis: ModalAnalysis, ax: Axes | None = None) -> Fig
     ax.set_ylabel("generalized coordinate", fontsize=font + 1)
     n_app = analysis.plant.n_appendages
     ax.set_title(
-        f"Modal interaction map — {analysis.plant.config.name} "
+        f"Modal interaction map — {style.literal(analysis.plant.config.name)} "
         f"({n_app} appendage{'s' if n_app != 1 else ''}, {n_dof} DOF)",
         fontsize=font + 3,
     )
@@ -221,7 +221,7 @@ def plot_frequencies(analysis: ModalAnalysis, ax: Axes | None = None) -> Figure:
                 if any(m.symmetry == s for m in flexible)]  # fmt: skip
     ax.legend(handles=handles, loc="upper left", fontsize=font, framealpha=0.9)
     ax.set_title(
-        f"Natural frequencies of the flexible modes — {analysis.plant.config.name}\n"
+        f"Natural frequencies of the flexible modes — {style.literal(analysis.plant.config.name)}\n"
         f"{n} flexible modes; {n_rigid} rigid-body modes at 0 Hz not shown",
         fontsize=font + 3,
     )

@@ -402,7 +402,7 @@ def plot_torques(ds: xr.Dataset) -> Figure:
 
 
 def _appendage_names(ds: xr.Dataset) -> list[str]:
-    return [str(a) for a in ds["appendage"].values]
+    return [style.literal(a) for a in ds["appendage"].values]
 
 
 def plot_root_deformation(ds: xr.Dataset) -> Figure:

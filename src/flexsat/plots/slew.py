@@ -127,7 +127,7 @@ def _target_quaternion(ds: xr.Dataset, scenario: SlewScenario) -> np.ndarray:
 
 def _law_name(ds: xr.Dataset) -> str:
     label = ds.attrs.get("controller_label", str(ds.attrs.get("controller", "")).upper())
-    return str(label) or "controller"
+    return style.literal(label) or "controller"  # a registered law's label: any text
 
 
 def _no_data(ax: Axes, text: str) -> None:

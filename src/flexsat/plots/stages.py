@@ -184,8 +184,8 @@ def _draw_channel(ax: Axes, t: np.ndarray, values: np.ndarray, channel: Channel)
         ax.legend(loc="upper right", fontsize=8, ncols=3)
     else:
         style.line(ax, t, factor * values, color="tab:blue", linewidth=1.0)
-    ax.set_ylabel(f"{channel.name} [{unit}]", fontsize=9)
-    ax.set_title(channel.description, fontsize=10)
+    ax.set_ylabel(style.literal(f"{channel.name} [{unit}]"), fontsize=9)  # a user stage's words
+    ax.set_title(style.literal(channel.description), fontsize=10)
 
 
 def plot_stage_records(ds: xr.Dataset, spec: StageSpec) -> Figure:
@@ -209,7 +209,7 @@ def plot_stage_records(ds: xr.Dataset, spec: StageSpec) -> Figure:
     for ax, channel in zip(axes[:, 0], channels, strict=True):
         _draw_channel(ax, t, _channel(ds, channel), channel)
     style.finish_time_axis(axes, t)
-    style.suptitle(fig, ds, f"{spec.name} ({spec.role}): {spec.description}")
+    style.suptitle(fig, ds, style.literal(f"{spec.name} ({spec.role}): {spec.description}"))
     return fig
 
 

@@ -9,6 +9,7 @@ changes the global backend.
 - :func:`figure_legend`: one legend below the axes, the margin grown to hold it;
   :func:`axes_legend`, the same of every distinct label the axes carry.
 - :func:`time_s`: the time coordinate of a result dataset [s].
+- :func:`literal`: a user's text (names, labels, messages) drawn as written, never as mathtext.
 - :func:`suptitle`: the figure title, the run's title below it and a failure notice.
 - :func:`line`, :func:`envelope`: a time series, thinned to a min/max envelope when long.
 - :func:`finish_time_axis`: grid, time limits and the time label of the bottom row.
@@ -47,6 +48,7 @@ __all__ = [
     "finish_time_axis",
     "forked_map",
     "line",
+    "literal",
     "positive",
     "save_figure",
     "suptitle",
@@ -190,6 +192,30 @@ def time_s(ds: xr.Dataset) -> np.ndarray:
     return np.asarray(ds["time"].values, dtype=float)
 
 
+def literal(text: object) -> str:
+    """``text`` as matplotlib draws it literally: every ``$`` escaped, no mathtext.
+
+    matplotlib parses a text holding an even number of unescaped ``$`` as mathtext,
+    where a ``\\``, ``{``, ``}``, ``^`` or ``_`` is markup and an unknown command an
+    error. Every string a user wrote (a scenario, appendage, satellite, campaign or
+    case name, a law's or stage's label, a failure message) enters a figure through
+    this function; with no unescaped ``$`` left, matplotlib draws the text as it is
+    (each ``\\$`` shown as ``$``), and next to a figure's own mathtext the escaped
+    signs stay literal too.
+
+    Parameters
+    ----------
+    text : object
+        The user's text (``str(text)`` is drawn).
+
+    Returns
+    -------
+    str
+        The text to hand to matplotlib.
+    """
+    return str(text).replace("$", r"\$")
+
+
 def suptitle(fig: Figure, ds: xr.Dataset, what: str) -> None:
     """Title ``what``, the run's title below it, and the failure message of a failed run.
 
@@ -202,10 +228,10 @@ def suptitle(fig: Figure, ds: xr.Dataset, what: str) -> None:
     what : str
         What the figure shows.
     """
-    scenario = ds.attrs.get("title", "flexsat open-loop run")
+    scenario = literal(ds.attrs.get("title", "flexsat open-loop run"))  # names the user's
     text = f"{what}\n{scenario}"
     if ds.attrs.get("status", "ok") != "ok":
-        text += f"  —  FAILED: {ds.attrs.get('message', '')}"
+        text += f"  —  FAILED: {literal(ds.attrs.get('message', ''))}"
     fig.suptitle(text, fontsize=11)
 
 

@@ -47,6 +47,7 @@ __all__ = [
     "SlewScenario",
     "TorqueSegment",
     "check_multiples_of_dt",
+    "check_observation_window",
     "load_scenario",
     "load_slew",
     "pulse",
@@ -385,13 +386,66 @@ class SlewScenario(_TimedRun):
         return round(self.control_dt_s / self.dt_s)
 
 
-def load_slew(path: str | Path | None = None) -> SlewScenario:
+def check_observation_window(scenario: SlewScenario, source: str = "scenario") -> SlewScenario:
+    """Refuse a slew whose observation window is not inside its run.
+
+    R1 and R2 are judged from ``requirements.settling_deadline_s`` to
+    ``requirements.window_end_s`` (default: the end of the run,
+    :func:`flexsat.analysis.requirements.observation_window`). A run that ends before
+    the window opens, or before a stated end of it, could only fail them, and would
+    do so without saying why: such a scenario is bad input. Checked where a user's
+    scenario meets a run (a scenario file, the ``flexsat slew`` options); a short run
+    built in code (a quick look, a compilation run) is not refused.
+
+    Parameters
+    ----------
+    scenario : SlewScenario
+        The slew.
+    source : str
+        What the scenario came from, for the message (a file name, the options).
+
+    Returns
+    -------
+    SlewScenario
+        ``scenario``, unchanged.
+
+    Raises
+    ------
+    ConfigError
+        Naming ``duration_s`` and the window's field, and the range allowed.
+    """
+    from flexsat.errors import ConfigError
+
+    duration, req = scenario.duration_s, scenario.requirements
+    if req.settling_deadline_s >= duration:
+        raise ConfigError(
+            f"{source}: duration_s = {duration:g} s ends the run before its observation "
+            f"window opens (requirements.settling_deadline_s = {req.settling_deadline_s:g} "
+            f"s), so R1 and R2 could not be judged: give duration_s > "
+            f"{req.settling_deadline_s:g} s or requirements.settling_deadline_s < "
+            f"{duration:g} s"
+        )
+    if req.window_end_s is not None and req.window_end_s > duration:
+        raise ConfigError(
+            f"{source}: requirements.window_end_s = {req.window_end_s:g} s is after the "
+            f"run ends (duration_s = {duration:g} s), so R1 and R2 could not be judged: "
+            f"give requirements.window_end_s <= duration_s, or no window_end_s (the end "
+            f"of the run)"
+        )
+    return scenario
+
+
+def load_slew(path: str | Path | None = None, *, check_window: bool = True) -> SlewScenario:
     """Read and validate a slew scenario TOML; ``None`` gives the thesis's slew.
 
     Parameters
     ----------
     path : str or Path, optional
         The TOML file.
+    check_window : bool
+        Refuse a scenario whose observation window is not inside its run
+        (:func:`check_observation_window`); False for a caller that changes the
+        duration and checks the result.
 
     Returns
     -------
@@ -404,7 +458,8 @@ def load_slew(path: str | Path | None = None) -> SlewScenario:
     """
     if path is None:
         return SlewScenario()
-    return validate_config(read_toml(path, "scenario"), source=str(path), model=SlewScenario)
+    scenario = validate_config(read_toml(path, "scenario"), source=str(path), model=SlewScenario)
+    return check_observation_window(scenario, str(path)) if check_window else scenario
 
 
 def thesis_openloop() -> OpenLoopScenario:
