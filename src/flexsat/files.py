@@ -283,7 +283,7 @@ def open_lock(path: str | Path) -> IO:
     return os.fdopen(fd, "a+")
 
 
-def _open_user_file(path: Path, what: str, limit: int | None = MAX_INPUT_BYTES) -> int:
+def _open_user_file(path: Path, what: str, limit: int | None) -> int:
     try:
         fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK | os.O_CLOEXEC)  # a FIFO opens at once
     except FileNotFoundError:
@@ -300,11 +300,14 @@ def _open_user_file(path: Path, what: str, limit: int | None = MAX_INPUT_BYTES) 
     if limit is not None and info.st_size > limit:
         os.close(fd)
         raise ConfigError(
-            f"{what} file {path}: {info.st_size} bytes, more than the "
-            f"{limit // 2**20} MiB flexsat reads"
+            f"{what} file {path}: {info.st_size} bytes, more than the {_cap(limit)} flexsat reads"
         )
     os.set_blocking(fd, True)
     return fd
+
+
+def _cap(limit: int) -> str:
+    return f"{limit} bytes ({limit / 2**20:.4g} MiB)"
 
 
 def read_user_file(path: str | Path, what: str) -> bytes:
@@ -328,19 +331,19 @@ def read_user_file(path: str | Path, what: str) -> bytes:
         Missing, unreadable, not a regular file (a FIFO, a device, a folder) or
         larger than :data:`MAX_INPUT_BYTES`.
     """
-    fd = _open_user_file(Path(path), what)
+    limit = MAX_INPUT_BYTES
+    fd = _open_user_file(Path(path), what, limit)
     with os.fdopen(fd, "rb") as handle:
         try:
-            data = handle.read(MAX_INPUT_BYTES + 1)
+            data = handle.read(limit + 1)
         except OSError as exc:
             raise ConfigError(f"cannot read {what} file {path}: {exc.strerror or exc}") from None
-    if len(data) > MAX_INPUT_BYTES:  # grew while read
-        raise ConfigError(f"{what} file {path}: more than the {MAX_INPUT_BYTES // 2**20} MiB "
-                          "flexsat reads")  # fmt: skip
+    if len(data) > limit:  # grew while read
+        raise ConfigError(f"{what} file {path}: more than the {_cap(limit)} flexsat reads")
     return data
 
 
-def check_user_file(path: str | Path, what: str, limit: int | None = MAX_INPUT_BYTES) -> Path:
+def check_user_file(path: str | Path, what: str, limited: bool = True) -> Path:
     """Check that a user's input file is a regular file a reader may open by name.
 
     For readers that take a file name (NetCDF, NPZ); the same checks as
@@ -352,9 +355,9 @@ def check_user_file(path: str | Path, what: str, limit: int | None = MAX_INPUT_B
         The file.
     what : str
         What it holds, for the message.
-    limit : int or None
-        Largest size accepted [bytes]; None for no limit (a run's NetCDF result,
-        which a reader opens lazily).
+    limited : bool
+        Refuse a file larger than :data:`MAX_INPUT_BYTES`; False for a run's NetCDF
+        result, which its reader opens lazily.
 
     Returns
     -------
@@ -366,5 +369,5 @@ def check_user_file(path: str | Path, what: str, limit: int | None = MAX_INPUT_B
     ConfigError
         As :func:`read_user_file`.
     """
-    os.close(_open_user_file(Path(path), what, limit))
+    os.close(_open_user_file(Path(path), what, MAX_INPUT_BYTES if limited else None))
     return Path(path)

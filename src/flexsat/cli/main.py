@@ -428,7 +428,7 @@ def animate(
 
     if not result.exists():
         raise FlexsatError(f"{result}: file not found")
-    check_user_file(result, "RESULT", limit=None)  # a FIFO or a device is refused, not read
+    check_user_file(result, "RESULT", limited=False)  # a FIFO or a device is refused, not read
     try:
         run = Result.from_netcdf(result)
         plant = result_plant(run)
@@ -479,7 +479,7 @@ def plot(
 
     if not result.exists():
         raise FlexsatError(f"RESULT {result}: no such file")
-    check_user_file(result, "RESULT", limit=None)  # a FIFO or a device is refused, not read
+    check_user_file(result, "RESULT", limited=False)  # a FIFO or a device is refused, not read
     try:
         loaded = Result.from_netcdf(result)
     except (OSError, ValueError) as exc:
