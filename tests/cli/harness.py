@@ -85,3 +85,30 @@ def _value(value) -> str:
     if isinstance(value, list | tuple):
         return "[" + ", ".join(_value(v) for v in value) + "]"
     raise TypeError(f"no TOML form for {value!r}")
+
+
+def modal_table() -> dict:
+    """A small valid table of the modal data format: a 6.75 kg panel, two modes, a tip.
+
+    Its rigid mass matrix about the interface is positive definite and the two modes'
+    effective masses stay below it (docs/modal_format.md, "Checks at load").
+    """
+    return {
+        "format_version": 1, "mass_kg": 6.75, "center_of_mass_m": [0.0, 0.75, 0.0],
+        "inertia_interface_kg_m2": [[5.0, 0.0, 0.0], [0.0, 1.3, 0.0], [0.0, 0.0, 6.0]],
+        "frequencies_hz": [0.8, 2.5], "damping_ratios": [0.005, 0.005],
+        "participation": [[0.0, 0.0, 1.5, 1.4, 0.0, 0.0], [0.0, 0.0, 0.5, 0.1, 0.0, 0.0]],
+        "output_points": [{"name": "tip", "position_m": [0.0, 1.5, 0.0],
+                           "mode_shapes": [[0.0, 0.0, 0.5], [0.0, 0.0, 0.3]]}],
+    }  # fmt: skip
+
+
+def npz_bytes(arrays: dict) -> bytes:
+    """An NPZ archive of ``arrays`` (name -> array), as bytes."""
+    import io
+
+    import numpy as np
+
+    buffer = io.BytesIO()
+    np.savez(buffer, **arrays)
+    return buffer.getvalue()

@@ -1,19 +1,32 @@
-"""Seeded fuzz: 300 mutated satellite configs through the real entry point.
+"""Seeded fuzz: 300 mutated satellite configs through the real entry point, and 400
+mutated modal data files through the loader.
 
 Each config is the nominal one with one to four values replaced by hostile ones
 (numbers scaled by up to 1e+-3, extreme or non-finite numbers, markup, wrong types,
 deleted or unknown keys), or its TOML text cut or corrupted. ``config show``,
 ``modal --json`` and the plain ``modal`` table must each end with exit code 0, or 2
 and one message: no traceback, no hang.
+
+Each modal data file (docs/modal_format.md) is a small valid one, TOML or NPZ, with
+values replaced (hostile numbers, wrong dtypes and shapes, deleted or unknown keys),
+an NPZ header forged to ask for far more than the file holds, or its bytes flipped or
+cut. :func:`~flexsat.config.modal_data.load_modal_data` is called in this process (the
+command line turns its ``ConfigError`` into exit code 2): each file loads or raises
+``ConfigError`` with a message, nothing else.
 """
 
 from __future__ import annotations
 
+import io
+import signal
 import traceback
+import zipfile
 
 import numpy as np
 
-from tests.cli.harness import Hang, flexsat, to_toml
+from flexsat.config.modal_data import load_modal_data
+from flexsat.errors import ConfigError
+from tests.cli.harness import Hang, flexsat, modal_table, npz_bytes, to_toml
 from tests.conftest import nominal_dict
 
 SEED = 20261201
@@ -80,7 +93,7 @@ def _mutate(rng: np.random.Generator) -> str:
     text = to_toml(data)
     if rng.random() < 0.15:  # damaged text: cut, or one character replaced
         cut = int(rng.integers(len(text)))
-        text = text[:cut] if rng.random() < 0.5 else text[:cut] + "\x01[\"]=" + text[cut + 1 :]
+        text = text[:cut] if rng.random() < 0.5 else text[:cut] + '\x01["]=' + text[cut + 1 :]
     return text
 
 
@@ -109,3 +122,140 @@ def test_mutated_configs_never_give_a_traceback_or_hang(tmp_path, capsys):
         problems[:5]
     )
     assert refused > CASES // 3  # the mutations are hostile: most configs are refused
+
+
+MODAL_SEED = 20261207
+MODAL_CASES = 400
+_DTYPES = (np.int32, np.int64, np.float16, np.float32, np.complex128, np.bool_, "U8", "S8",
+           "datetime64[s]", "<f8", ">f8")  # fmt: skip
+
+
+def _valid_arrays() -> dict[str, np.ndarray]:
+    from flexsat.config.modal_data import modal_data_from_dict
+
+    return modal_data_from_dict(modal_table()).to_arrays()
+
+
+def _forged_member(key: str, rng: np.random.Generator) -> bytes:
+    """A .npy member whose header asks for a shape its data does not hold."""
+    shape = tuple(
+        int(v) for v in rng.integers(1, 10 ** rng.integers(1, 7), size=rng.integers(1, 4))
+    )
+    header = io.BytesIO()
+    np.lib.format.write_array_header_1_0(
+        header, {"descr": "<f8", "fortran_order": False, "shape": shape}
+    )
+    return header.getvalue() + b"\0" * int(rng.integers(0, 4096))
+
+
+def _modal_npz(rng: np.random.Generator) -> bytes:
+    arrays = _valid_arrays()
+    forged = {}
+    for _ in range(rng.integers(1, 4)):
+        key = list(arrays)[rng.integers(len(arrays))]
+        action = rng.integers(9)
+        value = arrays[key]
+        if action == 0:  # another dtype
+            try:
+                arrays[key] = value.astype(_DTYPES[rng.integers(len(_DTYPES))])
+            except (TypeError, ValueError):
+                arrays[key] = np.array("x")
+        elif action == 1:  # a 0-d array
+            arrays[key] = np.array(value.ravel()[0] if value.size else 1.0)
+        elif action == 2:  # another shape
+            arrays[key] = np.atleast_1d(value)[..., None] if rng.random() < 0.5 else value.T
+        elif action == 3:  # cut along the first axis
+            arrays[key] = np.atleast_1d(value)[: int(rng.integers(0, max(value.size, 1)))]
+        elif action == 4:  # hostile numbers
+            if value.dtype.kind == "f" and value.size:
+                flat = value.astype(float).ravel()
+                flat[rng.integers(flat.size)] = _NUMBERS[rng.integers(len(_NUMBERS))]
+                arrays[key] = flat.reshape(value.shape)
+        elif action == 5:
+            arrays.pop(key)
+        elif action == 6:
+            arrays[f"unknown_{rng.integers(100)}"] = np.zeros(int(rng.integers(0, 5)))
+        elif action == 7:  # a header asking for far more than the data
+            forged[key] = _forged_member(key, rng)
+        else:  # Python objects (refused: never unpickled)
+            arrays[key] = np.array([{"x": 1}], dtype=object)
+    data = npz_bytes(arrays)
+    if forged:
+        buffer = io.BytesIO()
+        with zipfile.ZipFile(io.BytesIO(data)) as source, zipfile.ZipFile(buffer, "w") as out:
+            for info in source.infolist():
+                key = info.filename.removesuffix(".npy")
+                out.writestr(info.filename, forged.get(key, source.read(info)))
+        data = buffer.getvalue()
+    return data
+
+
+def _modal_toml(rng: np.random.Generator) -> bytes:
+    data = modal_table()
+    paths = _leaf_paths(data)
+    for _ in range(rng.integers(1, 4)):
+        path = paths[rng.integers(len(paths))]
+        node = data
+        try:
+            for part in path[:-1]:
+                node = node[part]
+            action = rng.integers(8)
+            current = node[path[-1]]
+            if action < 3 and isinstance(current, float):
+                node[path[-1]] = float(current * 10.0 ** rng.uniform(-300, 300))
+            elif action == 3 and isinstance(node, dict):
+                node.pop(path[-1], None)
+            elif action == 4 and isinstance(node, dict):
+                node[f"unknown_{rng.integers(100)}"] = _hostile(rng)
+            else:
+                node[path[-1]] = _hostile(rng)
+        except (KeyError, IndexError, TypeError):
+            continue  # an earlier edit replaced a parent: skip this one
+    return to_toml(data).encode()
+
+
+def _damaged(content: bytes, rng: np.random.Generator) -> bytes:
+    """``content`` cut short, or with a few bytes flipped."""
+    if rng.random() < 0.4:
+        return content[: int(rng.integers(len(content)))]
+    flipped = bytearray(content)
+    for _ in range(rng.integers(1, 9)):
+        flipped[rng.integers(len(flipped))] ^= 1 << int(rng.integers(8))
+    return bytes(flipped)
+
+
+def test_mutated_modal_data_files_load_or_give_one_message(tmp_path):
+    rng = np.random.default_rng(MODAL_SEED)
+    print(f"seed {MODAL_SEED}")
+    problems, refused = [], 0
+
+    def hang(signum, frame):
+        raise Hang("ran more than 10 s")
+
+    previous = signal.signal(signal.SIGALRM, hang)
+    try:
+        for k in range(MODAL_CASES):
+            npz = k % 2 == 1
+            content = _modal_npz(rng) if npz else _modal_toml(rng)
+            if rng.random() < 0.3:
+                content = _damaged(content, rng)
+            path = tmp_path / f"modal_{k:03d}.{'npz' if npz else 'toml'}"
+            path.write_bytes(content)
+            signal.alarm(10)
+            try:
+                load_modal_data(path)
+            except ConfigError as exc:
+                refused += 1
+                if not str(exc) or len(str(exc)) > 3000:
+                    problems.append(f"{path.name}: not one bounded message: {str(exc)[:300]}")
+            except Exception:  # anything else: record it with the input that caused it
+                problems.append(f"{path.name}: {traceback.format_exc()}")
+            finally:
+                signal.alarm(0)
+    finally:
+        signal.signal(signal.SIGALRM, previous)
+    assert not problems, f"{len(problems)} of {MODAL_CASES} failed (seed {MODAL_SEED}):\n" + (
+        "\n".join(problems[:5])
+    )
+    assert refused > MODAL_CASES // 2  # most mutations are hostile
+    assert refused < MODAL_CASES  # and some harmless: the valid files do load

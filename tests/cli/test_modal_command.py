@@ -89,3 +89,30 @@ def test_npz_modal_file(capsys, tmp_path, panel_data):
     config = tmp_path / "satellite.toml"
     config.write_text(to_toml(data))
     assert flexsat(["modal", "--json", "--config", str(config)], capsys).code == 0
+
+
+def test_a_modal_file_is_found_beside_the_config_that_names_it(capsys, tmp_path, monkeypatch,
+                                                                  panel_data):  # fmt: skip
+    # docs/modal_format.md, "In a satellite TOML": `file` is relative to the TOML's
+    # folder, so the command works from any folder (here the parent of fe/).
+    folder = tmp_path / "fe"
+    folder.mkdir()
+    save_modal_data(panel_data, folder / "wing.npz")
+    data = nominal_dict()
+    data["appendages"][0] = {"name": "wing", "model": "modal", "mount_point_m": [0.0, 0.8, 0.0],
+                             "file": "wing.npz"}  # fmt: skip
+    (folder / "modal_sat.toml").write_text(to_toml(data))
+    monkeypatch.chdir(tmp_path)
+    outcome = flexsat(["modal", "--json", "--config", "fe/modal_sat.toml"], capsys)
+    assert outcome.code == 0, outcome.stderr
+    # The exported plate in place of panel_1: the coupled frequencies of the nominal
+    # satellite (exact round trip; 1e-9 relative: the eigensolver's round-off).
+    reference = json.loads(flexsat(["modal", "--json"], capsys).stdout)["frequencies_hz"]
+    np.testing.assert_allclose(json.loads(outcome.stdout)["frequencies_hz"][6:], reference[6:],
+                               rtol=1e-9)  # fmt: skip
+    monkeypatch.chdir(folder)  # a file named from the working directory is not looked for
+    (folder / "fe").mkdir()
+    (folder / "fe" / "modal_sat.toml").write_text(to_toml(data))
+    outcome = flexsat(["modal", "--config", "fe/modal_sat.toml"], capsys)
+    assert outcome.code == 2
+    assert "modal data file not found: fe/wing.npz" in outcome.stderr  # beside the TOML

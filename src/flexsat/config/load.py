@@ -82,10 +82,30 @@ def load_config(path: str | Path | None = None) -> SatelliteConfig:
     ConfigError
         If the file is missing or unreadable, or any field is invalid; the message
         names the field and the allowed range.
+
+    Notes
+    -----
+    A file an appendage table names (``file = "wing.npz"``) is relative to the
+    folder of this TOML file, not to the working directory.
     """
     if path is None:
         return nominal()
-    return validate_config(read_toml(path, "config"), source=str(path))
+    data = _files_beside(read_toml(path, "config"), Path(path).parent)
+    return validate_config(data, source=str(path))
+
+
+def _files_beside(data: dict[str, Any], folder: Path) -> dict[str, Any]:
+    """``data`` with each appendage table's relative ``file`` joined to ``folder``."""
+    appendages = data.get("appendages")
+    if not isinstance(appendages, list):
+        return data
+    resolved = []
+    for table in appendages:
+        name = table.get("file") if isinstance(table, dict) else None
+        if isinstance(name, str) and name and not Path(name).is_absolute():
+            table = {**table, "file": str(folder / name)}
+        resolved.append(table)
+    return {**data, "appendages": resolved}
 
 
 def read_toml(path: str | Path, what: str = "config") -> dict[str, Any]:

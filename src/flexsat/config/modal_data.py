@@ -13,6 +13,8 @@ mode-shape rows. TOML suits a handful of modes, NPZ many; both carry the same ke
 from __future__ import annotations
 
 import tomllib
+import zipfile
+import zlib
 from pathlib import Path
 from typing import Annotated, Any, Literal
 
@@ -33,11 +35,25 @@ __all__ = [
 
 FORMAT_VERSION = 1
 
-Real = Annotated[float, Strict(), AllowInfNan(False)]
+# Every number is bounded, so that nothing downstream overflows (L^T L of 2000 modes,
+# omega^2, the eigenproblem of the hub and its appendages): the ranges span far beyond
+# any spacecraft structure.
+Real = Annotated[float, Strict(), AllowInfNan(False), Field(ge=-1e12, le=1e12)]
+Length = Annotated[float, Strict(), AllowInfNan(False), Field(ge=-1e3, le=1e3)]  # [m]
+Frequency = Annotated[float, Strict(), AllowInfNan(False), Field(ge=1e-3, le=1e5)]  # [Hz]
 Vector3 = tuple[Real, Real, Real]
+Point3 = tuple[Length, Length, Length]
 Vector6 = tuple[Real, Real, Real, Real, Real, Real]
 Matrix3 = tuple[Vector3, Vector3, Vector3]
 _MAX_MODES = 2000
+_MAX_OUTPUT_POINTS = 1000
+# The most numbers one NPZ array may hold: output_mode_shapes at the largest counts.
+_MAX_NUMBERS = _MAX_OUTPUT_POINTS * _MAX_MODES * 3
+# Deflate compresses at most 1032:1: a member declaring more is not a deflated array.
+_DEFLATE_MAX_RATIO = 1032
+_NPZ_KEYS = ("format_version", "mass_kg", "center_of_mass_m", "inertia_interface_kg_m2",
+             "frequencies_hz", "damping_ratios", "participation", "inertia_derivatives",
+             "output_names", "output_positions_m", "output_mode_shapes")  # fmt: skip
 # Relative slack of the positive-semidefiniteness tests (round-off of the file's own
 # digits: a reduction written with 16 significant digits is exact to ~1e-15).
 _PSD_RTOL = 1e-9
@@ -51,7 +67,7 @@ class OutputPoint(_Frozen):
     """A point of the structure whose motion is reported (e.g. the tip)."""
 
     name: Annotated[str, Field(min_length=1, max_length=64, description="the point's name")]
-    position_m: Vector3 = Field(description="undeformed position from the interface, frame M [m]")
+    position_m: Point3 = Field(description="undeformed position from the interface, frame M [m]")
     mode_shapes: list[Vector3] = Field(
         description="per mode, the point's translation per unit modal coordinate, frame M "
         "[m/(sqrt(kg) m)]"
@@ -71,12 +87,13 @@ class ModalData(_Frozen):
     mass_kg: Annotated[
         float, Strict(), AllowInfNan(False), Field(gt=0.0, le=1e7, description="mass [kg]")
     ]
-    center_of_mass_m: Vector3 = Field(description="interface -> centre of mass, frame M [m]")
+    center_of_mass_m: Point3 = Field(description="interface -> centre of mass, frame M [m]")
     inertia_interface_kg_m2: Matrix3 = Field(
         description="inertia about the interface point, frame M [kg m^2]"
     )
-    frequencies_hz: Annotated[list[Real], Field(max_length=_MAX_MODES)] = Field(
-        description="interface-clamped natural frequencies, ascending [Hz]"
+    frequencies_hz: Annotated[list[Frequency], Field(max_length=_MAX_MODES)] = Field(
+        description="interface-clamped natural frequencies, ascending, each within "
+        "[1e-3, 1e5] Hz [Hz]"
     )
     damping_ratios: list[Real] = Field(description="modal damping ratio zeta_k, in [0, 1) [-]")
     participation: list[Vector6] = Field(
@@ -88,7 +105,7 @@ class ModalData(_Frozen):
         description="optional: J'_k = dJ_I/d eta_k per mode, about the interface, frame M "
         "[sqrt(kg) m]; none: the inertia does not change with the modes",
     )
-    output_points: list[OutputPoint] = Field(
+    output_points: Annotated[list[OutputPoint], Field(max_length=_MAX_OUTPUT_POINTS)] = Field(
         default_factory=list, description="points whose motion is reported (e.g. the tip)"
     )
 
@@ -214,6 +231,12 @@ def _from_arrays(arrays: dict[str, np.ndarray]) -> dict[str, Any]:
     names = arrays.get("output_names", np.zeros(0, dtype=str))
     positions = arrays.get("output_positions_m", np.zeros((0, 3)))
     shapes = arrays.get("output_mode_shapes", np.zeros((0, 0, 3)))
+    for key, value, ndim, shape in (("output_names", names, 1, "(k,)"),
+                                    ("output_positions_m", positions, 2, "(k, 3)"),
+                                    ("output_mode_shapes", shapes, 3, "(k, n, 3)")):  # fmt: skip
+        if value.ndim != ndim:
+            raise ValueError(f"{key}: expected an array of shape {shape}, got shape "
+                             f"{value.shape}")  # fmt: skip
     if not len(names) == len(positions) == len(shapes):
         raise ValueError(
             "output_names, output_positions_m and output_mode_shapes: expected one entry "
@@ -224,6 +247,54 @@ def _from_arrays(arrays: dict[str, np.ndarray]) -> dict[str, Any]:
         for n, p, s in zip(names, positions, shapes, strict=True)
     ]
     return data
+
+
+def _read_npz(path: Path) -> dict[str, np.ndarray]:
+    """The arrays of an NPZ file, each header checked before its array is allocated.
+
+    A header's shape is not trusted: before reading, each member must be one of the
+    format's keys, hold no Python objects (nothing is unpickled), declare at most
+    ``_MAX_NUMBERS`` numbers, and declare exactly as many bytes as the member holds,
+    which in turn must fit its compressed size (stored: equal; deflated: at most
+    1032 times). A truncated or forged file is refused before any large allocation.
+    """
+    from numpy.lib import format as npy
+
+    arrays: dict[str, np.ndarray] = {}
+    with zipfile.ZipFile(path) as archive:
+        for info in archive.infolist():
+            key = info.filename.removesuffix(".npy")
+            if key not in _NPZ_KEYS or not info.filename.endswith(".npy"):
+                raise ValueError(f"unknown member {info.filename[:80]!r} (allowed: "
+                                 f"{', '.join(k + '.npy' for k in _NPZ_KEYS)})")  # fmt: skip
+            ratio = 1 if info.compress_type == zipfile.ZIP_STORED else _DEFLATE_MAX_RATIO
+            if info.file_size > ratio * info.compress_size + 64:
+                raise ValueError(f"{key}: the member declares {info.file_size} bytes in "
+                                 f"{info.compress_size} compressed bytes (damaged or "
+                                 "forged)")  # fmt: skip
+            with archive.open(info) as member:
+                version = npy.read_magic(member)
+                if version == (1, 0):
+                    shape, _, dtype = npy.read_array_header_1_0(member)
+                elif version == (2, 0):
+                    shape, _, dtype = npy.read_array_header_2_0(member)
+                else:
+                    raise ValueError(f"{key}: .npy format version {version} is not read "
+                                     "(1.0 and 2.0 are)")  # fmt: skip
+                if dtype.hasobject:
+                    raise ValueError(f"{key}: holds Python objects (refused: nothing is "
+                                     "unpickled)")  # fmt: skip
+                count = float(np.prod(shape, dtype=np.float64))
+                if count > _MAX_NUMBERS:
+                    raise ValueError(f"{key}: shape {shape} holds more than the "
+                                     f"{_MAX_NUMBERS} numbers the format allows")  # fmt: skip
+                declared, held = int(count) * dtype.itemsize, info.file_size - member.tell()
+                if declared != held:
+                    raise ValueError(f"{key}: the header's shape {shape} of {dtype} needs "
+                                     f"{declared} bytes, the file holds {held}")  # fmt: skip
+                member.seek(0)  # read_array reads the header again
+                arrays[key] = npy.read_array(member, allow_pickle=False)
+    return arrays
 
 
 def modal_data_from_dict(data: dict[str, Any], source: str = "modal data") -> ModalData:
@@ -276,11 +347,11 @@ def load_modal_data(path: str | Path) -> ModalData:
     elif suffix == ".npz":
         check_user_file(path, "modal data")  # a FIFO or a device is refused, not read
         try:
-            with np.load(path, allow_pickle=False) as npz:
-                data = _from_arrays({k: npz[k] for k in npz.files})
+            data = _from_arrays(_read_npz(path))
         except FileNotFoundError:
             raise ConfigError(f"modal data file not found: {path}") from None
-        except (OSError, ValueError) as exc:
+        except (OSError, ValueError, EOFError, zipfile.BadZipFile, zlib.error,
+                NotImplementedError) as exc:  # fmt: skip
             raise ConfigError(f"cannot read modal data file {path}: {exc}") from None
     else:
         raise ConfigError(f"modal data file {path}: the suffix must be .toml or .npz")
