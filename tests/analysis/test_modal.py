@@ -70,3 +70,49 @@ def test_asymmetric_layouts_have_no_mirror_labels(make):
     kinds = [m.kind for m in flexible]
     for kind in ("flapping", "in_plane", "torsion"):
         assert kinds.count(kind) == n_panels
+
+
+def _pair_and_a_third_panel() -> Plant:
+    """The thesis's mirrored pair (±Y) and a third, shorter panel (2 m) on +X spanning
+    along +X: the satellite is still symmetric about the hub XZ plane, the third panel
+    its own mirror image (no partner)."""
+    import copy
+
+    from tests.conftest import config_from, nominal_dict
+
+    data = nominal_dict()
+    third = copy.deepcopy(data["appendages"][0])
+    third.update(name="panel_3", mount_point_m=[0.8, 0.0, 0.0], mount_yaw_deg=-90.0, length_m=2.0)
+    data["appendages"].append(third)
+    return Plant.from_config(config_from(data))
+
+
+def test_a_panel_that_is_its_own_mirror_image_has_no_mirror_label():
+    # Reference: thesis table 3.3 for the pair. A mode that moves the third panel alone
+    # (>= 85 % of the appendages' mass-weighted motion in it: 89-97 % here) has no
+    # partner to be symmetric or antisymmetric with: "none". A mode of the pair (>= 90 %
+    # in panels 1 and 2) keeps the label table 3.3 gives the pair's mode of its kind nearest in
+    # frequency (table 3.3's frequencies are the two-panel satellite's; the third
+    # panel shifts them by under 3 %, far less than the 0.26-0.52-0.80-1.23 Hz gaps
+    # between the modes of one kind).
+    from flexsat.dynamics.symmetry import mirror_partners
+
+    plant = _pair_and_a_third_panel()
+    assert mirror_partners(plant) == [1, 0, 2]  # the pair swapped, the third onto itself
+    analysis = modal_analysis(plant)
+    weights = np.sqrt(np.diag(analysis.mass_matrix))
+    third = plant.layout.blocks[2].slice
+    alone, of_the_pair = 0, 0
+    for mode in (m for m in analysis.modes[6:] if m.frequency_hz < 2.0):  # rotational modes
+        motion = (analysis.shapes[:, mode.index - 1] * weights)[6:] ** 2
+        share = motion[third.start - 6 : third.stop - 6].sum() / motion.sum()
+        if share >= 0.85:
+            assert mode.symmetry == "none", mode
+            alone += 1
+        elif share <= 0.1:
+            ref = min((row for row in TABLE_3_3 if row[2] == mode.kind),
+                      key=lambda row: abs(row[1] - mode.frequency_hz))  # fmt: skip
+            assert abs(ref[1] - mode.frequency_hz) < 0.03 * ref[1], (mode, ref)
+            assert mode.symmetry == ref[3], (mode, ref)
+            of_the_pair += 1
+    assert alone == 3 and of_the_pair == 6  # its flapping, in-plane, torsion; table 3.3

@@ -8,8 +8,12 @@ classifies each flexible mode automatically:
   Z_M, translation = any root translation).
 - ``symmetry``: for a plant with a mirror symmetry (the two-panel case is symmetric
   about the hub XZ plane), the parity of the mode under the reflection:
-  ``symmetric`` (the panels move as mirror images) or ``antisymmetric``;
-  ``none`` when the plant has no mirror symmetry or the mode has no parity.
+  ``symmetric`` (the panels move as mirror images) or ``antisymmetric`` (as
+  opposite images); ``none`` when the plant has no mirror symmetry, the mode has
+  no parity, or the mode is not a motion of mirror pairs: an appendage that is its
+  own mirror image (a third panel in the plane beside a mirrored pair) has no
+  partner to move with, so a mode in which such appendages carry at least half of
+  the appendages' mass-weighted motion (:data:`_PAIRED_MIN`) is labelled ``none``.
 - ``hub_dof``: the hub DOF the mode drives most (mass-weighted amplitude), if it
   carries at least 10 % of the mode's largest mass-weighted amplitude.
 """
@@ -23,7 +27,7 @@ from scipy.linalg import eigh
 
 from flexsat.dynamics.plant import HUB_DOFS, JOINT_DOFS, Plant
 from flexsat.dynamics.rigid import rigid_inertia
-from flexsat.dynamics.symmetry import mirror_operator
+from flexsat.dynamics.symmetry import mirror_operator, mirror_partners
 from flexsat.errors import SimulationError
 
 __all__ = [
@@ -37,6 +41,10 @@ __all__ = [
 ]
 
 _PARITY_MIN = 0.9  # |<phi, P phi>_M| above this: the mode has a definite mirror parity
+_PAIRED_MIN = 0.5
+"""Share of a mode's appendage motion (sum of its squared mass-weighted amplitudes over
+the appendages' coordinates) the mirror pairs must carry for the mode to be labelled
+symmetric or antisymmetric: more than the appendages that are their own image."""
 _DOMINANT_MIN = 0.5  # normalized mass-weighted amplitude for a DOF to count as dominant
 _HUB_COUPLING_MIN = 0.1
 
@@ -251,6 +259,7 @@ def modal_analysis(plant: Plant) -> ModalAnalysis:
     participation = weighted / weighted.max(axis=0, keepdims=True)
     names = dof_names(plant)
     mirror = mirror_operator(plant)
+    paired = _paired_coordinates(plant)
     modes = []
     for k in range(plant.n_dof):
         phi = shapes[:, k]
@@ -261,7 +270,7 @@ def modal_analysis(plant: Plant) -> ModalAnalysis:
                 index=k + 1,
                 frequency_hz=float(frequencies[k]),
                 kind="rigid" if rigid else _kind(plant, phi),
-                symmetry="none" if rigid else _symmetry(phi, M0, mirror),
+                symmetry="none" if rigid else _symmetry(phi, M0, mirror, paired),
                 dominant_dofs=[names[j] for j in order if participation[j, k] >= _DOMINANT_MIN],
                 hub_dof=None if rigid else _hub_dof(participation[:, k]),
             )
@@ -289,9 +298,27 @@ def _kind(plant: Plant, phi: np.ndarray) -> str:
     return max(energy, key=energy.get)
 
 
-def _symmetry(phi: np.ndarray, M0: np.ndarray, mirror: np.ndarray | None) -> str:
-    if mirror is None:
+def _paired_coordinates(plant: Plant) -> np.ndarray | None:
+    """Mask over q of the coordinates of appendages with a mirror partner other than
+    themselves (None without a mirror symmetry)."""
+    partners = mirror_partners(plant)
+    if partners is None:
+        return None
+    mask = np.zeros(plant.n_dof, dtype=bool)
+    for i, j in enumerate(partners):
+        mask[plant.layout.blocks[i].slice] = i != j
+    return mask
+
+
+def _symmetry(phi: np.ndarray, M0: np.ndarray, mirror: np.ndarray | None,
+              paired: np.ndarray | None) -> str:  # fmt: skip
+    """The mode's mirror parity, if the mirror pairs carry it (:data:`_PAIRED_MIN`)."""
+    if mirror is None or paired is None:
         return "none"
+    motion = (phi * np.sqrt(np.diag(M0))) ** 2  # squared mass-weighted amplitudes
+    appendages = motion[6:].sum()
+    if appendages > 0.0 and motion[paired].sum() < _PAIRED_MIN * appendages:
+        return "none"  # mostly appendages that are their own image: no pair moves
     parity = float(phi @ M0 @ (mirror @ phi)) / float(phi @ M0 @ phi)
     if parity >= _PARITY_MIN:
         return "symmetric"
