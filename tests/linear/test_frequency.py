@@ -169,3 +169,86 @@ def test_delay_margin_matches_the_nonlinear_closed_loop(plant, loops):
     freqs = np.fft.rfftfreq(8 * third, dt)
     f_peak = freqs[np.argmax(np.abs(np.fft.rfft(tail, 8 * third)))]
     assert f_peak == pytest.approx(margins.delay_crossover_hz, abs=1.0 / (third * dt))
+
+
+def _control_loop(npz, K: np.ndarray, a: int):
+    """The loop gain of axis a built by python-control alone from an exported model."""
+    import control
+
+    names = [str(n) for n in npz["output_names"]]
+    rows = [names.index(n) for n in ("phi", "theta", "psi", "omega_x", "omega_y", "omega_z")]
+    plant = control.ss(npz["A"], npz["B"][:, :3], npz["C"][rows], npz["D"][rows][:, :3])
+    others = K.copy()
+    others[a] = 0.0  # the other two axes' loops closed, this one open
+    closed = control.feedback(plant, control.ss([], [], [], others))  # u = r - K_o y
+    return control.series(closed[:, a], control.ss([], [], [], K[[a]]))
+
+
+# python-control's margins solve degree-72 polynomials (see above).
+@pytest.mark.filterwarnings("ignore::RuntimeWarning")
+def test_every_crossover_and_flexible_peak_against_python_control(plant, rest_model, tmp_path):
+    import control
+    from flexsat.study.linear import write_margins
+
+    rest_model.save_npz(tmp_path / "model.npz")
+    npz = np.load(tmp_path / "model.npz")
+    K = pd_gains(plant)
+    axes = write_margins(plant)["axes"]  # what `flexsat margins --json` prints
+    phase_stabilized = {}
+    for a, axis in enumerate("xyz"):
+        loop = _control_loop(npz, K, a)
+        _, pm, _, _, wc, _ = control.stability_margins(loop, returnall=True)
+        ours = axes[axis]["crossovers"]
+        # Every gain crossover, and its phase margin: two root finders on the same
+        # exact response (python-control's polynomial |L|^2 = 1, flexsat's Brent on
+        # the grid's brackets), 1e-8 relative as for the smallest margin above.
+        np.testing.assert_allclose([c["frequency_hz"] for c in ours], np.sort(wc) / (2 * np.pi),
+                                   rtol=1e-8)  # fmt: skip
+        np.testing.assert_allclose([c["phase_margin_deg"] for c in ours], pm[np.argsort(wc)],
+                                   rtol=1e-8, atol=1e-8)  # fmt: skip
+        # The delay margin is the smallest (PM mod 360 deg) / (360 deg f_c), at its crossover.
+        delays = np.remainder(pm, 360.0) / np.degrees(wc)
+        k = int(np.argmin(delays))
+        assert axes[axis]["delay_margin_s"] == pytest.approx(delays[k], rel=1e-8)
+        assert axes[axis]["delay_crossover_hz"] == pytest.approx(wc[k] / (2 * np.pi), rel=1e-8)
+        # Peaks: |L| of the python-control loop around each of its lightly damped poles
+        # in the band (above 1e-4 Hz), on 2001 points over +-(20 zeta + 1e-3) (at most
+        # +-50 %) of the pole's frequency, then 2001 points over the two spacings beside the best:
+        # final spacing <= 2e-8 relative, so the grid's maximum is below the true peak
+        # by (spacing / 2 zeta)^2 / 2 < 1e-11 relative for zeta >= 0.005 (the panels'):
+        # the peaks agree to 1e-5 dB and 1e-6 relative in frequency.
+        lam = np.linalg.eigvals(loop.A)
+        light = (lam.imag > 0) & (-lam.real < 0.3 * np.abs(lam)) & (np.abs(lam) > 2e-4 * np.pi)
+        reference = []
+        for pole in lam[light]:
+            zeta, w = -pole.real / abs(pole), abs(pole)
+            half = min(20 * zeta + 1e-3, 0.5)
+            omega = w * np.linspace(1 - half, 1 + half, 2001)
+            mag = np.abs(loop.frequency_response(omega).magnitude).ravel()
+            k = int(np.argmax(mag))
+            if not 0 < k < mag.size - 1:
+                continue  # no peak inside the window: the pole is cancelled in this loop
+            omega = np.linspace(omega[k - 1], omega[k + 1], 2001)
+            mag = np.abs(loop.frequency_response(omega).magnitude).ravel()
+            k = int(np.argmax(mag))
+            f_k, db = omega[k] / (2 * np.pi), 20 * np.log10(mag[k])
+            if all(abs(f_k / f - 1) > 1e-5 for f, _ in reference):  # a pair shows one peak
+                reference.append((f_k, db))
+        reference = np.array(reference)
+        for peak in axes[axis]["flexible_peaks"]:
+            j = int(np.argmin(np.abs(reference[:, 0] / peak["peak_hz"] - 1)))
+            assert peak["peak_hz"] == pytest.approx(reference[j, 0], rel=1e-6)
+            assert peak["peak_gain_db"] == pytest.approx(reference[j, 1], abs=1e-5)
+            # Definition (docs/linear.md, "Loop gains and margins"): below 0 dB, gain.
+            assert peak["stabilized"] == ("phase" if reference[j, 1] >= 0.0 else "gain")
+        # No mode above 0 dB is missed: each adds two crossovers, so it must be listed.
+        above = reference[reference[:, 1] >= 0.0]
+        listed = [p for p in axes[axis]["flexible_peaks"] if p["stabilized"] == "phase"]
+        assert len(listed) == len(above) and len(ours) == 1 + 2 * len(above)
+        phase_stabilized[axis] = [(p["peak_hz"], p["peak_gain_db"]) for p in listed]
+    # The x loop: one phase-stabilized mode, 0.521 Hz at +28.5 dB, between the 0.415
+    # and 0.709 Hz crossovers; y: none; z: the 1.231 Hz mode at +23.1 dB.
+    assert [round(f, 3) for f, _ in phase_stabilized["x"]] == [0.521]
+    assert phase_stabilized["x"][0][1] == pytest.approx(28.46, abs=0.01)
+    assert phase_stabilized["y"] == []
+    assert [round(f, 3) for f, _ in phase_stabilized["z"]] == [1.231]

@@ -15,7 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 from scipy.linalg import eigh
-from scipy.optimize import brentq
+from scipy.optimize import brentq, minimize_scalar
 
 from flexsat.control.laws import LawConfig, get_law, law_names
 from flexsat.control.laws.pd import PDConfig
@@ -25,6 +25,8 @@ from flexsat.errors import ConfigError
 from flexsat.linear.model import LinearModel
 
 __all__ = [
+    "Crossover",
+    "FlexiblePeak",
     "LoopMargins",
     "effective_inertia",
     "effective_masses",
@@ -37,6 +39,7 @@ __all__ = [
 
 _AXES = ("x", "y", "z")
 _BESIDE_POLE = 1e-7  # relative offset of the grid points beside each pole frequency
+_PEAK_NEAR_MODE = 0.05  # a loop-gain peak belongs to a flexible mode within 5 % of it
 
 
 def rigid_model(plant: Plant) -> LinearModel:
@@ -218,13 +221,63 @@ def pd_loop(model: LinearModel, K: np.ndarray, axis: str) -> LinearModel:
 
 
 @dataclass(frozen=True)
+class Crossover:
+    """One gain crossover of a loop gain: |L| = 1 (0 dB).
+
+    Attributes
+    ----------
+    frequency_hz : float
+        Where |L| crosses 1 [Hz].
+    phase_margin_deg : float
+        180 deg + the phase of L there, in (-180, 180] [deg].
+    delay_margin_s : float
+        The pure delay that brings this crossing onto -180 deg:
+        (phase margin mod 360 deg) / (360 deg * frequency) [s].
+    """
+
+    frequency_hz: float
+    phase_margin_deg: float
+    delay_margin_s: float
+
+
+@dataclass(frozen=True)
+class FlexiblePeak:
+    """The resonance of one flexible mode in a loop gain, and how it is stabilized.
+
+    A mode is *gain-stabilized* when its peak loop gain stays below 0 dB: the loop
+    is stable whatever the phase of the mode, and a gain margin protects it. A mode
+    whose peak rises above 0 dB is *phase-stabilized*: it adds two gain crossovers,
+    and the loop stays stable only because the phase at them keeps away from
+    -180 deg (their phase and delay margins are in :attr:`LoopMargins.crossovers`).
+
+    Attributes
+    ----------
+    mode_hz : float
+        Natural frequency of the satellite's flexible mode (free model) [Hz].
+    peak_hz : float
+        Where |L| peaks [Hz].
+    peak_gain_db : float
+        20 log10 max |L| near the mode [dB]; inf for an undamped mode.
+    stabilized : str
+        ``"gain"`` (peak below 0 dB) or ``"phase"`` (at or above 0 dB).
+    """
+
+    mode_hz: float
+    peak_hz: float
+    peak_gain_db: float
+    stabilized: str
+
+
+@dataclass(frozen=True)
 class LoopMargins:
     """Stability margins of a SISO loop gain (negative feedback).
 
     ``gain_margin`` [-] (inf when the phase never crosses -180 deg above the lowest
     frequency); ``phase_margin_deg`` and ``delay_margin_s`` are the smallest over all
     gain crossovers (a flexible peak above 0 dB adds crossovers); the frequencies
-    are those of the limiting crossing [Hz]; ``crossovers_hz`` lists them all.
+    are those of the limiting crossing [Hz]; ``crossovers_hz`` lists them all, and
+    ``crossovers`` each with its own phase and delay margins; ``flexible_peaks`` the
+    flexible modes that show as a peak of |L|, each gain- or phase-stabilized.
 
     Attributes
     ----------
@@ -242,6 +295,10 @@ class LoopMargins:
         The gain crossover that sets it [Hz].
     crossovers_hz : tuple of float
         Every gain crossover, ascending [Hz].
+    crossovers : tuple of Crossover
+        Every gain crossover with its phase and delay margins, ascending.
+    flexible_peaks : tuple of FlexiblePeak
+        Every peak of |L| at a flexible mode of the satellite, ascending.
     """
 
     gain_margin: float
@@ -251,19 +308,30 @@ class LoopMargins:
     delay_margin_s: float
     delay_crossover_hz: float
     crossovers_hz: tuple[float, ...]
+    crossovers: tuple[Crossover, ...] = ()
+    flexible_peaks: tuple[FlexiblePeak, ...] = ()
 
     def to_dict(self) -> dict:
-        return {k: getattr(self, k) for k in self.__dataclass_fields__}
+        """The margins as JSON-ready values; crossovers and peaks as lists of dicts."""
+        out = {k: getattr(self, k) for k in self.__dataclass_fields__}
+        out["crossovers"] = [vars(c).copy() for c in self.crossovers]
+        out["flexible_peaks"] = [vars(p).copy() for p in self.flexible_peaks]
+        return out
 
 
-def loop_margins(loop: LinearModel, f_min_hz: float = 1e-4, f_max_hz: float = 200.0) -> LoopMargins:
+def loop_margins(
+    loop: LinearModel, f_min_hz: float = 1e-4, f_max_hz: float = 200.0,
+    modes_hz: np.ndarray | None = None,
+) -> LoopMargins:  # fmt: skip
     """Gain, phase and delay margins of a SISO loop gain, from its exact response.
 
     Crossings are bracketed on a log grid of 5000 points, to which the frequency of
     every pole of the loop is added with a point just below and just above it (so
     the two crossings beside a sharp or undamped peak are always bracketed), and are
     refined with Brent's method on the exact response (no fitting); phase crossings
-    likewise.
+    likewise. The peaks of |L| are the grid's local maxima refined by a bounded
+    scalar search between their neighbouring grid points; one within 5 % of a
+    flexible mode's frequency is that mode's peak (:class:`FlexiblePeak`).
 
     Parameters
     ----------
@@ -271,6 +339,9 @@ def loop_margins(loop: LinearModel, f_min_hz: float = 1e-4, f_max_hz: float = 20
         SISO loop gain L(s) (one input, one output) [-].
     f_min_hz, f_max_hz : float
         Frequency band searched [Hz].
+    modes_hz : ndarray, optional
+        Natural frequencies of the satellite's flexible modes [Hz]; default: those of
+        the loop's own lightly damped poles (damping ratio below 0.3).
 
     Returns
     -------
@@ -298,9 +369,11 @@ def loop_margins(loop: LinearModel, f_min_hz: float = 1e-4, f_max_hz: float = 20
         for k in np.nonzero(np.sign(log_mag[:-1]) != np.sign(log_mag[1:]))[0]
     ]
     pm, dm, f_pm, f_dm = np.inf, np.inf, np.nan, np.nan
+    crossovers = []
     for fc in cross:
         margin = np.angle(-L(fc))  # phase above -180 deg, in (-pi, pi]
         delay = (margin % (2 * np.pi)) / (2 * np.pi * fc)  # phase a delay can eat first
+        crossovers.append(Crossover(float(fc), float(np.degrees(margin)), float(delay)))
         if abs(np.degrees(margin)) < abs(pm):
             pm, f_pm = float(np.degrees(margin)), fc
         if delay < dm:
@@ -315,4 +388,36 @@ def loop_margins(loop: LinearModel, f_min_hz: float = 1e-4, f_max_hz: float = 20
         g = 1.0 / mag
         if abs(np.log(g)) < abs(np.log(gm)):
             gm, f_gm = float(g), fp
-    return LoopMargins(gm, f_gm, pm, f_pm, dm, f_dm, tuple(float(c) for c in cross))
+    if modes_hz is None:
+        light = lam[(lam.imag > 0) & (-lam.real < 0.3 * np.abs(lam))]
+        modes_hz = np.abs(light) / (2 * np.pi)
+    peaks = _flexible_peaks(L, lam, f, np.abs(G), np.asarray(modes_hz, dtype=float))
+    return LoopMargins(gm, f_gm, pm, f_pm, dm, f_dm, tuple(float(c) for c in cross),
+                       tuple(crossovers), peaks)  # fmt: skip
+
+
+def _flexible_peaks(L, lam: np.ndarray, f: np.ndarray, mag: np.ndarray,
+                    modes_hz: np.ndarray) -> tuple[FlexiblePeak, ...]:  # fmt: skip
+    """The local maxima of |L| on the grid, refined, each named by its flexible mode."""
+    if modes_hz.size == 0:
+        return ()
+    undamped = np.abs(lam[(lam.imag > 0) & (-lam.real <= 1e-9 * np.abs(lam))]) / (2 * np.pi)
+    peaks: dict[int, FlexiblePeak] = {}
+    for k in np.nonzero((mag[1:-1] > mag[:-2]) & (mag[1:-1] >= mag[2:]))[0] + 1:
+        if np.any(np.abs(undamped / f[k] - 1) < 10 * _BESIDE_POLE):
+            f_peak, gain = f[k], np.inf  # an undamped mode: |L| has no finite peak
+        else:
+            best = minimize_scalar(lambda x: -abs(L(np.exp(x))), method="bounded",
+                                   bounds=(np.log(f[k - 1]), np.log(f[k + 1])),
+                                   options={"xatol": 1e-12})  # fmt: skip
+            f_peak, gain = float(np.exp(best.x)), float(-best.fun)
+            if gain < mag[k]:  # never below the grid point that found it
+                f_peak, gain = f[k], mag[k]
+        m = int(np.argmin(np.abs(np.log(modes_hz / f_peak))))
+        if abs(modes_hz[m] / f_peak - 1) > _PEAK_NEAR_MODE:
+            continue  # a closed rigid loop's bump, not a flexible mode
+        db = 20 * np.log10(gain)
+        if m not in peaks or db > peaks[m].peak_gain_db:
+            peaks[m] = FlexiblePeak(float(modes_hz[m]), float(f_peak), float(db),
+                                    "gain" if db < 0.0 else "phase")  # fmt: skip
+    return tuple(peaks[m] for m in sorted(peaks))

@@ -30,6 +30,7 @@ __all__ = [
     "FIGURES",
     "FrequencyResponses",
     "frequency_grid_hz",
+    "phase_deg",
     "plot_bode",
     "plot_effective_inertia",
     "plot_loop_family",
@@ -60,6 +61,31 @@ def frequency_grid_hz(n: int = 3000) -> np.ndarray:
         The frequencies [Hz].
     """
     return np.geomspace(1e-3, 200.0, n)
+
+
+def phase_deg(response: np.ndarray) -> np.ndarray:
+    """The phase every figure draws: unwrapped along frequency, one branch from the start.
+
+    The phase is continuous over the grid (``numpy.unwrap``, no jump above 180 deg
+    between neighbouring frequencies), and the whole curve is shifted by a multiple
+    of 360 deg so that its lowest-frequency value lies in (-270, 90] deg: a double
+    integrator (torque to attitude, the loop gains) starts at -180 deg, a single one
+    (torque to rate) at -90 deg, whichever side of the branch cut the first complex
+    value's round-off falls.
+
+    Parameters
+    ----------
+    response : ndarray, shape (n_f,) or (n_f, ...)
+        Complex response, frequency along the first axis.
+
+    Returns
+    -------
+    ndarray
+        Phase [deg], the shape of ``response``.
+    """
+    phase = np.degrees(np.unwrap(np.angle(response), axis=0))
+    turns = np.ceil((phase[:1] + 270.0) / 360.0) - 1.0  # start in (-270, 90] deg
+    return phase - 360.0 * turns
 
 
 class FrequencyResponses:
@@ -139,7 +165,7 @@ def plot_bode(
             G = diagonal[model][:, a]
             colour = style.AXIS_COLOURS[a] if ls == "-" else "0.4"
             axes[0, a].loglog(f, np.abs(G), ls, color=colour, label=label)
-            axes[1, a].semilogx(f, np.degrees(np.unwrap(np.angle(G))), ls, color=colour)
+            axes[1, a].semilogx(f, phase_deg(G), ls, color=colour, label=label)
         axes[0, a].set_title(f"tau_{axis} -> {out}")
         axes[0, a].set_ylabel(f"|G| [{unit}]")
         axes[1, a].set_ylabel("phase [deg]")
@@ -258,6 +284,11 @@ def plot_loops(
 ) -> Figure:  # fmt: skip
     """Loop gain per axis: Bode with 0 dB, -180 deg, crossovers and flexible modes marked.
 
+    Every gain crossover is a dot on 0 dB labelled with its phase margin, and the
+    phase there a dot on the phase plot; the crossover that sets the delay margin is
+    ringed in red. Each flexible mode's peak is a triangle labelled with its peak
+    loop gain and ``G`` (gain-stabilized, below 0 dB) or ``P`` (phase-stabilized).
+
     Parameters
     ----------
     loops : dict of str to LinearModel
@@ -281,18 +312,36 @@ def plot_loops(
         L = responses(loops[axis])[:, 0, 0]
         m = margins[axis]
         colour = style.AXIS_COLOURS[a]
+        phase = phase_deg(L)
         axes[0, a].loglog(f, np.abs(L), color=colour)
-        axes[1, a].semilogx(f, np.degrees(np.unwrap(np.angle(L))), color=colour)
+        axes[1, a].semilogx(f, phase, color=colour)
         axes[0, a].axhline(1.0, color="0.3", linewidth=0.8)
         axes[1, a].axhline(-180.0, color="0.3", linewidth=0.8)
         for fm in modes_hz:
             for ax in axes[:, a]:
                 ax.axvline(fm, color="0.75", linewidth=0.6, linestyle=":")
-        for fc in m.crossovers_hz:
-            axes[0, a].plot(fc, 1.0, "o", color="k", ms=4)
+        for k, c in enumerate(m.crossovers):  # labels stepped down: close crossovers
+            axes[0, a].plot(c.frequency_hz, 1.0, "o", color="k", ms=4)
+            axes[0, a].annotate(f"PM {c.phase_margin_deg:.0f}°", (c.frequency_hz, 1.0),
+                                textcoords="offset points", xytext=(3, -11 - 10 * k),
+                                fontsize=7)  # fmt: skip
+            # The crossing's exact phase, PM - 180 deg, on the branch the curve is drawn on.
+            near = np.interp(np.log(c.frequency_hz), np.log(f), phase)
+            at = c.phase_margin_deg - 180.0
+            at += 360.0 * np.round((near - at) / 360.0)
+            axes[1, a].plot(c.frequency_hz, at, "o", color="k", ms=4)
+            if c.frequency_hz == m.delay_crossover_hz:
+                for ax, y in ((axes[0, a], 1.0), (axes[1, a], at)):
+                    ax.plot(c.frequency_hz, y, "o", mfc="none", mec="tab:red", ms=10, mew=1.5)
+        for p in m.flexible_peaks:
+            gain = 10 ** (p.peak_gain_db / 20) if np.isfinite(p.peak_gain_db) else np.abs(L).max()
+            axes[0, a].plot(p.peak_hz, gain, "v", color="k", ms=5)
+            axes[0, a].annotate(f"{p.peak_gain_db:+.1f} dB {p.stabilized[0].upper()}",
+                                (p.peak_hz, gain), textcoords="offset points", xytext=(4, 2),
+                                fontsize=7)  # fmt: skip
         axes[0, a].set_title(
             f"axis {axis}: PM {m.phase_margin_deg:.1f} deg, GM {_db(m.gain_margin)}, "
-            f"DM {m.delay_margin_s:.3g} s",
+            f"DM {m.delay_margin_s:.3g} s at {m.delay_crossover_hz:.3g} Hz (red)",
             fontsize=9,
         )
         axes[0, a].set_ylabel("|L| [-]")
@@ -300,7 +349,8 @@ def plot_loops(
         axes[1, a].set_xlabel("frequency [Hz] (dotted: flexible modes)")
     for ax in axes.ravel():
         ax.grid(True, which="both", color="0.88", linewidth=0.5)
-    fig.suptitle("PD loop gain per axis (loop broken at that torque, others closed)")
+    fig.suptitle("Loop gain per axis (loop broken at that torque, others closed); "
+                 "flexible peaks: G gain-, P phase-stabilized")  # fmt: skip
     return fig
 
 
@@ -326,7 +376,7 @@ def plot_nichols(
     ax = axes[0, 0]
     for a, axis in enumerate(style.AXES):
         L = responses(loops[axis])[:, 0, 0]
-        ax.plot(np.degrees(np.unwrap(np.angle(L))), 20 * np.log10(np.abs(L)),
+        ax.plot(phase_deg(L), 20 * np.log10(np.abs(L)),
                 color=style.AXIS_COLOURS[a], label=f"axis {axis}")  # fmt: skip
     ax.plot(-180.0, 0.0, "+", color="k", ms=12, mew=2)
     ax.set_xlabel("open-loop phase [deg]")

@@ -438,17 +438,39 @@ def _frequency(root: Path, outputs: dict, context: dict) -> str:
     ]
     rows = [[axis, *(src.cell("axes", axis, key) for key, _ in keys)] for axis in src.get("axes")]
     law = _esc(str(src.get("law")).upper())
+    axes = src.get("axes")
+    crossings = [
+        [axis, *(src.cell("axes", axis, "crossovers", k, key)
+                 for key in ("frequency_hz", "phase_margin_deg", "delay_margin_s")),
+         "sets the delay margin" if c["frequency_hz"] == m["delay_crossover_hz"] else ""]
+        for axis, m in axes.items() for k, c in enumerate(m.get("crossovers", []))
+    ]  # fmt: skip
+    peaks = [
+        [axis, *(src.cell("axes", axis, "flexible_peaks", k, key)
+                 for key in ("mode_hz", "peak_hz", "peak_gain_db", "stabilized"))]
+        for axis, m in axes.items() for k in range(len(m.get("flexible_peaks", [])))
+    ]  # fmt: skip
     return "".join([
         f"<p>The nominal slew's law ({law}) linearized about rest and closed around the "
         "flexible plant, one axis at a time (the loop broken at that axis's torque, the "
         "others closed); the sliding-mode laws inside their boundary layer with Λ and JK "
         "at their steady-state values. Bode plots compare the flexible plant with its "
         "rigid model (alternating pole–zero pairs of the flexible modes); the loop-gain "
-        "figure marks the flexible modes (dotted) and every 0 dB crossover, so a "
-        "flexible peak that crosses 0 dB shows as an extra crossover and a smaller "
-        "margin.</p>",
+        "figure marks the flexible modes (dotted), every 0 dB crossover with its phase "
+        "margin, the crossover that sets the delay margin (red) and each flexible "
+        "peak with its loop gain, so a flexible peak that crosses 0 dB shows as two "
+        "extra crossovers and a smaller delay margin.</p>",
         _table(["axis", *(label for _, label in keys)], rows,
                f"Loop margins of the {law} law per axis", sortable=True),
+        _table(["axis", "gain crossover [Hz]", "phase margin [deg]", "delay margin [s]", ""],
+               crossings, "Every gain crossover: its phase margin and the delay that "
+               "brings it onto −180°", sortable=True),
+        "<p>A flexible mode is <em>gain-stabilized</em> when its peak loop gain stays "
+        "below 0 dB, whatever its phase; <em>phase-stabilized</em> when the peak rises "
+        "above 0 dB: it adds two gain crossovers, and the loop is stable only because "
+        "the phase there keeps away from −180° (their margins above).</p>",
+        _table(["axis", "mode [Hz]", "peak at [Hz]", "peak loop gain [dB]", "stabilized"],
+               peaks, "Peak loop gain of each flexible mode seen by the loop", sortable=True),
         _figures(root, outputs["figures"]),
     ])  # fmt: skip
 
