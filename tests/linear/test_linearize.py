@@ -149,6 +149,15 @@ def test_spin_about_the_intermediate_axis_is_unstable(plant):
     assert linearize(plant, about=[0.5, 0.0, 0.0]).poles().real.max() < 1e-9
 
 
+def test_the_whole_model_converts_to_python_control(rest_model):
+    # Tip outputs and joint states are named "panel_1.tip_x"...: python-control takes
+    # the states as named and the outputs with "_" for ".".
+    sys = rest_model.to_statespace()
+    assert "panel_1_tip_x" in sys.output_labels and "panel_1.eta_x" in sys.state_labels
+    assert sys.noutputs == len(rest_model.output_names)
+    assert np.array_equal(sys.C, rest_model.C)
+
+
 def test_statespace_round_trips_through_python_control(plant, rest_model):
     import control
 

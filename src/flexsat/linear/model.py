@@ -29,7 +29,7 @@ import numpy as np
 
 from flexsat.errors import ConfigError
 
-__all__ = ["MAT_VARIABLES", "LinearModel"]
+__all__ = ["MAT_VARIABLES", "LinearModel", "statespace_name"]
 
 _BATCH = 256  # frequencies solved at once (stacked LAPACK calls)
 
@@ -124,13 +124,20 @@ class LinearModel:
         return out
 
     def to_statespace(self):
-        """The model as a ``control.StateSpace`` with the signal names attached."""
+        """The model as a ``control.StateSpace`` with the signal names attached.
+
+        python-control keeps the dot for a subsystem's signal in an interconnection
+        and refuses it in an input or output name, so there each ``.`` of a name
+        becomes ``_`` (:func:`statespace_name`: ``panel_1.tip_x`` -> ``panel_1_tip_x``);
+        state names are kept as they are.
+        """
         import control
 
         return control.ss(
             self.A, self.B, self.C, self.D,
-            states=list(self.state_names), inputs=list(self.input_names),
-            outputs=list(self.output_names), name="flexsat",
+            states=list(self.state_names),
+            inputs=[statespace_name(n) for n in self.input_names],
+            outputs=[statespace_name(n) for n in self.output_names], name="flexsat",
         )  # fmt: skip
 
     def to_dict(self) -> dict:
@@ -167,6 +174,22 @@ class LinearModel:
         with replacing(path) as handle:  # a link at path is replaced, never followed
             savemat(handle, data, oned_as="column")
         return path
+
+
+def statespace_name(name: str) -> str:
+    """An input or output name as python-control accepts it: each ``.`` made ``_``.
+
+    Parameters
+    ----------
+    name : str
+        A signal name of a :class:`LinearModel` (``"panel_1.tip_x"``).
+
+    Returns
+    -------
+    str
+        ``"panel_1_tip_x"``.
+    """
+    return name.replace(".", "_")
 
 
 def _indices(names: list[str] | None, allowed: tuple[str, ...], what: str) -> list[int]:
