@@ -135,3 +135,44 @@ def test_log_axes_keep_only_the_ticks_in_view_and_draw_the_same_image(tmp_path):
         lo, hi = sorted(axis.get_view_interval())
         for ticks in (axis.get_majorticklocs(), axis.get_minorticklocs()):
             assert ticks.size and np.all((ticks >= lo * (1 - 1e-6)) & (ticks <= hi * (1 + 1e-6)))
+
+
+# A name that matplotlib would parse as mathtext (two $) and refuse (an unknown command).
+_HOSTILE = r"cost $x^{ $ and \undefinedcommand_y"
+
+
+def _drawn(text) -> tuple[str, bool]:
+    """What matplotlib draws for a Text: (string, whether it is parsed as mathtext)."""
+    return text._preprocess_math(text.get_text())
+
+
+@pytest.mark.parametrize("name", [_HOSTILE, r"a\$b", "$", "plain_name {x}"])
+def test_literal_text_is_drawn_as_written(name):
+    fig, axes = style.figure(1, 1, size=(6.0, 3.0))
+    ax = axes[0, 0]
+    ax.plot([0.0, 1.0], [0.0, 1.0], label=style.literal(name))
+    ax.set_title(style.literal(name))
+    legend = ax.legend()
+    FigureCanvasAgg(fig).draw()  # an unknown mathtext command would raise here
+    assert _drawn(ax.title) == (name, False)
+    assert _drawn(legend.get_texts()[0]) == (name, False)
+
+
+def test_literal_text_beside_the_figures_own_mathtext_stays_literal():
+    fig, axes = style.figure(1, 1, size=(6.0, 3.0))
+    title = axes[0, 0].set_title(rf"$\omega_z$ of {style.literal('run $1 and $2')}")
+    FigureCanvasAgg(fig).draw()
+    text, math = _drawn(title)
+    assert math  # the figure's own symbol is still mathtext...
+    assert text.endswith(r"of run \$1 and \$2")  # ...where \$ is mathtext's literal dollar
+
+
+def test_a_failed_runs_title_and_message_are_drawn_as_written():
+    ds = xr.Dataset(attrs={"title": f"flexsat slew run '{_HOSTILE}'", "status": "failed",
+                           "message": "diverged at $t$ = 3 s"})  # fmt: skip
+    fig, _ = style.figure(1, 1, size=(6.0, 3.0))
+    style.suptitle(fig, ds, "Pointing")
+    FigureCanvasAgg(fig).draw()
+    text, math = _drawn(fig._suptitle)
+    assert not math
+    assert text == f"Pointing\nflexsat slew run '{_HOSTILE}'  —  FAILED: diverged at $t$ = 3 s"
