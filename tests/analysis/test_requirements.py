@@ -14,6 +14,7 @@ from flexsat.analysis import (
     relative_performance_error,
     slew_metrics,
 )
+from flexsat.analysis.requirements import residual_rate_verdict
 from flexsat.control.quaternion import quaternion_error, target_quaternion
 from flexsat.errors import ConfigError
 from flexsat.simulate import SlewScenario, load_slew, run_slew
@@ -228,3 +229,94 @@ def test_the_window_is_set_in_the_slew_toml(tmp_path):
 def test_a_law_without_lambda_has_no_switch_time():
     metrics = slew_metrics(synthetic_slew(settles, quiet).drop_vars("lambda_act"))
     assert np.isnan(metrics["lambda_switch_time_s"]) and metrics["r1_pass"]
+
+
+# --- stability verdict from the residual-rate envelope, and R3 of a unit actuator ---
+
+WINDOW = (90.0, 120.0)
+BAND = 1e-3  # [deg/s] R2's jitter band
+CYCLE_HZ = 2.45  # [Hz] the delayed ASMC loop's oscillation about Z (docs/guide/avionics.md)
+
+
+def _rate(amplitude, t):
+    """|A(t) sin(2 pi f t)|: a residual rate oscillating at CYCLE_HZ [deg/s]."""
+    return np.abs(amplitude(t) * np.sin(2.0 * np.pi * CYCLE_HZ * t))
+
+
+@pytest.mark.parametrize(
+    ("amplitude", "verdict"),
+    [
+        (lambda t: 0.26 + 0 * t, "limit cycle"),  # constant above the band
+        (lambda t: 0.26 * np.exp(-(t - 90.0) / 5.0), "stable"),  # halves every 3.5 s
+        (lambda t: 0.26 * np.exp((t - 90.0) / 5.0), "diverges"),  # doubles every 3.5 s
+        (lambda t: 5e-4 + 0 * t, "stable"),  # constant inside the band: a forced response
+        (lambda t: 1e-9 * np.exp((t - 90.0) / 3.0), "stable"),  # grows to 2e-5, inside the band
+    ],
+    ids=["constant", "decaying", "growing", "inside the band", "growing inside the band"],
+)
+def test_the_residual_rate_envelope_classifies_the_loop(amplitude, verdict):
+    # 10 ms records, the slew's. The envelope of each half of the 90-120 s window is
+    # its peak: for the constant 0.26 deg/s oscillation, 0.26 to the sampling of the
+    # sine's crest (2.45 Hz at 100 Hz: within 1 - cos(pi f dt) = 0.3 %).
+    t = np.round(np.arange(0.0, 120.0 + 5e-3, RECORD_DT), 10)
+    result = residual_rate_verdict(t, _rate(amplitude, t), WINDOW, BAND)
+    assert result["verdict"] == verdict
+    assert result["span_s"] == [90.0, 120.0]
+    if verdict == "limit cycle":
+        assert result["envelope_last_deg_s"] == pytest.approx(0.26, rel=3e-3)
+        assert result["envelope_ratio"] == pytest.approx(1.0, abs=3e-3)
+
+
+def test_the_envelope_ratio_is_the_halves_peak_ratio():
+    # exp(-t/5) over halves of 15 s: the ratio of the halves' peaks (their first
+    # records, 90 and 105 s) is exp(-3) = 0.0498, to the crest sampling (0.3 %).
+    t = np.round(np.arange(0.0, 120.0 + 5e-3, RECORD_DT), 10)
+    rate = 0.26 * np.exp(-(t - 90.0) / 5.0) * (1.0 + 0 * t)
+    result = residual_rate_verdict(t, rate, WINDOW, BAND)
+    assert result["envelope_first_deg_s"] == pytest.approx(0.26, rel=1e-12)
+    assert result["envelope_ratio"] == pytest.approx(np.exp(-3.0), rel=1e-3)
+    assert result["verdict"] == "stable"
+
+
+def test_a_stopped_run_diverges_and_a_short_one_is_judged_on_its_last_quarter():
+    t = np.round(np.arange(0.0, 40.0 + 5e-3, RECORD_DT), 10)
+    rate = _rate(lambda s: 0.15 + 0 * s, t)
+    # a run that stopped (non-finite state) diverges whatever its records show
+    assert residual_rate_verdict(t, rate, WINDOW, BAND, stopped=True)["verdict"] == "diverges"
+    # a 40 s run does not reach the 90-120 s window (nor does a window past its end,
+    # as a shortened scenario gives, (90, 40)): its last quarter, 30-40 s, is judged
+    for window in (WINDOW, (90.0, 40.0)):
+        result = residual_rate_verdict(t, rate, window, BAND)
+        assert result["span_s"] == [30.0, 40.0]
+        assert result["verdict"] == "limit cycle"
+        assert result["envelope_last_deg_s"] == pytest.approx(0.15, rel=3e-3)
+
+
+def _wheel_slew(torque_ratio: float, applied_nm: float, saturated: bool = False):
+    """A synthetic slew with a wheel cluster's records: the hub torque (motors plus the
+    wheels' gyroscopic torque) at ``applied_nm`` on X, the motor torque asked of the
+    fullest wheel at ``torque_ratio`` of its limit."""
+    ds = synthetic_slew(settles, quiet)
+    n = ds.sizes["time"]
+    tau = np.zeros((n, 3))
+    tau[n // 2, 0] = applied_nm
+    return ds.assign(
+        tau_applied=(("time", "axis"), tau),
+        actuator_torque_ratio=("time", np.full(n, torque_ratio)),
+        actuator_saturated=("time", np.where(np.arange(n) == n // 2, float(saturated), 0.0)),
+    )
+
+
+def test_r3_of_a_wheel_cluster_is_judged_on_what_each_wheel_is_asked():
+    # 3.1 N m on the hub (the T_max = 2 N m rule's failure, measured on a wheel
+    # cluster biased at 3000 rpm: tests/control/test_wheels.py) with each motor asked
+    # 99 % of its limit and no wheel at its momentum limit: R3 holds.
+    metrics = slew_metrics(_wheel_slew(0.99, 3.1))
+    assert metrics["r3_pass"] and metrics["max_abs_torque_nm"][0] == 3.1
+    # a motor asked beyond its limit (clipped: the cluster does not deliver), or a
+    # wheel at its momentum limit, fails it whatever the hub torque
+    assert not slew_metrics(_wheel_slew(1.234, 1.7))["r3_pass"]
+    assert not slew_metrics(_wheel_slew(0.5, 1.7, saturated=True))["r3_pass"]
+    # an actuator without units keeps the hub-torque rule
+    no_units = _wheel_slew(0.99, 3.1).drop_vars(["actuator_torque_ratio"])
+    assert not slew_metrics(no_units)["r3_pass"]

@@ -26,6 +26,7 @@ __all__ = [
     "error_rotation_vector",
     "observation_window",
     "relative_performance_error",
+    "residual_rate_verdict",
     "settling_time",
     "slew_metrics",
 ]
@@ -231,6 +232,92 @@ def actuator_saturation_times(ds: xr.Dataset) -> dict[str, float]:
     return times
 
 
+DECAY_RATIO = 0.5
+"""A residual-rate envelope whose peak over the judged span's second half is at most
+this share of its peak over the first half decays (:func:`residual_rate_verdict`)."""
+GROWTH_RATIO = 2.0
+"""One whose second-half peak is at least this multiple of the first half's grows."""
+
+
+def residual_rate_verdict(
+    t: np.ndarray,
+    rate_deg_s: np.ndarray,
+    window: tuple[float, float],
+    band_deg_s: float,
+    stopped: bool = False,
+) -> dict:
+    """Is a closed loop stable, in a limit cycle or diverging, from its residual rate.
+
+    The span judged is ``window`` (the observation window R1 and R2 are judged over),
+    or the last quarter of the records when they do not reach the window's end (a
+    shortened run: its first three quarters may still hold the manoeuvre). It is cut
+    in two halves; the envelope of each is its peak residual rate. The verdict
+    (``docs/control.md``, 'Stability verdict of the delay sweep'):
+
+    1. ``"diverges"``: the run stopped (a state went non-finite);
+    2. ``"stable"``: the second half's peak is inside the jitter band ``band_deg_s``
+       (an oscillation that small is not told apart from the disturbances' forced
+       response);
+    3. ``"diverges"``: the envelope grows, the second half's peak at least
+       :data:`GROWTH_RATIO` times the first's;
+    4. ``"stable"``: the envelope decays, the second half's peak at most
+       :data:`DECAY_RATIO` times the first's;
+    5. ``"limit cycle"``: otherwise, an oscillation above the band that neither
+       decays nor grows; its amplitude is the second half's peak.
+
+    Parameters
+    ----------
+    t : ndarray, shape (n,)
+        Record times [s], increasing.
+    rate_deg_s : ndarray, shape (n,)
+        Residual rate ‖ω − ω_d‖ at each record [deg/s].
+    window : tuple of float
+        Observation window (start, end) [s].
+    band_deg_s : float
+        The jitter band (R2's) [deg/s].
+    stopped : bool
+        The run stopped before its end (non-finite state).
+
+    Returns
+    -------
+    dict
+        ``verdict`` (``"stable"``, ``"limit cycle"`` or ``"diverges"``), ``span_s``
+        (start, end) judged [s], ``envelope_first_deg_s`` and
+        ``envelope_last_deg_s``, the peaks over its halves [deg/s] (NaN without
+        records), and ``envelope_ratio`` [-], the second over the first.
+    """
+    t = np.asarray(t, dtype=float)
+    rate = np.abs(np.asarray(rate_deg_s, dtype=float))
+    start, end = window
+    if t.size == 0 or end <= start or t[-1] < end - _TIME_TOL:  # the window is not covered
+        end = float(t[-1]) if t.size else end
+        start = float(t[0]) + 0.75 * (end - float(t[0])) if t.size else start
+    middle = 0.5 * (start + end)
+    first = rate[(t >= start - _TIME_TOL) & (t < middle)]
+    last = rate[(t >= middle) & (t <= end + _TIME_TOL)]
+    peak_first = float(np.max(first)) if first.size else float("nan")
+    peak_last = float(np.max(last)) if last.size else float("nan")
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ratio = float(np.divide(peak_last, peak_first))
+    if stopped or not np.isfinite(peak_last):
+        verdict = "diverges"
+    elif peak_last < band_deg_s:
+        verdict = "stable"
+    elif ratio >= GROWTH_RATIO:
+        verdict = "diverges"
+    elif ratio <= DECAY_RATIO:
+        verdict = "stable"
+    else:
+        verdict = "limit cycle"
+    return {
+        "verdict": verdict,
+        "span_s": [float(start), float(end)],
+        "envelope_first_deg_s": peak_first,
+        "envelope_last_deg_s": peak_last,
+        "envelope_ratio": ratio,
+    }
+
+
 def _stored_scenario(ds: xr.Dataset) -> dict:
     text = ds.attrs.get("scenario")
     return json.loads(text) if text else {}
@@ -256,9 +343,14 @@ def slew_metrics(ds: xr.Dataset, *, requirements: Requirements | None = None) ->
         Keys end in their unit. R1: the pointing error stays below ``pointing_deg``
         at every record of ``observation_window_s`` (start, end); R2: the residual
         rate stays below ``jitter_deg_s`` there; both fail when the records do not
-        reach the window's end (a run shorter than the deadline, or stopped). R3:
-        ‖applied torque‖ <= T_max on every axis at every record and no actuator
-        unit saturated (``actuator_saturation_s``: when each first did). ``ape_deg`` and
+        reach the window's end (a run shorter than the deadline, or stopped). R3, the
+        actuator asked no more than it can give (``docs/control.md``, 'R3 with an
+        actuator of units'): an actuator of units that records
+        ``actuator_torque_ratio`` (a wheel cluster: the largest motor torque asked of a
+        unit over its limit) passes when that ratio stays <= 1 at every record and no
+        unit saturated; any other, when ‖applied torque‖ <= T_max on every axis at
+        every record and no unit saturated (``actuator_saturation_s``: when each
+        first did). ``max_abs_torque_nm`` is the applied torque's peak either way. ``ape_deg`` and
         ``rpe_deg`` are the APE and RPE over the window (RPE over windows of
         ``rpe_window_s``), ``max_rate_error_deg_s`` the largest residual rate there.
         Settling times are when each quantity enters its band for good (NaN if not
@@ -293,6 +385,11 @@ def slew_metrics(ds: xr.Dataset, *, requirements: Requirements | None = None) ->
     applied = np.abs(ds.variables["tau_applied"].values)
     commanded = np.abs(ds.variables["tau_cmd"].values)
     saturation = actuator_saturation_times(ds)
+    if "actuator_torque_ratio" in ds:  # the units' own limits (a wheel's gyroscopic
+        asked = ds.variables["actuator_torque_ratio"].values  # torque is no motor's)
+        within = bool(np.all(asked <= 1.0 + 1e-12))
+    else:
+        within = bool(np.all(applied <= t_max_nm * (1 + 1e-12)))
     leaves = np.nonzero(lam > lam[0] * (1 + 1e-9))[0]
     return {
         "controller": str(ds.attrs.get("controller", "")),
@@ -309,7 +406,7 @@ def slew_metrics(ds: xr.Dataset, *, requirements: Requirements | None = None) ->
         "max_rate_error_deg_s": max_rate,
         "max_abs_torque_nm": applied.max(axis=0).tolist(),
         "max_commanded_torque_nm": commanded.max(axis=0).tolist(),
-        "r3_pass": bool(np.all(applied <= t_max_nm * (1 + 1e-12))) and not saturation,
+        "r3_pass": within and not saturation,
         "actuator_saturation_s": saturation,
         "lambda_switch_time_s": float(t[leaves[0]]) if leaves.size else float("nan"),
         "final_euler_deg": ds.variables["euler_deg"].values[-1].tolist(),

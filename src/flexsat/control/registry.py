@@ -37,16 +37,21 @@ class Channel:
         One line for the dataset and the docs.
     per_axis : bool
         True: three columns (body axes x, y, z, dims ``(time, axis)``); False: one.
+    per_unit : int
+        More than 0 (and not ``per_axis``): one column for each of that many units of
+        the stage, e.g. the wheels of a cluster (dims ``(time, unit)``, column k for
+        unit k + 1; a stage with fewer units records NaN in the others).
     """
 
     name: str
     units: str
     description: str
     per_axis: bool = False
+    per_unit: int = 0
 
     @property
     def size(self) -> int:
-        return 3 if self.per_axis else 1
+        return 3 if self.per_axis else max(self.per_unit, 1)
 
 
 def channel_columns(channels: tuple[Channel, ...]) -> dict[str, slice]:

@@ -320,9 +320,10 @@ def finish_slew(run: PreparedSlew, status: int, done: int, rows: int, wall: floa
         """The control channels, pointing and rate errors, from the records."""
         more = {}
         for channel, columns in layout.channels():
-            values = rec_ctrl[:, columns] if channel.per_axis else rec_ctrl[:, columns.start]
+            dims = ta if channel.per_axis else ("time", "unit") if channel.per_unit else "time"
+            values = rec_ctrl[:, columns] if len(dims) == 2 else rec_ctrl[:, columns.start]
             attributes = {"units": channel.units, "long_name": channel.description}
-            more[channel.name] = (ta if channel.per_axis else "time", values, attributes)
+            more[channel.name] = (dims, values, attributes)
         # of the true attitude (relative to N), whatever the sensor measured
         q_N, omega = data_vars["q"][1], data_vars["omega"][1]
         pointing = pointing_errors(target, np.ascontiguousarray(q_N[:, at.attitude]))

@@ -276,7 +276,7 @@ def wheels_step(tau_cmd, t, dt, params, state, tau_applied, record):
     p, s = params, state
     n = int(p[_N])
     bias = p[_IS] * p[_WBIAS]
-    hx, hy, hz, h2, h_abs, saturated = 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
+    hx, hy, hz, h2, h_abs, saturated, asked = 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
     for i in range(n):
         u = 0.0
         for a in range(3):
@@ -284,8 +284,10 @@ def wheels_step(tau_cmd, t, dt, params, state, tau_applied, record):
         if p[_KNULL] != 0.0:  # null-space momentum management, off by default
             for j in range(n):
                 u -= p[_KNULL] * p[_NULL + MAX_WHEELS * i + j] * (_momentum(p, s, j) - bias)
+        asked = max(asked, abs(u))
         s[2 * n + i] = min(p[_UMAX], max(-p[_UMAX], u))
         h = _momentum(p, s, i)
+        record[8 + i] = h * p[_INV_IS] / _RPM  # the axial spin rate [rpm]
         hx += p[_A + i] * h
         hy += p[_A + MAX_WHEELS + i] * h
         hz += p[_A + 2 * MAX_WHEELS + i] * h
@@ -302,6 +304,9 @@ def wheels_step(tau_cmd, t, dt, params, state, tau_applied, record):
     record[5] = s[3 * n + 1]
     record[6] = h_abs / p[_IS] / p[_WMAX]  # the max of each wheel's ratio, bit for bit
     record[7] = saturated
+    for i in range(n, MAX_WHEELS):
+        record[8 + i] = np.nan  # no such wheel
+    record[8 + MAX_WHEELS] = asked / p[_UMAX]
     return 0
 
 
@@ -315,6 +320,11 @@ WHEELS = StageSpec(
         Channel("wheel_friction_loss", "J", "integral of sum f_i Omega_i"),
         Channel("wheel_speed_ratio", "1", "max |h_i| / (I_s Omega_max)"),
         Channel("actuator_saturated", "1", "bit i set: wheel i at its momentum limit"),
+        Channel("wheel_speed", "rpm", "h_i / I_s: each wheel's axial spin rate (its speed "
+                "relative to the hub plus a_i . omega)", per_unit=MAX_WHEELS),
+        Channel("actuator_torque_ratio", "1",
+                "max |u_cmd,i| / u_max: the largest motor torque asked of a wheel (before "
+                "its clip) over the motor limit"),
     ),
     description="reaction-wheel cluster, momenta integrated with the plant",
 )  # fmt: skip
