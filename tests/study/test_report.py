@@ -201,3 +201,32 @@ def test_a_section_that_cannot_be_drawn_fails_its_part(tmp_path):
     write_report(out)
     entry = json.loads((out / "study.json").read_text())["parts"][0]
     assert entry["status"] == "ok" and entry["error"] is None and "report_failed" not in entry
+
+
+def test_the_margins_table_lists_every_crossover_and_flexible_peak(tmp_path):
+    from flexsat.config import nominal
+    from flexsat.dynamics.plant import Plant
+    from flexsat.simulate import SlewScenario
+    from flexsat.study import report as report_module
+    from flexsat.study.linear import write_margins
+
+    # The study's frequency part: the nominal slew's law (ASMC) about rest.
+    summary = write_margins(Plant.from_config(nominal()), SlewScenario())
+    (tmp_path / "frequency").mkdir()
+    (tmp_path / "frequency" / "margins.json").write_text(json.dumps(summary))
+    section = report_module._frequency(tmp_path, {"json": "frequency/margins.json",
+                                                  "figures": []}, {})  # fmt: skip
+    parser = _Cells()
+    parser.feed(section)
+    shown = {cell["data-path"]: json.loads(cell["data-value"]) for cell in parser.cells}
+    for axis, m in summary["axes"].items():
+        assert m["crossovers"] and m["flexible_peaks"]
+        for k, crossing in enumerate(m["crossovers"]):
+            for key in ("frequency_hz", "phase_margin_deg", "delay_margin_s"):
+                assert shown[f"axes/{axis}/crossovers/{k}/{key}"] == crossing[key]
+        for k, peak in enumerate(m["flexible_peaks"]):
+            for key in ("mode_hz", "peak_hz", "peak_gain_db", "stabilized"):
+                assert shown[f"axes/{axis}/flexible_peaks/{k}/{key}"] == peak[key]
+    # One row per crossover names the one that sets its axis's delay margin.
+    assert section.count("<td>sets the delay margin</td>") == 3
+    assert "gain-stabilized" in section and "phase-stabilized" in section
