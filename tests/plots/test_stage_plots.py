@@ -175,3 +175,55 @@ def test_a_users_stage_is_drawn_once_registered(echo, nominal_plant, tmp_path):
     np.testing.assert_array_equal(count_ax.get_lines()[0].get_ydata(), ds["echo_instants"].values)
     (written,) = write_result_figures(ds, tmp_path, kinds=("echo",))
     assert written.name == "echo.png" and written.read_bytes()[:8] == PNG_MAGIC
+
+
+def test_the_wheel_figure_draws_each_wheels_speed_against_its_limit(avionics_ds):
+    # Third panel: the four pyramid wheels' recorded speeds [rpm] as drawn, the limit
+    # +-6000 rpm (the stage's default), and the sign changes of the speeds counted.
+    ax = plot_stage(avionics_ds, "wheels").axes[2]
+    speed = avionics_ds["wheel_speed"].values
+    lines = ax.get_lines()
+    for k in range(4):
+        assert lines[k].get_label() == f"wheel {k + 1}"
+        np.testing.assert_array_equal(lines[k].get_ydata(), speed[:, k])
+    assert sorted(line.get_ydata()[0] for line in lines[4:6]) == [-6000.0, 6000.0]
+    nonzero = [s[s != 0.0] for s in speed[:, :4].T]
+    crossings = sum(int(np.sum(s[:-1] * s[1:] < 0.0)) for s in nonzero)
+    assert f"{crossings} zero crossings" in ax.get_title()
+    asked = 100.0 * avionics_ds["actuator_torque_ratio"].values.max()
+    assert f"asked {asked:.3g} % of the limit" in ax.get_title()
+
+
+def test_the_estimation_figure_draws_the_bias_inside_its_3_sigma(avionics_ds):
+    # The right column's grey band is b_hat +- 3 sigma of the bias [deg/h].
+    ax = plot_stage(avionics_ds, "mekf").axes[1]
+    (band,) = ax.collections
+    y = band.get_paths()[0].vertices[:, 1]
+    bias_hat = avionics_ds["estimated_gyro_bias"].values[:, 0] * ARCSEC
+    sigma3 = 3.0 * avionics_ds["estimated_gyro_bias_sigma"].values[:, 0] * ARCSEC
+    np.testing.assert_allclose([y.min(), y.max()],
+                               [(bias_hat - sigma3).min(), (bias_hat + sigma3).max()])  # fmt: skip
+
+
+def test_a_small_power_keeps_its_axis_label_inside_the_figure():
+    # The SADM's motor power is ~1e-4 W (0.1 N m at the 1e-3 rad/s of one turn per
+    # orbit): its tick labels "-0.00015" pushed "sadm_power [W]" past the figure's
+    # left edge. Drawn with its power of ten above the axis, every label starts
+    # inside the figure (x0 >= 0 px).
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    from flexsat.control.stages.sadm_drive import SADM_DRIVE
+    from flexsat.plots.stages import plot_stage_records
+
+    t = np.arange(0.0, 120.0, 0.01)
+    ds = xr.Dataset({"sadm_power": ("time", 1.2e-4 * np.sin(t)),
+                     "sadm_torque": ("time", 0.1 * np.abs(np.sin(t))),
+                     "sadm_tracking_error": ("time", 4e-4 * np.abs(np.sin(t))),
+                     "design_inertia_change": ("time", 0.0 * t)},
+                    coords={"time": t}, attrs={"scenario": "{}"})  # fmt: skip
+    fig = plot_stage_records(ds, SADM_DRIVE)
+    canvas = FigureCanvasAgg(fig)
+    canvas.draw()
+    renderer = canvas.get_renderer()
+    for ax in fig.axes:
+        assert ax.yaxis.label.get_window_extent(renderer).x0 >= 0.0, ax.get_ylabel()

@@ -53,6 +53,7 @@ __all__ = [
     "plot_wheels",
     "readable_units",
     "stage_figure_names",
+    "zero_crossings",
 ]
 
 _REGISTRIES = {"reference": REFERENCES, "sensor": SENSORS, "joint_actuator": JOINT_ACTUATORS,
@@ -171,7 +172,8 @@ def readable_units(values: np.ndarray, units: str) -> tuple[float, str]:
 
 
 def _channel(ds: xr.Dataset, channel: Channel) -> np.ndarray:
-    """A record as floats, shape (m, 3) for a per-axis channel, (m,) otherwise."""
+    """A record as floats, shape (m, 3) for a per-axis channel, (m, units) for a
+    per-unit one, (m,) otherwise."""
     return np.asarray(ds.variables[channel.name].values, dtype=float)
 
 
@@ -182,8 +184,17 @@ def _draw_channel(ax: Axes, t: np.ndarray, values: np.ndarray, channel: Channel)
             style.line(ax, t, factor * values[:, k], color=style.AXIS_COLOURS[k],
                        linewidth=1.0, label=style.AXES[k])  # fmt: skip
         ax.legend(loc="upper right", fontsize=8, ncols=3)
+    elif channel.per_unit:
+        units = [k for k in range(values.shape[1]) if np.isfinite(values[:, k]).any()]
+        for k in units:
+            style.line(ax, t, factor * values[:, k], color=f"C{k}", linewidth=1.0,
+                       label=f"unit {k + 1}")  # fmt: skip
+        ax.legend(loc="upper right", fontsize=8, ncols=max(min(len(units), 6), 1))
     else:
         style.line(ax, t, factor * values, color="tab:blue", linewidth=1.0)
+    # tick labels of at most 4 digits, the power of ten above the axis: a 1e-4 W power's
+    # "-0.00015" pushed its label out of the figure's fixed left margin
+    ax.ticklabel_format(axis="y", style="sci", scilimits=(-3, 4), useMathText=True)
     ax.set_ylabel(style.literal(f"{channel.name} [{unit}]"), fontsize=9)  # a user stage's words
     ax.set_title(style.literal(channel.description), fontsize=10)
 
@@ -218,10 +229,11 @@ def plot_estimation(ds: xr.Dataset, spec: StageSpec) -> Figure:
 
     Left column, per body axis: the estimation error 2 vec(q̂⁻¹ ⊗ q_true) [arcsec]
     with the filter's ±3σ (σ = sqrt(diag P) of the attitude). Right column, per
-    axis: the estimated gyro bias b̂ against the gyro's true bias when the run
-    recorded it [deg/h]. Bottom: the NEES eᵀ P⁻¹ e of the attitude, χ² with 3
-    degrees of freedom for a consistent filter, with its two-sided 95 % interval,
-    the share of records inside it and its mean (3 when consistent).
+    axis: the estimated gyro bias b̂ inside its ±3σ (σ = sqrt(diag P) of the bias)
+    against the gyro's true bias when the run recorded it [deg/h]. Bottom: the NEES
+    eᵀ P⁻¹ e of the attitude, χ² with 3 degrees of freedom for a consistent filter,
+    with its two-sided 95 % interval, the share of records inside it and its mean
+    (3 when consistent).
 
     Parameters
     ----------
@@ -239,6 +251,8 @@ def plot_estimation(ds: xr.Dataset, spec: StageSpec) -> Figure:
     error = _values(ds, "estimation_error") * _ARCSEC
     sigma3 = 3.0 * _values(ds, "estimation_sigma") * _ARCSEC
     bias_hat = _values(ds, "estimated_gyro_bias") * _ARCSEC
+    bias_sigma3 = (3.0 * _values(ds, "estimated_gyro_bias_sigma") * _ARCSEC
+                   if "estimated_gyro_bias_sigma" in ds.data_vars else None)  # fmt: skip
     bias = _values(ds, "gyro_bias") * _ARCSEC if "gyro_bias" in ds.data_vars else None
     nees = _values(ds, "estimation_nees")
     fig, axes = style.figure(4, 2, size=(13.0, 10.5))
@@ -253,6 +267,10 @@ def plot_estimation(ds: xr.Dataset, spec: StageSpec) -> Figure:
         ax.set_title(f"axis {a}: RMS {rms:.3g} arcsec, {100 * inside:.1f} % inside ±3σ",
                      fontsize=10)  # fmt: skip
         ax = axes[k, 1]
+        if bias_sigma3 is not None:
+            ax.fill_between(t, bias_hat[:, k] - bias_sigma3[:, k],
+                            bias_hat[:, k] + bias_sigma3[:, k], color="0.85",
+                            label="b̂ ± 3σ (filter)")  # fmt: skip
         if bias is not None:
             style.line(ax, t, bias[:, k], color="0.2", linewidth=1.2, label="true bias (gyro)")
         style.line(ax, t, bias_hat[:, k], color="tab:orange", linewidth=1.0,
@@ -290,7 +308,9 @@ def plot_wheels(ds: xr.Dataset, spec: StageSpec) -> Figure:
     Top: the cluster's momentum Σ a_i h_i per hub axis [N m s]. Middle: the
     fullest wheel's momentum as a share of its limit I_s Ω_max [%], the
     intervals where a wheel is held at its limit shaded and the first
-    saturation of each wheel in the title. Bottom: the wheels' kinetic energy
+    saturation of each wheel in the title. Third: each wheel's speed h_i / I_s
+    [rpm] against ±Ω_max, its zero crossings and the largest motor torque asked of
+    a wheel (R3's) in the title. Bottom: the wheels' kinetic energy
     Σ h_i² / (2 I_s), the motor work and the friction loss [J].
 
     Parameters
@@ -308,7 +328,7 @@ def plot_wheels(ds: xr.Dataset, spec: StageSpec) -> Figure:
     t = style.time_s(ds)
     momentum = _values(ds, "wheel_momentum_B")
     ratio = 100.0 * _values(ds, "wheel_speed_ratio")
-    fig, axes = style.figure(3, 1, size=(11.0, 9.5))
+    fig, axes = style.figure(4, 1, size=(11.0, 12.0))
     ax = axes[0, 0]
     for k in range(3):
         style.line(ax, t, momentum[:, k], color=style.AXIS_COLOURS[k], linewidth=1.0,
@@ -327,6 +347,8 @@ def plot_wheels(ds: xr.Dataset, spec: StageSpec) -> Figure:
     ax.set_ylabel("max |h_i| / (I_s Ω_max) [%]")
     ax.set_title(_first_saturations(ds), fontsize=10)
     ax = axes[2, 0]
+    _draw_wheel_speeds(ds, t, ax)
+    ax = axes[3, 0]
     for name, colour, label in (
         ("wheel_kinetic_energy", "tab:blue", "kinetic energy Σ h_i² / (2 I_s)"),
         ("wheel_motor_work", "tab:green", "motor work ∫ Σ u_i Ω_i dt"),
@@ -340,6 +362,49 @@ def plot_wheels(ds: xr.Dataset, spec: StageSpec) -> Figure:
     style.finish_time_axis(axes, t)
     style.suptitle(fig, ds, f"Reaction wheels ({spec.description})")
     return fig
+
+
+def zero_crossings(values: np.ndarray) -> int:
+    """How many times a record changes sign (records at exactly zero passed over).
+
+    Parameters
+    ----------
+    values : ndarray, shape (m,)
+        A record, any unit; NaN records passed over.
+
+    Returns
+    -------
+    int
+        The sign changes between consecutive non-zero records.
+    """
+    signs = np.sign(np.asarray(values, dtype=float))
+    signs = signs[np.isfinite(signs) & (signs != 0.0)]
+    return int(np.count_nonzero(np.diff(signs)))
+
+
+def _draw_wheel_speeds(ds: xr.Dataset, t: np.ndarray, ax: Axes) -> None:
+    """Each wheel's speed [rpm] with its limit ±Ω_max and zero, the motor torque asked
+    of the wheels over their limit in the title (R3's, ``actuator_torque_ratio``)."""
+    if "wheel_speed" not in ds.data_vars:  # a run recorded before the channel existed
+        ax.set_title("wheel speeds not recorded", fontsize=10)
+        return
+    speed = _values(ds, "wheel_speed")
+    units = [k for k in range(speed.shape[1]) if np.isfinite(speed[:, k]).any()]
+    for k in units:
+        style.line(ax, t, speed[:, k], color=f"C{k}", linewidth=1.0, label=f"wheel {k + 1}")
+    actuator = json.loads(ds.attrs.get("scenario", "{}")).get("actuator", {})
+    limit = actuator.get("max_speed_rpm")
+    if limit is not None:
+        ax.axhline(limit, color="tab:red", linewidth=1.0, label="±Ω_max")
+        ax.axhline(-limit, color="tab:red", linewidth=1.0)
+    ax.axhline(0.0, color="0.4", linewidth=0.6)
+    crossings = sum(zero_crossings(speed[:, k]) for k in units)
+    title = f"wheel speeds h_i / I_s: {crossings} zero crossings"
+    if "actuator_torque_ratio" in ds.data_vars:
+        asked = float(np.nanmax(_values(ds, "actuator_torque_ratio"), initial=0.0))
+        title += f"; largest motor torque asked {100 * asked:.3g} % of the limit"
+    ax.set_ylabel("Ω_i [rpm]")
+    ax.set_title(title, fontsize=10)
 
 
 def _first_saturations(ds: xr.Dataset) -> str:

@@ -68,6 +68,21 @@ class MEKFConfig(StageConfig):
         0.1, description="P0 of the gyro bias [deg/h]"
     )
 
+    def check(self, scenario) -> None:
+        """Refuse an MEKF with neither a gyro nor a star tracker before it in the
+        sensing chain: it would filter the ideal sensor's noiseless outputs."""
+        before: dict = {}
+        for _, stage in scenario.stage_chain():
+            if stage is self:
+                break
+            if hasattr(stage, "estimator_noise"):
+                before.update(stage.estimator_noise())
+        if "arw" not in before and "star_tracker" not in before:
+            raise ValueError(
+                "kind: an MEKF needs a gyro or a star tracker (or both) before it in the "
+                "sensing chain ([sensor], then [[sensor_stages]] in order); it has neither"
+            )
+
     def packed(self, scenario) -> np.ndarray:
         declared: dict = {}
         for _, stage in scenario.stage_chain():
@@ -233,6 +248,7 @@ def mekf_step(x, n_dof, t, params, state, q_meas, omega_meas, record):
     record[3] = nees
     record[4], record[5], record[6] = sqrt(P[0, 0]), sqrt(P[1, 1]), sqrt(P[2, 2])
     record[7], record[8], record[9] = s[_B], s[_B + 1], s[_B + 2]
+    record[10], record[11], record[12] = sqrt(P[3, 3]), sqrt(P[4, 4]), sqrt(P[5, 5])
     return 0
 
 
@@ -243,6 +259,8 @@ MEKF = StageSpec(
         Channel("estimation_nees", "1", "e^T P^-1 e of the attitude (chi-square, 3 dof)"),
         Channel("estimation_sigma", "rad", "sqrt(diag P) of the attitude", per_axis=True),
         Channel("estimated_gyro_bias", "rad/s", "b_hat", per_axis=True),
+        Channel("estimated_gyro_bias_sigma", "rad/s", "sqrt(diag P) of the gyro bias",
+                per_axis=True),
     ),
     description="multiplicative extended Kalman filter (gyro + star tracker)",
 )  # fmt: skip

@@ -23,6 +23,7 @@ from numba import njit
 from pydantic import Field, model_validator
 
 from flexsat.config.models import Positive, _Frozen
+from flexsat.control.registry import Channel
 from flexsat.control.stages.registry import StageConfig, StageSpec
 
 __all__ = ["MAX_SECTIONS", "NOTCH", "Notch", "NotchConfig", "notch_for_modes"]
@@ -151,11 +152,14 @@ def notch_step(tau_cmd, t, dt, params, state, tau_applied, record):
             state[z + 1] = c[2] * u - c[4] * y
             u = y
         tau_applied[a] = u
+        record[a] = u
     return 0
 
 
 NOTCH = StageSpec(
     role="actuator", name="notch", config=NotchConfig, step=notch_step,
     state_size=6 * MAX_SECTIONS,
+    records=(Channel("notch_output", "N m", "the filtered torque command, each axis",
+                     per_axis=True),),
     description="notch and roll-off filter on the commanded torque",
 )  # fmt: skip
