@@ -25,7 +25,7 @@ from flexsat.config import nominal, validate_config
 from flexsat.errors import ConfigError
 
 # Columns that legitimately differ between two runs of the same case.
-TIMING = ["case_wall_time_s"]
+TIMING = ["case_wall_time_s", "case_cpu_time_s"]
 
 
 def _table(store):
@@ -278,9 +278,12 @@ def test_cli_campaign_json(tmp_path):
     assert result.returncode == 0, result.stderr
     summary = json.loads(result.stdout)
     for key in ("cases", "failed", "r1_pass_rate", "r2_pass_rate", "r3_pass_rate",
-                "worst_final_pointing_error_deg", "wall_time_s"):  # fmt: skip
+                "worst_final_pointing_error_deg", "computed_this_run", "resumed_this_run",
+                "cpu_time_s", "campaign_wall_time_s", "run_wall_time_s"):  # fmt: skip
         assert key in summary
     assert summary["cases"] == 3
+    # --cases 2 of a campaign with the nominal: 3 cases, and the summary says why
+    assert summary["cases_text"] == "3 cases: 2 drawn + the nominal"
     replay = subprocess.run(
         [sys.executable, "-m", "flexsat", "campaign", "replay", str(tmp_path), "random-00001"],
         capture_output=True, text=True, timeout=300,

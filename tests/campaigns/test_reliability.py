@@ -66,10 +66,10 @@ def test_the_study_resumes_only_an_identical_campaign(tmp_path):
 
     definition = _short("montecarlo-random", 1.0)
     options = {"workers": 1, "resume": True, "n_random": 1, "progress": False}
-    assert fly_campaign(definition, nominal(), tmp_path, **options)["ran"] == 2
+    assert fly_campaign(definition, nominal(), tmp_path, **options)["computed_this_run"] == 2
     with pytest.raises(ConfigError, match="the satellite config"):
         fly_campaign(definition, _heavy(), tmp_path, **options)
-    assert fly_campaign(definition, nominal(), tmp_path, **options)["ran"] == 0
+    assert fly_campaign(definition, nominal(), tmp_path, **options)["computed_this_run"] == 0
 
 
 def test_damaged_cases_are_named_then_recomputed_alone(tmp_path, small_store):
@@ -246,7 +246,7 @@ def test_ctrl_c_while_drawing_the_figures_says_the_cases_are_stored(tmp_path):
     resumed = subprocess.run([*process.args, "--resume"], capture_output=True, text=True,
                              check=True)  # fmt: skip
     summary = json.loads(resumed.stdout)
-    assert summary["ran"] == 0 and len(summary["figures"]) > 0
+    assert summary["computed_this_run"] == 0 and len(summary["figures"]) > 0
 
 
 def test_killing_the_parent_leaves_no_worker_behind(tmp_path):

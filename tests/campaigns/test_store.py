@@ -60,3 +60,18 @@ def test_a_history_reads_back_exactly_with_its_units_and_descriptions(tmp_path) 
         assert (ds.attrs["case_id"], ds.attrs["status"]) == ("random-00007", "failed")
         assert "pointing_error_deg" not in ds  # what the case lacks is left out
     assert sorted(p.name for p in path.parent.iterdir()) == ["random-00007.nc"]  # no partial
+
+
+def test_a_case_without_metrics_gets_nan_in_the_list_columns(tmp_path) -> None:
+    """A case that failed before its metrics (its inputs refused while streaming, a
+    worker lost) has none of the per-axis lists the flown cases have: its cells are
+    NaN, and the table is still built (it raised a TypeError)."""
+    store = CampaignStore(tmp_path)
+    store.cases_dir.mkdir(parents=True)
+    flown = {"max_abs_torque_nm": [1.0, 2.0, 3.0], "final_pointing_error_deg": 0.5}
+    store.write_case({"case_id": "a", "status": "ok", "metrics": flown, "inputs_digest": "x"})
+    store.write_case({"case_id": "b", "status": "failed", "metrics": {}, "inputs_digest": "y"})
+    table = store.table()
+    columns = [f"metrics.max_abs_torque_nm[{k}]" for k in range(3)]
+    assert table.loc[0, columns].tolist() == [1.0, 2.0, 3.0]
+    assert table.loc[1, columns].isna().all()

@@ -259,3 +259,143 @@ def test_mutated_modal_data_files_load_or_give_one_message(tmp_path):
     )
     assert refused > MODAL_CASES // 2  # most mutations are hostile
     assert refused < MODAL_CASES  # and some harmless: the valid files do load
+
+
+# --- campaign files -------------------------------------------------------------------
+
+CAMPAIGN_SEED = 20261207
+CAMPAIGN_CASES = 320
+
+_PATHS = ["hub.mass_kg", "hub.inertia", "hub", "hub.radius_m", "appendages", "appendages[*]",
+          "appendages[0].name", "appendages[*].inertia", "appendages[9].inertia",
+          "appendages[*].target_frequencies_hz", "appendages[*].target_frequencies_hz.flapping",
+          "appendages[*].sadm_angle_deg", "appendages[*].damping_ratio", "appendages[*].model",
+          "initial.rate_deg_s", "initial.rate_deg_s[7]", "initial.rate_deg_s[*]",
+          "initial.appendages", "actuator.gain[*]", "disturbances.sloshing_ratio",
+          "duration_s", "dt_s", "[*]", "hub..mass_kg", "hub.mass_kg[0]", "", "x" * 200,
+          "appendages[-1].inertia", "controller.kind"]  # fmt: skip
+_SOURCES = ("value", "uniform", "normal", "truncnormal")
+
+
+def _trimmed(name: str) -> dict:
+    """A preset as plain data, its cases cut to a few (every structure kept) so that
+    checking a mutation resolves a handful of cases, not dozens."""
+    import tomllib
+    from importlib import resources
+
+    preset = resources.files("flexsat.campaigns") / "presets" / f"{name}.toml"
+    data = tomllib.loads(preset.read_text(encoding="utf-8"))
+    data["cases"] = data.get("cases", [])[:3]
+    for axis in data.get("grid", {}).get("axes", []):
+        axis["levels"] = axis["levels"][:2]
+    if "random" in data:
+        data["random"]["n"] = 2
+    return data
+
+
+def _search_base() -> dict:
+    """A worst-case search (no preset has one): its parameters' bounds mutated too."""
+    return {"name": "search", "base": {"duration_s": 120.0},
+            "worst_case": {"metric": "final_pointing_error_deg", "maxiter": 2, "parameters": [
+                {"path": "hub.mass_kg", "bounds": [120.0, 180.0]},
+                {"path": "appendages[*].sadm_angle_deg", "bounds": [0.0, 90.0]},
+                {"path": "hub.inertia", "op": "scale", "bounds": [0.8, 1.2]}]}}  # fmt: skip
+
+
+def _hostile_modifier(rng: np.random.Generator) -> dict:
+    """A modifier of a random path, op and value source, each possibly hostile."""
+    modifier = {"path": _PATHS[rng.integers(len(_PATHS))]}
+    if rng.random() < 0.7:
+        modifier["op"] = ["set", "scale", "add", 3][rng.integers(4)]
+    source = _SOURCES[rng.integers(len(_SOURCES))]
+    sizes = {"value": None, "uniform": 2, "normal": 2, "truncnormal": 4}
+    if sizes[source] is None or rng.random() < 0.2:
+        modifier[source] = _hostile(rng)
+    else:
+        modifier[source] = [_NUMBERS[rng.integers(len(_NUMBERS))] if rng.random() < 0.4
+                            else float(rng.normal() * 10.0 ** rng.uniform(-3, 3))
+                            for _ in range(sizes[source])]  # fmt: skip
+    return modifier
+
+
+def _mutate_campaign(rng: np.random.Generator, bases: list[dict]) -> str:
+    import copy
+
+    data = copy.deepcopy(bases[rng.integers(len(bases))])
+    for _ in range(rng.integers(1, 4)):
+        paths = _leaf_paths(data)
+        path = paths[rng.integers(len(paths))]
+        node = data
+        try:
+            for part in path[:-1]:
+                node = node[part]
+            action = rng.integers(10)
+            current = node[path[-1]]
+            if (
+                action < 3
+                and isinstance(current, list)
+                and (not current or (isinstance(current[0], dict) and "path" in current[0]))
+            ):
+                current.append(_hostile_modifier(rng))  # a list of modifiers: one more
+            elif action < 3 and isinstance(current, dict) and "path" in current:
+                node[path[-1]] = _hostile_modifier(rng)  # fmt: skip
+            elif action < 5 and isinstance(current, float | int) and not isinstance(current, bool):
+                node[path[-1]] = (
+                    current * float(rng.choice([-1.0, 1.0])) * 10.0 ** rng.uniform(-300, 300)
+                )
+            elif action == 5 and isinstance(node, dict):
+                node.pop(path[-1], None)
+            elif action == 6 and isinstance(node, dict):
+                node[f"unknown_{rng.integers(100)}"] = _hostile(rng)
+            elif action == 7 and path[-1] == "path":
+                node[path[-1]] = _PATHS[rng.integers(len(_PATHS))]
+            else:
+                node[path[-1]] = _hostile(rng)
+        except (KeyError, IndexError, TypeError):
+            continue  # an earlier edit replaced a parent: skip this one
+    text = to_toml(data)
+    if rng.random() < 0.1:  # damaged text: cut, or one character replaced
+        cut = int(rng.integers(len(text)))
+        text = text[:cut] if rng.random() < 0.5 else text[:cut] + '\x01["]=' + text[cut + 1 :]
+    return text
+
+
+def test_mutated_campaigns_are_refused_in_one_message_before_any_case_runs(tmp_path):
+    """Campaign files (the presets, cut to a few cases, and a worst-case search) with one
+    to three values, modifiers or keys made hostile, or their text damaged, go through
+    what ``flexsat campaign`` checks before any case runs (in this process: the cases
+    are resolved, never flown): each is accepted or refused with a FlexsatError of
+    exit code 2 and one bounded message, never another exception."""
+    from flexsat.campaigns.definition import CAMPAIGN_PRESETS, CaseStream, load_campaign
+    from flexsat.campaigns.worstcase import check_search
+    from flexsat.config import nominal
+    from flexsat.errors import FlexsatError
+
+    print(f"campaign fuzz seed {CAMPAIGN_SEED}")
+    satellite = nominal()
+    bases = [_trimmed(name) for name in CAMPAIGN_PRESETS] + [_search_base()]
+    rng = np.random.default_rng(CAMPAIGN_SEED)
+    problems, refused = [], 0
+    for k in range(CAMPAIGN_CASES):
+        path = tmp_path / f"campaign_{k:03d}.toml"
+        path.write_text(_mutate_campaign(rng, bases), encoding="utf-8")
+        try:
+            definition = load_campaign(path)
+            if definition.worst_case is not None:
+                check_search(definition, definition.worst_case, satellite)
+            else:  # a preset's own count of random cases, cut to 2 (each is resolved alike)
+                CaseStream(definition, satellite, None if definition.random is None else 2)
+        except FlexsatError as exc:
+            refused += 1
+            message = str(exc)
+            if exc.exit_code != 2 or not message or len(message) > 3000:
+                problems.append(f"{path.name}: exit {exc.exit_code}, message {message[:300]!r}")
+        except Exception:  # a traceback: record it with the input that caused it
+            problems.append(
+                f"{path.name}: {traceback.format_exc()[-1500:]}\n{path.read_text()[:1500]}"
+            )
+    assert not problems, (
+        f"{len(problems)} of {CAMPAIGN_CASES} failed (seed {CAMPAIGN_SEED}):\n"
+        + "\n".join(problems[:3])
+    )
+    assert refused > CAMPAIGN_CASES // 3  # the mutations are hostile: most are refused

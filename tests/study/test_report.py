@@ -230,3 +230,41 @@ def test_the_margins_table_lists_every_crossover_and_flexible_peak(tmp_path):
     # One row per crossover names the one that sets its axis's delay margin.
     assert section.count("<td>sets the delay margin</td>") == 3
     assert "gain-stabilized" in section and "phase-stabilized" in section
+
+
+def test_a_campaign_table_says_what_it_counts_and_names_each_requirements_worst(tmp_path):
+    # A store of 3 cases, one failing R2 with the smallest pointing error: the report's
+    # campaign section labels its counts and times by what they count and names that
+    # case among R2's worst (ranked by pointing error only, it was not named).
+    from flexsat.campaigns import CampaignStore, summarize
+    from flexsat.study import report
+
+    store = CampaignStore(tmp_path / "campaigns" / "mc")
+    store.cases_dir.mkdir(parents=True)
+    for case_id, r2, rate, pointing in (("nominal", True, 1e-5, 0.02),
+                                        ("random-00000", False, 2e-3, 0.001),
+                                        ("random-00001", True, 5e-5, 0.03)):  # fmt: skip
+        metrics = {"r1_pass": True, "r2_pass": r2, "r3_pass": True, "ape_deg": 0.01,
+                   "max_rate_error_deg_s": rate, "max_commanded_torque_nm": [1.0, 1.0, 1.0],
+                   "final_pointing_error_deg": pointing}  # fmt: skip
+        store.write_case({"case_id": case_id, "status": "ok", "metrics": metrics,
+                          "inputs_digest": "x", "case_cpu_time_s": 2.0})  # fmt: skip
+    summary = {**summarize(store.root), "computed_this_run": 0, "resumed_this_run": 3,
+               "run_wall_time_s": 0.04, "cases_text": "3 cases: 2 drawn + the nominal"}  # fmt: skip
+    (store.root / "summary.json").write_text(json.dumps(summary))
+    outputs = {"summaries": {"mc": "campaigns/mc/summary.json"}, "figures": []}
+    html = report._campaigns(tmp_path, outputs, {})
+    for label in ("cases stored", "computed by this run", "resumed from the store by this run",
+                  "CPU time of the stored cases [s]", "wall time of every run into the store [s]",
+                  "wall time of this run [s]", "3 cases: 2 drawn + the nominal",
+                  "Worst cases per requirement"):  # fmt: skip
+        assert label in html
+    assert ">ran<" not in html and ">wall_time_s<" not in html
+    cells = _Cells()
+    cells.feed(html)
+    shown = {c["data-path"]: json.loads(c["data-value"]) for c in cells.cells}
+    assert shown["cpu_time_s"] == 6.0  # 3 cases of 2.0 s, summed exactly
+    assert shown["resumed_this_run"] == 3 and shown["computed_this_run"] == 0
+    r2 = [g["requirement"] for g in summary["worst_by_requirement"]].index("R2")
+    assert shown[f"worst_by_requirement/{r2}/cases/0/passes"] is False
+    assert "random-00000" in html.split("Worst cases per requirement")[1]

@@ -51,6 +51,7 @@ __all__ = [
     "SobolCases",
     "WorstCaseSearch",
     "campaign_fingerprint",
+    "describe_counts",
     "dispersed_modifiers",
     "load_campaign",
     "resolve_cases",
@@ -324,6 +325,28 @@ class ResolvedCase:
         return _digest({"plant": self.plant, "scenario": self.scenario})
 
 
+def describe_counts(counts: dict[str, int]) -> str:
+    """A campaign's cases in words: ``"101 cases: 100 drawn + the nominal"``.
+
+    Parameters
+    ----------
+    counts : dict
+        Cases per source, as :meth:`CaseStream.counts` gives them.
+
+    Returns
+    -------
+    str
+        The total and its parts.
+    """
+    words = {"listed": "listed", "grid": "from the grid", "random": "drawn",
+             "sobol": "from Saltelli's sample"}  # fmt: skip
+    parts = [f"{counts[key]} {word}" for key, word in words.items() if counts.get(key)]
+    if counts.get("nominal"):
+        parts.append("the nominal")
+    total = sum(counts.values())
+    return f"{total} case{'' if total == 1 else 's'}: {' + '.join(parts)}"
+
+
 def _digest(data) -> str:
     return hashlib.sha256(json.dumps(data, sort_keys=True).encode()).hexdigest()[:16]
 
@@ -411,6 +434,20 @@ class CaseStream:
         self.head = [self.resolve(spec) for spec in self._fixed]
         n_head = min(self._n_streamed, max(1, HEAD_CASES - len(self.head)))
         self.head += [self.resolve(self._streamed_spec(i)) for i in range(n_head)]
+
+    def counts(self) -> dict[str, int]:
+        """How many cases come from each source (see :func:`describe_counts`).
+
+        Returns
+        -------
+        dict
+            ``nominal`` (0 or 1), ``listed`` (``[[cases]]``), ``grid``, ``random``
+            (drawn, ``--cases``) and ``sobol`` (Saltelli's sample).
+        """
+        nominal, listed = int(self.definition.include_nominal), len(self.definition.cases)
+        return {"nominal": nominal, "listed": listed,
+                "grid": len(self._fixed) - nominal - listed, "random": self.n_random,
+                "sobol": 0 if self._sobol is None else len(self._sobol)}  # fmt: skip
 
     @property
     def _n_streamed(self) -> int:

@@ -57,8 +57,9 @@ def run_ensemble(cases: Iterable[ResolvedCase], threads: int = 1,
         while True:
             chunk = _prepare(list(itertools.islice(source, size)))
             flying = None
-            if chunk:
-                flying = (chunk, flyer.submit(_fly, chunk, threads, time.perf_counter()))
+            if chunk:  # the clocks: this thread's CPU is not the flight's (_finish)
+                clocks = (time.process_time(), time.thread_time())
+                flying = (chunk, flyer.submit(_fly, chunk, threads, time.perf_counter()), clocks)
             if pending is not None:
                 yield from _finish(*pending)
             if flying is None:
@@ -68,12 +69,13 @@ def run_ensemble(cases: Iterable[ResolvedCase], threads: int = 1,
 
 class _Case:
     """One case of a batch: its row, its prepared slew (None if it failed before) and
-    its wall time so far [s] (preparation, its share of the batch's loop, finishing)."""
+    its wall and CPU time so far [s] (preparation, its share of the batch's loop,
+    finishing)."""
 
-    __slots__ = ("row", "run", "wall")
+    __slots__ = ("cpu", "row", "run", "wall")
 
-    def __init__(self, row: dict, run, wall: float) -> None:
-        self.row, self.run, self.wall = row, run, wall
+    def __init__(self, row: dict, run, wall: float, cpu: float) -> None:
+        self.row, self.run, self.wall, self.cpu = row, run, wall, cpu
 
 
 def _prepare(cases: list[ResolvedCase]) -> list[_Case]:
@@ -81,16 +83,17 @@ def _prepare(cases: list[ResolvedCase]) -> list[_Case]:
 
     prepared = []
     for case in cases:
-        start = time.perf_counter()
+        start, cpu = time.perf_counter(), time.thread_time()
         row, run = case_row(case), None
         if case.error:  # refused while streaming: a failed row, nothing to run
-            row.update(status="failed", error=case.error, metrics={}, case_wall_time_s=0.0)
+            row.update(status="failed", error=case.error, metrics={}, case_wall_time_s=0.0,
+                       case_cpu_time_s=0.0)  # fmt: skip
         else:
             try:
                 run = prepare_slew(*case_inputs(case))
             except Exception as exc:  # a failed case is data, not a crash of the campaign
                 fail_row(row, exc)
-        prepared.append(_Case(row, run, time.perf_counter() - start))
+        prepared.append(_Case(row, run, time.perf_counter() - start, time.thread_time() - cpu))
     return prepared
 
 
@@ -102,28 +105,37 @@ def _fly(chunk: list[_Case], threads: int, start: float):
     return flown, time.perf_counter() - start
 
 
-def _finish(chunk: list[_Case], future) -> Iterator[dict]:
+def _finish(chunk: list[_Case], future, clocks: tuple[float, float]) -> Iterator[dict]:
+    """Post-process a flown batch. ``clocks``: the process's and this thread's CPU time
+    when the batch was submitted; the process's CPU since then, less this thread's
+    (storing and preparing the other batches meanwhile), is the flight's."""
     from flexsat.simulate.closedloop import finish_slew
 
+    failure = None
     try:
         flown, wall = future.result()
     except Exception as exc:  # the compiled call itself failed: every case of it fails
-        flown, wall = None, 0.0
+        flown, wall, failure = None, 0.0, exc
+    flight_cpu = (time.process_time() - clocks[0]) - (time.thread_time() - clocks[1])
+    if failure is not None:
         for c in chunk:
             if c.run is not None:
-                fail_row(c.row, exc)
+                fail_row(c.row, failure)
                 c.run = None
     ran = [c for c in chunk if c.run is not None]
     share = wall / max(1, len(ran))  # each case's share of the batch's loop time
+    share_cpu = max(0.0, flight_cpu) / max(1, len(ran))
     for k, c in enumerate(ran):
-        start = time.perf_counter()
+        start, cpu = time.perf_counter(), time.thread_time()
         status, done, rows = (int(v) for v in flown[k])
         try:
             finish_row(c.row, finish_slew(c.run, status, done, rows, share))
         except Exception as exc:  # a failed case is data, not a crash of the campaign
             fail_row(c.row, exc)
         c.wall += share + time.perf_counter() - start
+        c.cpu += share_cpu + time.thread_time() - cpu
         c.run = None  # the records are no longer needed
     for c in chunk:
         c.row.setdefault("case_wall_time_s", c.wall)
+        c.row.setdefault("case_cpu_time_s", c.cpu)
         yield c.row

@@ -19,7 +19,7 @@ import re
 from typing import Annotated, Any, Literal
 
 import numpy as np
-from pydantic import Field, model_validator
+from pydantic import Field, ValidationError, model_validator
 from scipy import special
 
 from flexsat.config.models import HubConfig, _Frozen
@@ -223,7 +223,7 @@ def apply_modifiers(
                 if modifier.op not in derived.ops:
                     raise KeyError(f"{concrete} takes op = {' or '.join(map(repr, derived.ops))}"
                                    f" on this appendage model, not {modifier.op!r}")  # fmt: skip
-                derived.apply(parent, value)
+                _apply_derived(modifier, concrete, derived, parent, value)
             elif modifier.op == "scale":
                 parent[key] = _scaled(parent[key], value)
             else:
@@ -245,6 +245,20 @@ def _check_fits(modifier: Modifier, concrete: str, current: Any, derived: Derive
         raise ModifierError(f"{where}: {concrete} is {_shown(current)}, not a number or a "
                             "list of numbers: only numeric fields can be scaled (use op = "
                             "'set')")  # fmt: skip
+
+
+def _apply_derived(modifier: Modifier, concrete: str, derived: DerivedPath, parent: dict,
+                   value: float) -> None:  # fmt: skip
+    """Compute a derived path; a table it cannot be computed from (refused by an
+    earlier modifier's value) is named, as a refused value would be."""
+    try:
+        derived.apply(parent, value)
+    except ValidationError as exc:
+        first = exc.errors()[0]
+        field = ".".join(str(part) for part in first["loc"])
+        raise ModifierError(f"modifier {modifier.path!r}: {concrete} is computed from the "
+                            f"values around it, and {field} = {_shown(first.get('input'))} is "
+                            f"refused: {first['msg']}") from None  # fmt: skip
 
 
 def _shown(value: Any) -> str:

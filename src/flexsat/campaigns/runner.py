@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import contextlib
 import itertools
+import math
 import os
 import re
 import signal
@@ -39,6 +40,9 @@ __all__ = [
     "HISTORY_KEY",
     "HISTORY_UNITS",
     "RUNNERS",
+    "SUMMARY_ROWS",
+    "WORST_BY",
+    "WORST_CASES",
     "CampaignInterrupted",
     "case_history",
     "replay_case",
@@ -101,8 +105,39 @@ def replay_case(store: str | Path, case_id: str):
     return run_slew(plant, scenario)
 
 
+WORST_CASES = 5
+"""Worst cases listed per requirement and for the pointing error."""
+
+WORST_BY = (
+    ("R1", "r1_pass", "ape_deg", "deg"),
+    ("R2", "r2_pass", "max_rate_error_deg_s", "deg/s"),
+    ("R3", "r3_pass", "max_commanded_torque_nm", "N m"),
+    ("pointing", None, "final_pointing_error_deg", "deg"),
+)
+"""What the worst cases are ranked by: (name, verdict key or None, metric, unit). R1 by
+the absolute pointing error over the window, R2 by the largest residual rate over it,
+R3 by the peak commanded torque (the largest axis), the pointing error at the end."""
+
+
+SUMMARY_ROWS = (
+    ("cases", "cases stored"),
+    ("computed_this_run", "computed by this run"),
+    ("resumed_this_run", "resumed from the store by this run"),
+    ("failed", "failed cases (stopped or refused)"),
+    ("r1_pass_rate", "R1 pass rate (absolute pointing)"),
+    ("r2_pass_rate", "R2 pass rate (residual rate)"),
+    ("r3_pass_rate", "R3 pass rate (torque limit)"),
+    ("worst_final_pointing_error_deg", "worst final pointing error [deg]"),
+    ("cpu_time_s", "CPU time of the stored cases [s]"),
+    ("campaign_wall_time_s", "wall time of every run into the store [s]"),
+    ("run_wall_time_s", "wall time of this run [s]"),
+)
+"""The rows of a campaign's summary table (CLI and report): key in the summary, and
+the label that says what it counts."""
+
+
 def summarize(store: str | Path) -> dict:
-    """Pass rates and the worst cases of a stored campaign.
+    """Pass rates, the worst cases and the cost of a stored campaign.
 
     Parameters
     ----------
@@ -112,12 +147,19 @@ def summarize(store: str | Path) -> dict:
     Returns
     -------
     dict
-        ``cases``, ``failed``, the pass rate of each requirement (``r1_pass_rate``...,
-        fractions in [0, 1]) and the worst cases by final pointing error [deg]. Also
-        ``requirements`` (per requirement: passes, the exact 95 % interval of the
-        pass rate and the failing case ids), ``metrics`` (per metric: min, 5/50/95 %,
-        max) and ``cases_for_3sigma_at_95`` (the cases needed, with no failure, to
-        claim 99.73 % at 95 % confidence); see :mod:`flexsat.campaigns.statistics`.
+        ``cases`` (stored), ``failed``, the pass rate of each requirement
+        (``r1_pass_rate``..., fractions in [0, 1]), ``worst_by_requirement`` (for R1,
+        R2, R3 and the final pointing error, :data:`WORST_BY`: the metric, its unit,
+        the failing count and the :data:`WORST_CASES` worst cases, failing ones first,
+        then by the metric, largest first: ``case_id``, ``value``, ``passes``) and,
+        as before, ``worst_cases`` by final pointing error [deg]. ``cpu_time_s``: the
+        stored cases' own CPU time, summed [s] (a case stored without it counts its
+        wall time); ``campaign_wall_time_s``: the wall times of the runs recorded in
+        the store, summed [s] (``runs`` of them). Also ``requirements`` (per
+        requirement: passes, the exact 95 % interval of the pass rate and the failing
+        case ids), ``metrics`` (per metric: min, 5/50/95 %, max) and
+        ``cases_for_3sigma_at_95`` (the cases needed, with no failure, to claim
+        99.73 % at 95 % confidence); see :mod:`flexsat.campaigns.statistics`.
     """
     from flexsat.campaigns.statistics import (
         cases_needed,
@@ -125,31 +167,64 @@ def summarize(store: str | Path) -> dict:
         requirement_statistics,
     )
 
-    table = CampaignStore(store).table()
-    rows = CampaignStore(store).rows()
+    opened = CampaignStore(store)
+    table = opened.table()
+    rows = opened.rows()
     n = len(rows)
 
     def rate(key: str) -> float:
         return sum(bool(r["metrics"].get(key)) for r in rows) / n if n else float("nan")
 
-    errors = [
-        (r["metrics"]["final_pointing_error_deg"], r["case_id"])
-        for r in rows
-        if r["status"] == "ok" and r["metrics"].get("final_pointing_error_deg") is not None
+    def seconds(row: dict) -> float:
+        value = row.get("case_cpu_time_s", row.get("case_wall_time_s"))
+        return value if isinstance(value, int | float) and math.isfinite(value) else 0.0
+
+    worst_by = [_worst(rows, *spec) for spec in WORST_BY]
+    pointing = [c for c in worst_by[-1]["cases"] if c["value"] is not None]
+    worst_cases = [
+        {"case_id": c["case_id"], "final_pointing_error_deg": c["value"]} for c in pointing
     ]
-    worst = sorted(errors, reverse=True)[:5]
+    runs = opened.runs()
     return {
         "cases": n,
         "failed": sum(r["status"] != "ok" for r in rows),
         "r1_pass_rate": rate("r1_pass"),
         "r2_pass_rate": rate("r2_pass"),
         "r3_pass_rate": rate("r3_pass"),
-        "worst_final_pointing_error_deg": worst[0][0] if worst else float("nan"),
-        "worst_cases": [{"case_id": c, "final_pointing_error_deg": e} for e, c in worst],
+        "worst_final_pointing_error_deg": pointing[0]["value"] if pointing else float("nan"),
+        "worst_cases": worst_cases,
+        "worst_by_requirement": worst_by,
+        "cpu_time_s": sum(seconds(r) for r in rows),
+        "campaign_wall_time_s": sum(float(r.get("wall_time_s", 0.0)) for r in runs),
+        "runs": len(runs),
         "requirements": requirement_statistics(table).to_dict("records") if n else [],
         "metrics": metric_statistics(table).to_dict("records") if n else [],
         "cases_for_3sigma_at_95": cases_needed(0.9973, 0.95),
     }
+
+
+def _worst(rows: list[dict], name: str, verdict: str | None, metric: str, unit: str) -> dict:
+    """The worst cases by one requirement (see :data:`WORST_BY`)."""
+    ranked = []
+    for row in rows:
+        ok = row["status"] == "ok"
+        value = row["metrics"].get(metric) if ok else None
+        if isinstance(value, list):  # per axis: the largest
+            value = max(value) if value else None
+        if not isinstance(value, int | float) or not math.isfinite(value):
+            value = None
+        passes = None if verdict is None else bool(ok and row["metrics"].get(verdict))
+        if verdict is None and value is None:
+            continue  # no value to rank by
+        # failing first, then the largest value; a case without a value after those with one
+        ranked.append(((passes is True, value is None, -(value or 0.0), row["case_id"]),
+                       {"case_id": row["case_id"], "value": value, "passes": passes}))  # fmt: skip
+    ranked.sort(key=lambda item: item[0])
+    return {
+        "requirement": name, "verdict": verdict, "metric": metric, "unit": unit,
+        "failing": sum(entry["passes"] is False for _, entry in ranked),
+        "cases": [entry for _, entry in ranked[:WORST_CASES]],
+    }  # fmt: skip
 
 
 HISTORY_KEY = "history"
@@ -228,14 +303,16 @@ def run_case(case: ResolvedCase) -> dict:
     dict
         The case's row: ``case_id``, ``status``, ``message``, ``parameters``,
         ``inputs``, ``metrics`` (:func:`flexsat.analysis.slew_metrics`, SI or the
-        key's unit).
+        key's unit), ``case_wall_time_s`` and ``case_cpu_time_s`` (the case's own
+        wall and CPU time [s]).
     """
     from flexsat.simulate import run_slew
 
     row = case_row(case)
-    start = time.perf_counter()
+    start, cpu = time.perf_counter(), time.process_time()
     if case.error:  # refused while streaming: a failed row, nothing to run
-        row.update(status="failed", error=case.error, metrics={}, case_wall_time_s=0.0)
+        row.update(status="failed", error=case.error, metrics={}, case_wall_time_s=0.0,
+                   case_cpu_time_s=0.0)  # fmt: skip
         return row
     try:
         plant, scenario = case_inputs(case)
@@ -243,6 +320,8 @@ def run_case(case: ResolvedCase) -> dict:
     except Exception as exc:  # a failed case is data, not a crash of the campaign
         fail_row(row, exc)
     row["case_wall_time_s"] = time.perf_counter() - start
+    # the process's CPU: a worker (or this process) runs one case at a time
+    row["case_cpu_time_s"] = time.process_time() - cpu
     return row
 
 
@@ -337,7 +416,10 @@ def run_campaign(
     Returns
     -------
     dict
-        ``cases``, ``ran`` (this call), ``failed``, ``wall_time_s``, the store paths; for a
+        ``cases``, ``case_counts`` (:meth:`CaseStream.counts`), ``ran`` (computed by
+        this call), ``resumed`` (found stored by this call), ``failed``,
+        ``wall_time_s`` (this call's; each run's is also recorded in the store,
+        :meth:`CampaignStore.record_run`), the store paths; for a
         ``[worst_case]`` search, what :func:`~flexsat.campaigns.worstcase.run_worst_case`
         returns (the worst case found).
 
@@ -403,6 +485,8 @@ def run_campaign(
                 try:
                     store.record_case_inputs(todo.digest.hexdigest())
                     table = store.write_tables()
+                    wall = time.perf_counter() - start
+                    store.record_run(todo.ran, todo.skipped, wall)
                 except OSError as exc:
                     raise _write_error(store, cases, exc) from None
         except _Interrupted as stop:
@@ -410,9 +494,11 @@ def run_campaign(
     return {
         "campaign": definition.name,
         "cases": len(cases),
+        "case_counts": cases.counts(),
         "ran": todo.ran,
+        "resumed": todo.skipped,
         "failed": int(table["status"].ne("ok").sum()) if "status" in table else 0,
-        "wall_time_s": time.perf_counter() - start,
+        "wall_time_s": wall,
         "parquet": str(store.tables[0]),
         "csv": str(store.tables[1]),
     }
@@ -534,6 +620,7 @@ def _lost_case(case: ResolvedCase, exitcode: int | None) -> dict:
         "error": f"its worker process died running it (exit code {exitcode}), twice",
         "metrics": {},
         "case_wall_time_s": float("nan"),
+        "case_cpu_time_s": float("nan"),
     }
 
 

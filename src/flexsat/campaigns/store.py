@@ -12,7 +12,8 @@ definition, of the satellite config, the number of cases and a digest of the fir
 cases' inputs, checked before any case runs; every stored case's own inputs digest,
 checked as the cases stream by; and, once a run has streamed every case, the
 digest over all cases' inputs (``all_case_inputs``). Resuming is refused when any
-of them differs, naming which. While a
+of them differs, naming which. It also lists the runs made into the store (``runs``:
+the cases each computed and resumed, its wall time). While a
 campaign runs into the store, ``campaign.lock`` is locked (``flock``) and names
 the process holding it, so a second run into the same store is refused instead of
 recomputing the same cases. A killed run's lock is freed by the kernel shortly
@@ -206,6 +207,35 @@ class CampaignStore:
         stored["all_case_inputs"] = digest
         _write_atomic(marker, json.dumps(stored, indent=2))
 
+    def record_run(self, computed: int, resumed: int, wall_time_s: float) -> None:
+        """Append one run's counts and wall time to ``campaign.json`` (``runs``).
+
+        Parameters
+        ----------
+        computed : int
+            Cases the run computed.
+        resumed : int
+            Cases it found stored (same inputs) and did not recompute.
+        wall_time_s : float
+            The run's wall time, from its start to its tables written [s].
+        """
+        marker = self.root / "campaign.json"
+        stored = json.loads(marker.read_text())
+        runs = stored.get("runs") if isinstance(stored.get("runs"), list) else []
+        runs.append({"computed": int(computed), "resumed": int(resumed),
+                     "wall_time_s": float(wall_time_s)})  # fmt: skip
+        stored["runs"] = runs
+        _write_atomic(marker, json.dumps(stored, indent=2))
+
+    def runs(self) -> list[dict]:
+        """The runs recorded into this store (:meth:`record_run`), oldest first; none for
+        a store written before runs were recorded, or a damaged ``campaign.json``."""
+        try:
+            runs = json.loads((self.root / "campaign.json").read_text()).get("runs", [])
+        except (OSError, ValueError, AttributeError):
+            return []
+        return [r for r in runs if isinstance(r, dict)] if isinstance(runs, list) else []
+
     def write_case(self, row: dict) -> None:
         _write_atomic(self.cases_dir / f"{row['case_id']}.json", dumps(row))
 
@@ -266,7 +296,11 @@ class CampaignStore:
         frame = pd.json_normalize(rows, sep=".")
         for column in list(frame.columns):
             if frame[column].map(lambda v: isinstance(v, list)).any():
-                expanded = pd.DataFrame(frame[column].tolist(), index=frame.index)
+                # a case without the value (one that failed before its metrics) gets NaN
+                lists = [v if isinstance(v, list) else [] for v in frame[column]]
+                width = max(map(len, lists))
+                padded = [v + [np.nan] * (width - len(v)) for v in lists]
+                expanded = pd.DataFrame(padded, index=frame.index)
                 expanded.columns = [f"{column}[{k}]" for k in expanded.columns]
                 frame = pd.concat([frame.drop(columns=column), expanded], axis=1)
         return frame.sort_values("case_id").reset_index(drop=True) if len(frame) else frame

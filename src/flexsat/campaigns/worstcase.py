@@ -31,7 +31,7 @@ from flexsat.campaigns.store import CampaignStore, _write_atomic
 from flexsat.config.models import SatelliteConfig
 from flexsat.errors import ConfigError
 
-__all__ = ["run_worst_case"]
+__all__ = ["check_search", "run_worst_case"]
 
 
 def run_worst_case(
@@ -72,16 +72,13 @@ def run_worst_case(
     -------
     dict
         ``case_id``, ``metric``, ``value`` and ``parameters`` of the worst case found,
-        ``cases`` (evaluations), ``ran`` (this call), ``failed`` and ``failed_cases``
+        ``cases`` (evaluations), ``ran`` (computed by this call), ``resumed`` (found
+        stored by this call), ``failed`` and ``failed_cases``
         (evaluations that failed, not taken as the worst), ``generations``, the
         table paths; also written to ``worst_case.json``.
     """
-    base = definition.model_copy(update={"cases": [], "grid": None, "random": None,
-                                         "sobol": None, "include_nominal": True})  # fmt: skip
-    stream = CaseStream(base, satellite)  # validates the base slew
+    stream, probe = check_search(definition, search, satellite)
     bounds = [p.bounds for p in search.parameters]
-    probe = stream.resolve(("de-check", (search.seed, 0),
-                            *dispersed_modifiers(search.parameters, [lo for lo, _ in bounds])))
     store = CampaignStore(out)
     # the nominal case's digest covers the satellite and the base slew
     fingerprint = {"definition": _search_digest(definition, search), "satellite":
@@ -114,6 +111,8 @@ def run_worst_case(
             init="latinhypercube", tol=0.0,
         )  # fmt: skip
         store.write_tables()
+        wall = time.perf_counter() - start
+        store.record_run(state["ran"], state["evaluations"] - state["ran"], wall)
     if not values:
         raise ConfigError(
             f"worst_case.metric {search.metric!r}: no evaluation gave a finite value (a "
@@ -126,13 +125,49 @@ def run_worst_case(
     summary = {
         "campaign": definition.name, "worst_case": True, "case_id": worst, "metric": search.metric,
         "value": values[worst], "parameters": store.row(worst)["parameters"],
-        "cases": state["evaluations"], "ran": state["ran"], "failed": len(state["failed"]),
-        "failed_cases": state["failed"], "generations": int(result.nit),
-        "wall_time_s": time.perf_counter() - start,
+        "cases": state["evaluations"], "ran": state["ran"],
+        "resumed": state["evaluations"] - state["ran"], "failed": len(state["failed"]),
+        "failed_cases": state["failed"], "generations": int(result.nit), "wall_time_s": wall,
         "parquet": str(store.tables[0]), "csv": str(store.tables[1]),
     }  # fmt: skip
     _write_atomic(store.root / "worst_case.json", json.dumps(summary, indent=2))
     return summary
+
+
+def check_search(definition: CampaignDefinition, search: WorstCaseSearch,
+                 satellite: SatelliteConfig) -> tuple[CaseStream, ResolvedCase]:  # fmt: skip
+    """Check a search before any evaluation runs: the base slew, and the cases at both
+    corners of the parameters' box (every parameter at its low, then its high bound).
+
+    Parameters
+    ----------
+    definition : CampaignDefinition
+        The campaign (its base slew).
+    search : WorstCaseSearch
+        Its ``[worst_case]`` table.
+    satellite : SatelliteConfig
+        The base satellite.
+
+    Returns
+    -------
+    stream : CaseStream
+        The base slew's cases (the nominal), which resolves each evaluation.
+    probe : ResolvedCase
+        The low corner's case (its digest is part of the store's fingerprint).
+
+    Raises
+    ------
+    ConfigError
+        Naming the case and the value its modifier gives that is refused.
+    """
+    base = definition.model_copy(update={"cases": [], "grid": None, "random": None,
+                                         "sobol": None, "include_nominal": True})  # fmt: skip
+    stream = CaseStream(base, satellite)  # validates the base slew
+    corners = [[p.bounds[k] for p in search.parameters] for k in (0, 1)]
+    probe, _ = (stream.resolve((f"de-check-{name}", (search.seed, 0),
+                                *dispersed_modifiers(search.parameters, corner)))
+                for name, corner in zip(("low", "high"), corners, strict=True))  # fmt: skip
+    return stream, probe
 
 
 def _value(store: CampaignStore, case: ResolvedCase, metric: str, values: dict, state: dict

@@ -534,7 +534,10 @@ def campaign(
                      "(batches in one compiled call, --workers threads)."),
     ] = CampaignRunner.pool,
     cases: Annotated[
-        int | None, typer.Option(help="Number of random cases (random campaigns).")
+        int | None,
+        typer.Option(help="Random cases to draw (random campaigns; default the campaign's "
+                     "[random] n). The nominal case comes on top when the campaign "
+                     "includes it: --cases 100 runs 101 cases."),
     ] = None,
     duration: Annotated[
         float | None, typer.Option(help="Override every case's duration [s] (quick looks).")
@@ -603,13 +606,13 @@ def campaign(
     if json_output:
         typer.echo(dumps(summary))
         return
-    keys = ("cases", "ran", "failed", "r1_pass_rate", "r2_pass_rate", "r3_pass_rate",
-            "worst_final_pointing_error_deg", "wall_time_s")  # fmt: skip
-    print_table(_console, f"Campaign {definition.name}: {summary['cases']} cases",
-                ("metric", "value"), [[key, summary[key]] for key in keys])  # fmt: skip
-    for worst in summary["worst_cases"]:
-        _console.print(f"  worst: {worst['case_id']}  "
-                       f"{format_number(worst['final_pointing_error_deg'])} deg")  # fmt: skip
+    from flexsat.campaigns.runner import SUMMARY_ROWS
+
+    title = summary.get("cases_text", f"{summary['cases']} cases")
+    print_table(_console, f"Campaign {definition.name}: {title}", ("quantity", "value"),
+                [[label, summary[key]] for key, label in SUMMARY_ROWS])  # fmt: skip
+    for group in summary["worst_by_requirement"]:
+        _console.print(f"  {_worst_line(group)}")
     if "worst_case" in summary:  # a search: what it found, by the metric it searched
         found = summary["worst_case"]
         _console.print(f"  worst-case search: {found['case_id']}  {found['metric']} = "
@@ -617,6 +620,18 @@ def campaign(
     _console.print(f"wrote {summary['parquet']} and {summary['csv']}")
     for path in summary["figures"]:
         _console.print(f"wrote {path}")
+
+
+def _worst_line(group: dict) -> str:
+    """One requirement's worst cases on a line (``summary["worst_by_requirement"]``)."""
+    verdict = {True: " pass", False: " FAIL", None: ""}
+    cases = ", ".join(
+        f"{c['case_id']} {'—' if c['value'] is None else format_number(c['value'])}"
+        f"{verdict[c['passes']]}" for c in group["cases"]
+    )  # fmt: skip
+    failing = "" if group["verdict"] is None else f"; {group['failing']} failing"
+    return (f"worst {group['requirement']} (by {group['metric']} [{group['unit']}]{failing}): "
+            f"{cases or 'none'}")  # fmt: skip
 
 
 @app.command()

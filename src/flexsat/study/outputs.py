@@ -264,10 +264,15 @@ def fly_campaign(definition, config, store: Path, *, progress: bool = True, **ba
     Returns
     -------
     dict
-        :func:`flexsat.campaigns.summarize` plus ``wall_time_s``, ``ran``,
-        ``parquet``, ``csv`` and ``figures``; also written to ``store/summary.json``.
+        :func:`flexsat.campaigns.summarize` (``cases`` stored, ``cpu_time_s`` of
+        every stored case, ``campaign_wall_time_s`` of every run into the store...)
+        plus this run's ``computed_this_run``, ``resumed_this_run`` (cases found
+        stored) and ``run_wall_time_s`` [s]; ``case_counts`` and ``cases_text`` (where
+        the cases come from: ``"101 cases: 100 drawn + the nominal"``), ``parquet``,
+        ``csv`` and ``figures``; also written to ``store/summary.json``.
     """
     from flexsat.campaigns import run_campaign, summarize
+    from flexsat.campaigns.definition import describe_counts
     from flexsat.campaigns.runner import CampaignInterrupted
     from flexsat.plots.campaign import write_campaign_figures
     from flexsat.plots.campaign_statistics import write_statistics_figures
@@ -275,11 +280,15 @@ def fly_campaign(definition, config, store: Path, *, progress: bool = True, **ba
     run = run_campaign(definition, config, store, progress=progress, **backend)
     summary = {
         **summarize(store),
-        "wall_time_s": run["wall_time_s"],
-        "ran": run["ran"],
+        "computed_this_run": run["ran"],
+        "resumed_this_run": run["resumed"],
+        "run_wall_time_s": run["wall_time_s"],
         "parquet": str(run["parquet"]),
         "csv": str(run["csv"]),
     }
+    if "case_counts" in run:  # where the cases come from (a search has evaluations)
+        summary["case_counts"] = run["case_counts"]
+        summary["cases_text"] = describe_counts(run["case_counts"])
     try:
         figures = write_campaign_figures(store)
         figures += write_statistics_figures(store)

@@ -492,37 +492,41 @@ def _campaign_cases(root: Path, store: str) -> str:
 _SUMMARY_TABLE_FIGURE = "summary_table.png"  # shown as the HTML tables above instead
 
 
+def _campaign_worst(src: _Source) -> str:
+    """The worst cases of a campaign by each requirement (R1, R2, R3) and by the final
+    pointing error: failing cases first, then by the metric (``worst_by_requirement``)."""
+    rows = []
+    for g, group in enumerate(src.get("worst_by_requirement")):
+        ranked_by = f"{group['metric']} [{group['unit']}]"
+        failing = src.cell("worst_by_requirement", g, "failing") if group["verdict"] else "—"
+        for i, case in enumerate(group["cases"]):
+            verdict = (src.cell("worst_by_requirement", g, "cases", i, "passes")
+                       if group["verdict"] else "—")  # fmt: skip
+            value = src.cell("worst_by_requirement", g, "cases", i, "value")
+            rows.append([group["requirement"], ranked_by, failing, str(i + 1), case["case_id"],
+                         value, verdict])  # fmt: skip
+    header = ["requirement", "ranked by", "failing cases", "rank", "case", "value", "verdict"]
+    return _table(header, rows, "Worst cases per requirement (failing cases first)")
+
+
 def _campaigns(root: Path, outputs: dict, context: dict) -> str:
+    from flexsat.campaigns.runner import SUMMARY_ROWS
+
     parts = []
     for name, rel in outputs["summaries"].items():
         src = _Source(root, rel)
-        keys = (
-            "cases",
-            "ran",
-            "failed",
-            "r1_pass_rate",
-            "r2_pass_rate",
-            "r3_pass_rate",
-            "worst_final_pointing_error_deg",
-            "wall_time_s",
-        )
-        rows = [[key, src.cell(key)] for key in keys]
-        rows += [
-            [
-                f"worst case {i + 1}: {w['case_id']}",
-                src.cell("worst_cases", i, "final_pointing_error_deg"),
-            ]
-            for i, w in enumerate(src.get("worst_cases"))
-        ]
+        rows = [[label, src.cell(key)] for key, label in SUMMARY_ROWS]
         store = Path(rel).parent.as_posix()
         parts.append(f"<h3>{_esc(name)}</h3>")
+        counted = src.data.get("cases_text", f"{src.get('cases')} cases")
         parts.append(
             _table(
-                ["metric", "value"],
+                ["quantity", "value"],
                 rows,
-                f"Campaign {name} (store {store}: results.parquet, results.csv)",
+                f"Campaign {name}, {counted} (store {store}: results.parquet, results.csv)",
             )
         )
+        parts.append(_campaign_worst(src))
         parts.append(_campaign_cases(root, store))
         figures = [f for f in outputs["figures"]
                    if f.startswith(store + "/") and not f.endswith(_SUMMARY_TABLE_FIGURE)]
