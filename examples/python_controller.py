@@ -7,6 +7,13 @@ same design model as the built-in laws (the rigid nominal satellite). Any callab
 ``(t, q, omega_B) -> tau`` flies: the built-in laws run compiled inside the RK4
 loop, a Python law is called at each control instant (here every 10 ms), which is
 slower but needs no numba.
+
+With the gains below it meets the thesis's requirements on its slew: R1 and R2 over
+the observation window (from 90 s) and R3. The integral gain is what R2 asks of
+it: the constant disturbances leave a PD a standing error, and the integral removes
+it at a rate set by ki / kp; with ki = 0.002 (and natural_frequency = 0.3 rad/s) the
+residual rate creeps into the R2 band only at 99 s, after the window has opened,
+and R2 fails.
 """
 
 # %%
@@ -27,7 +34,7 @@ from flexsat.simulate import SlewScenario, design_inertia, run_slew
 class QuaternionPID:
     """tau = w x Jw - J (kp q_v,e + ki integral(q_v,e) + kd w), rest-to-rest."""
 
-    def __init__(self, target_euler_deg, natural_frequency=0.3, damping_ratio=0.9, ki=0.002):
+    def __init__(self, target_euler_deg, natural_frequency=0.4, damping_ratio=0.9, ki=0.005):
         self.J = design_inertia()  # [kg m^2], the rigidized nominal satellite
         self.q_d = target_quaternion(target_euler_deg)  # scalar first
         self.kp = 2.0 * natural_frequency**2  # [1/s^2] (q_v,e ~ theta / 2)
@@ -62,6 +69,7 @@ scenario = SlewScenario(duration_s=DURATION_S, control_dt_s=0.01)  # control eve
 law = QuaternionPID(scenario.target_euler_deg)
 result = run_slew(Plant.from_config(nominal()), scenario, controller=law)
 metrics = slew_metrics(result.dataset)  # the requirements of the stored scenario
-for key in ("controller", "final_pointing_error_deg", "r1_pass", "r2_pass", "r3_pass"):
+for key in ("controller", "final_pointing_error_deg", "r1_pass", "r2_pass", "r3_pass",
+            "r2_settling_time_s", "max_rate_error_deg_s"):
     print(f"{key:26s} {metrics[key]}")
 plot_pointing(result.dataset)

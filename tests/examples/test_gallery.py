@@ -198,11 +198,25 @@ def test_compiled_law(run_example):
 
 def test_python_controller(run_example):
     # 120 s at 10 ms control: the PID's integral removes the PD's standing error
-    # under the constant disturbances; R1 and R3 hold.
-    metrics = run_example("python_controller", duration_s=120.0)["metrics"]
+    # under the constant disturbances, and the example meets what it says: R1, R2 and
+    # R3 over the thesis's window from 90 s. Measured: inside R2 from 83.5 s, largest
+    # residual rate over the window 7.6e-4 deg/s (band 1e-3), APE 0.019 deg (band
+    # 0.05); the gains it names as failing (ki = 0.002, 0.3 rad/s) settle at 99.3 s.
+    g = run_example("python_controller", duration_s=120.0)
+    metrics = g["metrics"]
     assert metrics["controller"] == "python"
-    assert metrics["r3_pass"]
+    assert metrics["r1_pass"] and metrics["r2_pass"] and metrics["r3_pass"]
+    assert metrics["r2_settling_time_s"] < metrics["observation_window_s"][0]
     assert metrics["final_pointing_error_deg"] < 0.05
+    # ... and what it says of the slower integral holds: R2 is lost, late to settle.
+    from flexsat.analysis import slew_metrics
+    from flexsat.simulate import run_slew
+
+    slow = g["QuaternionPID"](g["scenario"].target_euler_deg, natural_frequency=0.3, ki=0.002)
+    plant = g["Plant"].from_config(g["nominal"]())
+    late = slew_metrics(run_slew(plant, g["scenario"], controller=slow,
+                                 progress=False).dataset)  # fmt: skip
+    assert not late["r2_pass"] and late["r2_settling_time_s"] > 90.0
 
 
 def test_linear_design(run_example):
