@@ -10,8 +10,10 @@ import time
 from pathlib import Path
 
 import psutil
+import pytest
 
 from flexsat.config import nominal, preset_path
+from flexsat.parallel import figure_workers
 from flexsat.study import PARTS, pipeline
 
 
@@ -24,6 +26,23 @@ def test_quick_study_runs_every_part_but_the_campaigns(quick_study):
         if part["status"] == "ok":
             assert part["wall_time_s"] > 0.0
             assert part["error"] is None
+
+
+def test_the_study_states_its_estimate_per_part(quick_study):
+    # Said before the first part (and kept in study.json): the estimated wall time of
+    # every part that runs, the longer lane's sum and the basis it rests on.
+    _, manifest = quick_study
+    estimate = manifest["estimate"]
+    ran = {part["name"] for part in manifest["parts"] if part["status"] != "skipped"}
+    assert set(estimate["parts"]) == ran
+    assert all(seconds >= 0.0 for seconds in estimate["parts"].values())
+    lanes = {part.name: part.lane for part in PARTS}
+    longer = max(sum(s for name, s in estimate["parts"].items() if lanes[name] == lane)
+                 for lane in (0, 1))  # fmt: skip
+    # the longer lane's sum; on one core (one lane), every part's
+    assert estimate["total_s"] == pytest.approx(
+        longer if figure_workers() > 1 else sum(estimate["parts"].values()), rel=1e-12)
+    assert estimate["basis"].startswith("basis: a 10 s slew flown now took")
 
 
 def test_every_output_the_manifest_names_exists(quick_study):

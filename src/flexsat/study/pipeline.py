@@ -370,6 +370,7 @@ def run_study(
     }
     lanes = LANES if figure_workers() > 1 else 1
     manifest["compilation_s"], per_lane = _compile(ctx, console, lanes)
+    manifest["estimate"] = _estimate(ctx, console, lanes)
     start = time.perf_counter()
     done: dict[str, dict] = {}
 
@@ -378,7 +379,7 @@ def run_study(
         manifest["parts"] = [done[p.name] for p in PARTS if p.name in done]
         manifest["total_wall_time_s"] = time.perf_counter() - start
         write_json(out / MANIFEST, manifest)
-        _announce(console, part, entry)
+        _announce(console, part, entry, manifest["estimate"], done)
 
     # each lane's own kernels, loaded before its first part: compilation, not the parts'
     prepared = _run_parts(ctx, record, lanes, per_lane)
@@ -643,9 +644,46 @@ def _run_part(part: Part, ctx: StudyContext) -> dict:
     return entry
 
 
-def _announce(console: Console, part: Part, entry: dict) -> None:
+def _estimate(ctx: StudyContext, console: Console, lanes: int) -> dict | None:
+    """Calibrate, print the study's estimate per part (:mod:`flexsat.study.estimate`)
+    before the first part, and return it for the manifest (``basis``, ``parts``: part
+    name -> estimated wall time [s], ``total_s``); None if no slew could be flown to
+    calibrate it (the parts then say why)."""
+    from flexsat.study import estimate
+
+    try:
+        basis = estimate.calibrate(ctx.plant, ctx.workers)
+        rows = estimate.study_estimate(ctx, PARTS, basis)
+    except Exception as exc:  # the parts that fly the same satellite report the problem
+        console.print(f"no estimate: {escape(f'{type(exc).__name__}: {exc}')}", highlight=False)
+        return None
+    lane_of = {part.name: part.lane if lanes > 1 else 0 for part in PARTS}
+    total = estimate.total_s(rows, lane_of)
+    estimate.print_estimate(console, rows, basis, {p.name: p.title for p in PARTS}, total)
+    return {"basis": basis.describe(), "parts": {name: seconds for name, _, seconds in rows},
+            "total_s": total}  # fmt: skip
+
+
+def _announce(console: Console, part: Part, entry: dict, estimate: dict | None = None,
+              done: dict | None = None) -> None:  # fmt: skip
+    """One line per part: its outcome and wall time, then, with an estimate, a bar of
+    the study's progress (the estimated time of the parts done, against the total)."""
+    from rich.progress_bar import ProgressBar
+    from rich.table import Table
+
     style = {"ok": "green", "failed": "bold red", "skipped": "yellow"}[entry["status"]]
-    line = f"[{style}]{entry['status']:>7}[/] {part.title} ({entry['wall_time_s']:.1f} s)"
+    line = f"[{style}]{entry['status']:>7}[/] {part.title} ({entry['wall_time_s']:.1f} s"
+    expected = (estimate or {}).get("parts", {}).get(part.name)
+    line += f", estimate {expected:.0f} s)" if expected is not None else ")"
     if entry["status"] != "ok":
         line += f": {escape(entry['error'])}"
     console.print(line, highlight=False)
+    if not estimate or sum(estimate["parts"].values()) <= 0.0 or done is None:
+        return
+    planned = sum(estimate["parts"].values())
+    finished = sum(estimate["parts"].get(name, 0.0) for name in done)
+    row = Table.grid(padding=(0, 1))
+    row.add_row("        study", ProgressBar(total=planned, completed=finished, width=30),
+                f"{min(finished / planned, 1.0):4.0%} of the estimate, {len(done)}/"
+                f"{len(PARTS)} parts")  # fmt: skip
+    console.print(row)

@@ -1,0 +1,304 @@
+"""What the study will cost, said before it starts: per part, from its runs and the rest.
+
+Each part of :data:`flexsat.study.pipeline.PARTS` is counted in the work it does
+(:func:`part_work`): the runs it flies, their simulated seconds (the scenarios'
+durations times the runs, the campaigns' case counts included) and how many fly
+side by side, and its overhead, the figures, files and analyses besides the runs.
+One slew flown on this machine just before the parts start (:func:`calibrate`)
+gives the wall time a simulated second takes now: the runs are counted at that
+rate, and the overheads, known on a quiet 2-core reference machine
+(:data:`QUICK_OVERHEAD_S`), are scaled by the same speed against the reference.
+A campaign case costs about its simulated time at that rate: the full study's
+extra 414 cases of 120 s took about 4 min on two quiet cores, 1.2 s a case per core,
+against 1.32 s for the bare thesis slew.
+
+The estimate is an estimate: a part whose runs stop early takes less, and a
+machine whose load changes during the study, or whose load slows its files and
+figures more than its arithmetic, takes more or less than said.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+
+__all__ = [
+    "CASE_FACTOR",
+    "QUICK_OVERHEAD_S",
+    "REFERENCE_WALL_PER_SIM_S",
+    "Basis",
+    "PartWork",
+    "calibrate",
+    "part_work",
+    "study_estimate",
+]
+
+CALIBRATION_S = 10.0
+"""Simulated seconds of the calibration slew [s]."""
+REFERENCE_WALL_PER_SIM_S = 0.008
+"""Wall time per simulated second of the calibration slew on the reference machine
+(a quiet 2-core machine: 0.08 s for its 10 s) [s/s]."""
+CASE_FACTOR = 1.26
+"""A campaign case's wall time against its simulated time at the calibrated rate [-]:
+its records, metrics and stored files besides the run. On the reference machine the
+full study's 414 cases beyond the quick study (4 min 29 s against 18.5 s) took 1.21 s
+a case on each of the two cores, against 0.96 s for 120 s at the calibrated rate."""
+QUICK_OVERHEAD_S = {
+    "configuration": 0.0, "modal": 5.7, "openloop": 2.9, "slew": 3.0, "frequency": 4.8,
+    "comparison": 2.0, "animation": 1.8, "avionics": 4.5, "laws": 1.5,
+}  # fmt: skip
+"""What each part of the quick study does besides flying its runs (figures, files,
+analyses) on the reference machine [s]: the quick study's 18.5 s there (warm,
+docs/performance.md) shared among the parts as their wall times were in one quick
+study on this 2-core machine, less their runs' simulated time."""
+FULL_OVERHEAD_FACTOR = {"modal": 3.0, "comparison": 13.0, "animation": 2.5, "avionics": 1.4}
+"""The full study's overhead against the quick one's, per part [-]: three times the
+mode GIFs (6 against 2), each compared law's 13 figures (against the one comparison
+figure), 150 animation frames against 60, the longer delay sweep."""
+
+
+@dataclass(frozen=True)
+class Basis:
+    """What turns work into wall time.
+
+    Parameters
+    ----------
+    wall_per_sim_s : float
+        Wall time per simulated second of the nominal slew, measured now [s/s].
+    workers : int
+        Processes the campaigns' cases share.
+    side_by_side : int
+        Processes a part's runs share (:func:`flexsat.parallel.figure_workers`).
+    """
+
+    wall_per_sim_s: float
+    workers: int
+    side_by_side: int
+
+    @property
+    def speed(self) -> float:
+        """This machine now against the reference: > 1 is slower [-]."""
+        return self.wall_per_sim_s / REFERENCE_WALL_PER_SIM_S
+
+    def describe(self) -> str:
+        """One sentence: the basis of the estimate."""
+        return (
+            f"basis: a {CALIBRATION_S:g} s slew flown now took "
+            f"{self.wall_per_sim_s * CALIBRATION_S:.2f} s ({self.wall_per_sim_s * 1e3:.1f} ms "
+            f"per simulated second, {self.speed:.2f} x a quiet 2-core reference); every run "
+            f"counted at that rate, {self.side_by_side} side by side (campaign cases "
+            f"{self.workers}); figures and files as the parts took on the reference, "
+            f"scaled alike"
+        )
+
+
+@dataclass(frozen=True)
+class PartWork:
+    """The work of one part, before it is turned into wall time.
+
+    Parameters
+    ----------
+    runs : int
+        Simulations flown.
+    simulated_s : float
+        Their simulated time, summed [s].
+    parallel : int
+        How many of them fly side by side.
+    overhead_s : float
+        Everything else (figures, files, analyses) on the reference machine [s].
+    what : str
+        The work in words.
+    factor : float
+        Wall time of a run against its simulated time at the calibrated rate [-].
+    """
+
+    runs: int = 0
+    simulated_s: float = 0.0
+    parallel: int = 1
+    overhead_s: float = 0.0
+    what: str = "no run"
+    factor: float = 1.0
+
+    def wall_s(self, basis: Basis) -> float:
+        """The estimated wall time [s]: the runs at the measured rate (times ``factor``,
+        :data:`CASE_FACTOR` for campaign cases), side by side, and the overhead scaled
+        by the machine's speed against the reference."""
+        runs = self.factor * self.simulated_s * basis.wall_per_sim_s / max(self.parallel, 1)
+        return runs + self.overhead_s * basis.speed
+
+
+def calibrate(plant, workers: int | None = None) -> Basis:
+    """Fly :data:`CALIBRATION_S` of the nominal slew of ``plant`` and time it.
+
+    Parameters
+    ----------
+    plant : Plant
+        The study's satellite (its kernels already compiled or loaded).
+    workers : int, optional
+        The campaigns' worker processes (default: every core).
+
+    Returns
+    -------
+    Basis
+    """
+    import os
+
+    from flexsat.parallel import figure_workers
+    from flexsat.simulate import SlewScenario, run_slew
+
+    scenario = SlewScenario.model_validate({"duration_s": CALIBRATION_S, "record_dt_s": 0.1})
+    start = time.perf_counter()
+    run_slew(plant, scenario, progress=False)
+    elapsed = time.perf_counter() - start
+    return Basis(elapsed / CALIBRATION_S, workers or os.cpu_count() or 1, figure_workers())
+
+
+def _cases(ctx) -> dict[str, tuple[int, float]]:
+    """Per thesis campaign: (its cases, their duration [s])."""
+    from flexsat.campaigns import load_campaign
+    from flexsat.campaigns.definition import CaseStream
+    from flexsat.simulate import SlewScenario
+    from flexsat.study.pipeline import CAMPAIGNS
+
+    out = {}
+    for name in CAMPAIGNS:
+        definition = load_campaign(name)
+        duration = definition.base.get("duration_s", SlewScenario().duration_s)
+        out[name] = (len(CaseStream(definition, ctx.config)), float(duration))
+    return out
+
+
+def part_work(name: str, ctx, side_by_side: int = 2) -> PartWork:
+    """The work of the part called ``name`` in the study ``ctx``.
+
+    Parameters
+    ----------
+    name : str
+        A part of :data:`flexsat.study.pipeline.PARTS`.
+    ctx : StudyContext
+        The study (its satellite, quick or full, its laws).
+    side_by_side : int
+        Processes a part's runs share.
+
+    Returns
+    -------
+    PartWork
+    """
+    from flexsat.simulate import OpenLoopScenario, SlewScenario
+    from flexsat.study import avionics, laws
+
+    slew_s = SlewScenario().duration_s
+    quick = ctx.quick
+    others = len(ctx.laws) - 1
+    overhead = QUICK_OVERHEAD_S.get(name, 0.0) * (
+        1.0 if quick else FULL_OVERHEAD_FACTOR.get(name, 1.0)
+    )
+    if name == "openloop":
+        duration = OpenLoopScenario().duration_s
+        return PartWork(1, duration, 1, overhead, f"1 open-loop run of {duration:g} s")
+    if name == "slew":
+        return PartWork(1, slew_s, 1, overhead, f"1 slew of {slew_s:g} s")
+    if name == "comparison":
+        return PartWork(others, others * slew_s, side_by_side, overhead,
+                        f"{others} slews of {slew_s:g} s")  # fmt: skip
+    if name == "avionics":
+        delays = len(avionics.QUICK_DELAYS_S if quick else avionics.DELAYS_S)
+        around = len(avionics.QUICK_MARGIN_FACTORS if quick else avionics.MARGIN_FACTORS)
+        runs = 2 + delays + around + 1 + 2  # ideal and avionics, the sweep, the arrays x2
+        return PartWork(runs, runs * slew_s, side_by_side, overhead,
+                        f"about {runs} slews of {slew_s:g} s")  # fmt: skip
+    if name in ("campaigns", "laws"):
+        cases = _cases(ctx)
+        every = sum(c for c, _ in cases.values())
+        flown = sum(c * d for c, d in cases.values())
+        if name == "campaigns":
+            listed = ", ".join(f"{k} {c}" for k, (c, _) in cases.items())
+            return PartWork(every, flown, ctx.workers or side_by_side, overhead,
+                            f"{every} cases ({listed})", CASE_FACTOR)  # fmt: skip
+        variants = others + 2  # the laws and the ASMC with hybrid damping
+        if quick:  # the first case of each campaign and variant, each distinct case once:
+            # the nominal opens both the sensitivity and the critical-case sets
+            n = variants * laws.QUICK_CASES * (len(cases) - 1)
+            first = max(d for _, d in cases.values())
+            what = f"{n} cases ({variants} variants, the first case of each campaign)"
+            return PartWork(n, n * first, side_by_side, overhead, what, CASE_FACTOR)
+        extra = variants - 1  # the default law's stores are the campaigns part's own
+        what = f"{extra * every} cases ({extra} variants besides the default law)"
+        return PartWork(extra * every, extra * flown, ctx.workers or side_by_side, overhead,
+                        what, CASE_FACTOR)  # fmt: skip
+    return PartWork(overhead_s=overhead, what="figures and analysis" if overhead else "no run")
+
+
+def study_estimate(ctx, parts, basis: Basis) -> list[tuple[str, PartWork, float]]:
+    """Per part that will run: (name, its work, its estimated wall time [s]).
+
+    Parameters
+    ----------
+    ctx : StudyContext
+        The study.
+    parts : sequence of Part
+        The parts (:data:`flexsat.study.pipeline.PARTS`).
+    basis : Basis
+        From :func:`calibrate`.
+
+    Returns
+    -------
+    list of tuple
+        Parts that will be skipped (``full_only`` in a quick study, or not
+        applicable to the satellite) are left out.
+    """
+    rows = []
+    for part in parts:
+        if part.full_only and ctx.quick:
+            continue
+        if part.applies is not None and part.applies(ctx) is not None:
+            continue  # skipped on this satellite
+        work = part_work(part.name, ctx, basis.side_by_side)
+        rows.append((part.name, work, work.wall_s(basis)))
+    return rows
+
+
+def total_s(rows: list[tuple[str, PartWork, float]], lane_of: dict[str, int]) -> float:
+    """The study's estimated wall time [s]: the longer lane's sum (the lanes run side
+    by side; ``lane_of`` maps a part to its lane, one lane: every part to 0)."""
+    lanes: dict[int, float] = {}
+    for name, _, seconds in rows:
+        lanes[lane_of.get(name, 0)] = lanes.get(lane_of.get(name, 0), 0.0) + seconds
+    return max(lanes.values(), default=0.0)
+
+
+def print_estimate(console, rows, basis: Basis, titles: dict[str, str], total: float) -> None:
+    """Print the estimate: a table of the parts (work, estimated wall time), the total
+    and the basis.
+
+    Parameters
+    ----------
+    console : rich.console.Console
+        Where.
+    rows : list of tuple
+        From :func:`study_estimate`.
+    basis : Basis
+        From :func:`calibrate`.
+    titles : dict
+        Part name -> its title.
+    total : float
+        From :func:`total_s` [s].
+    """
+    from rich.table import Table
+
+    table = Table(title=f"Estimate: about {_duration(total)} (compilation excluded)",
+                  title_justify="left", box=None, pad_edge=False)  # fmt: skip
+    for column, justify in (("part", "left"), ("work", "left"), ("estimate", "right")):
+        table.add_column(column, justify=justify)
+    for name, work, seconds in rows:
+        table.add_row(titles.get(name, name), work.what, _duration(seconds))
+    console.print(table)
+    console.print(basis.describe(), highlight=False)
+
+
+def _duration(seconds: float) -> str:
+    """``12 s``, ``4 min 29 s``."""
+    if seconds < 60.0:
+        return f"{seconds:.0f} s"
+    minutes, rest = divmod(round(seconds), 60)
+    return f"{minutes} min {rest:02d} s"
