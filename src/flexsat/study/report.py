@@ -573,7 +573,7 @@ def _laws(root: Path, outputs: dict, context: dict) -> str:
 
 
 def _avionics(root: Path, outputs: dict, context: dict) -> str:
-    from flexsat.study.avionics import render_avionics
+    from flexsat.study.avionics import SWEEP_HEADER, render_avionics
 
     def cell(relative, *path):
         return _Source(root, relative).cell(*path)
@@ -583,13 +583,15 @@ def _avionics(root: Path, outputs: dict, context: dict) -> str:
         "<p>The thesis's slew with a gyro, a star tracker, the MEKF and four reaction "
         "wheels beside the ideal loop, both against the thesis's disturbances at their "
         "maximum, then the ideal loop with a computational delay "
-        "(docs/control.md, 'Avionics in the loop'). The figures: the stability boundary "
+        "(docs/control.md, 'Avionics in the loop'), each delay called stable, in a limit "
+        "cycle or diverging from its residual-rate envelope over the observation window "
+        "(docs/control.md, 'Stability verdict of the delay sweep'). The figures: the "
+        "stability boundary "
         "against delay, then the avionics run's attitude estimation (the MEKF's error "
         "inside its ±3σ, its NEES against the χ² interval) and its wheels (momentum, "
         "the fullest wheel against its limit).</p>",
         _table(["metric", "ideal", "avionics"], side, "Ideal loop and realistic avionics"),
-        _table(["delay [s]", "R1", "R2", "APE [deg]", "max rate error [deg/s]", "unstable"],
-               sweep, "Sweep over the computational delay"),
+        _table(list(SWEEP_HEADER), sweep, "Sweep over the computational delay"),
         _table(["metric", "arrays held", "arrays turning"], sadm,
                "Ideal loop, plates on a solar-array drive: held and turning") if sadm else "",
         f"<p>{_esc(sentence)}</p>",
