@@ -26,8 +26,9 @@ Its equations (Euler-Poincare for the hub, Lagrange for eta)::
 with a_I = a_hub + alpha x r_m + omega x (omega x r_m) the interface acceleration and
 (F_a, N_a) the wrench the hub exerts on the appendage at the interface. Eliminating
 eta_ddot leaves the residual mass M_rr(c~) - L^T L at the interface: the articulated
-inertia this model transmits to the hub. Every sum is over the modes once: cost is
-linear in n.
+inertia this model transmits to the hub. The hub receives -F_a and, about its centre
+of mass, -(N_a + r_m x F_a) at the plant's accelerations: tau_flex, the whole interface
+load (:func:`joint_wrench`). Every sum is over the modes once: cost is linear in n.
 """
 
 from __future__ import annotations
@@ -74,6 +75,7 @@ from flexsat.dynamics.linalg3 import (
     add_block,
     cross,
     dot,
+    euler_rate_bias,
     euler_rate_matrix,
     load_block33,
     load_m33_at,
@@ -400,22 +402,71 @@ def observe(q, qd, members, params, out):
 
 @njit(cache=True, error_model="numpy")  # compiled with WRENCH_SIGNATURE on first use
 def joint_wrench(q, qd, qdd, Q, members, params, out):
-    """Add the modes' elastic, damping and external forces transmitted to the hub:
-    sum_k l_k (omega_k^2 eta_k + 2 zeta_k omega_k eta_dot_k - Q_k) at the interface
-    (eq. M.7, the mode-displacement load; ``qdd`` is not read, docs/model.md)."""
+    """Add the whole wrench each modal appendage's interface exerts on the hub (eq. M.7).
+
+    The hub moves the appendage through its interface I, so the wrench (F_a, N_a) the
+    hub exerts on it there is what it needs to move as it does (eqs. M.5-M.6, at the
+    plant's accelerations)::
+
+        F_a = m a_I + alpha x c~ + omega x (omega x c~) + 2 omega x s_dot + L_t^T eta_ddot
+        N_a = c~ x a_I + J alpha + J_dot omega + omega x J omega + omega x L_r^T eta_dot
+              + L_r^T eta_ddot
+        a_I = a_hub + alpha x r_m + omega x (omega x r_m),
+        alpha = S(Theta) Theta_ddot + S_dot(Theta) Theta_dot,   a_hub = R_NB^T r_ddot_N,
+
+    and the hub receives -F_a and, about its centre of mass, -(N_a + r_m x F_a): the
+    modes' elastic, damping and external forces (the eta_ddot terms hold them, eq. M.4)
+    and the inertia of the residual mass M_rr - L^T L, which a truncated mode set does
+    not carry. ``Q`` is not read: its effect (joint actuation, the constraint forces of
+    coordinates the engine locks) is in ``qdd``. One pass over the modes, nothing
+    allocated.
+
+    Parameters
+    ----------
+    q, qd : ndarray, shape (n_dof,)
+        Generalized coordinates [m, rad, sqrt(kg) m] and rates of the whole plant.
+    qdd : ndarray, shape (n_dof,)
+        Generalized accelerations of the whole plant at (q, qd), hub rows included.
+    Q : ndarray, shape (n_dof,)
+        External generalized forces [N, N m, sqrt(kg) m/s^2 per coordinate]; not read.
+    members : ndarray, shape (k, 2), int64
+        Per appendage: appendage index and offset of its first coordinate in q [-].
+    params : ndarray, shape (k, p)
+        Per appendage: its packed row (``P_*`` slots) [SI].
+    out : ndarray, shape (6,)
+        The hub wrench, added to: force [N] and torque about the hub centre of mass
+        [N m], hub frame B.
+
+    Returns
+    -------
+    int
+        ``STATUS_OK``.
+    """
+    phi, theta = q[3], q[4]
+    omega = mv(euler_rate_matrix(phi, theta), load_seg(qd, 3))
+    alpha = add(mv(euler_rate_matrix(phi, theta), load_seg(qdd, 3)),
+                euler_rate_bias(phi, theta, qd[3], qd[4], qd[5]))  # fmt: skip
+    a_hub = mtv(rot_zyx(phi, theta, q[5]), load_seg(qdd, 0))
     for j in range(members.shape[0]):
         o, p = members[j, 1], params[j]
         r = load_seg(p, P_MOUNT)
-        F, N = (0.0, 0.0, 0.0), (0.0, 0.0, 0.0)
+        s, s_dot, h_r = _modal_sums(q, qd, o, p)
+        J, J_dot = _inertia(q, qd, o, p)
+        c1 = add(load_seg(p, P_FIRST), s)  # c~ = m c + L_t^T eta
+        a_I = add(add(a_hub, cross(alpha, r)), cross(omega, cross(omega, r)))
+        g_t, g_r = (0.0, 0.0, 0.0), (0.0, 0.0, 0.0)  # L_t^T eta_ddot, L_r^T eta_ddot
         for k in range(int(p[P_N])):
             b = P_MODES + MODE_SIZE * k
-            e = p[b + MODE_K] * q[o + k] + p[b + MODE_C] * qd[o + k] - Q[o + k]
-            F = add(F, scale(e, load_seg(p, b + MODE_LT)))
-            N = add(N, scale(e, load_seg(p, b + MODE_LR)))
+            g_t = add(g_t, scale(qdd[o + k], load_seg(p, b + MODE_LT)))
+            g_r = add(g_r, scale(qdd[o + k], load_seg(p, b + MODE_LR)))
+        F = add(add(scale(p[P_MASS], a_I), cross(alpha, c1)), cross(omega, cross(omega, c1)))
+        F = add(add(F, scale(2.0, cross(omega, s_dot))), g_t)
+        N = add(add(cross(c1, a_I), mv(J, alpha)), mv(J_dot, omega))
+        N = add(add(N, cross(omega, mv(J, omega))), add(cross(omega, h_r), g_r))
         T = add(N, cross(r, F))
         for a in range(3):
-            out[a] += F[a]
-            out[3 + a] += T[a]
+            out[a] -= F[a]
+            out[3 + a] -= T[a]
     return STATUS_OK
 
 
