@@ -65,7 +65,7 @@ def chain_plant(segments: int) -> Plant:
             "length_m": LENGTH, "width_m": 0.01, "thickness_m": 0.001,
             "mass_kg": RHO_A * LENGTH, "joint": {"dofs": ["rz"]},
             "beam": {"EI_in_plane_N_m2": EI_Z}}  # fmt: skip
-    return _pair(wing, {"mount_zyx_deg": [180.0, 0.0, 0.0]})
+    return _pair(wing, {"mount_yaw_deg": 180.0})
 
 
 def yaw_error(plant: Plant, reference: float) -> float:

@@ -63,9 +63,9 @@ def _containers(node):
 
 
 def test_a_derived_path_takes_only_its_op_and_an_unknown_path_lists_what_there_is():
-    # A chain's sadm_angle_deg turns its mount (a set value); scaling it has no meaning
-    # and is refused by name. A path the appendage lacks lists the fields and derived
-    # paths its model offers, so the user sees what to write instead.
+    # A chain's damping_ratio sets every joint's ratio (a set value); scaling it has no
+    # meaning and is refused by name. A path the appendage lacks lists the fields and
+    # derived paths its model offers, so the user sees what to write instead.
     import tomllib
 
     from flexsat.campaigns.modifiers import Modifier, apply_modifiers
@@ -73,14 +73,14 @@ def test_a_derived_path_takes_only_its_op_and_an_unknown_path_lists_what_there_i
 
     data = tomllib.loads(preset_path("chain").read_text())
     rng = np.random.default_rng(0)
-    with pytest.raises(KeyError, match=r"appendages\[0\]\.sadm_angle_deg takes op = 'set'"):
-        apply_modifiers(data, [Modifier(path="appendages[*].sadm_angle_deg", op="scale",
+    with pytest.raises(KeyError, match=r"appendages\[0\]\.damping_ratio takes op = 'set'"):
+        apply_modifiers(data, [Modifier(path="appendages[*].damping_ratio", op="scale",
                                         value=2.0)], rng, {})  # fmt: skip
     with pytest.raises(KeyError) as error:
         apply_modifiers(data, [Modifier(path="appendages[0].stiffness_scale", value=2.0)],
                         rng, {})  # fmt: skip
     message = error.value.args[0]
     assert "a 'chain' appendage" in message
-    for offered in ("beam.EI_flap_N_m2", "joint.damping_ratio", "mount_zyx_deg[i]",
+    for offered in ("beam.EI_flap_N_m2", "joint.damping_ratio", "mount_yaw_deg",
                     "damping_ratio", "target_frequencies_hz.torsion", "sadm_angle_deg"):
         assert offered in message  # fmt: skip

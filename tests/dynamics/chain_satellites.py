@@ -16,7 +16,7 @@ def plate_as_chain(app: dict, segments: int = 1) -> dict:
     tf = app["target_frequencies_hz"]
     return {
         "name": app["name"], "model": "chain", "mount_point_m": app["mount_point_m"],
-        "mount_zyx_deg": [app["mount_yaw_deg"], app["sadm_angle_deg"], 0.0],
+        "mount_yaw_deg": app["mount_yaw_deg"], "sadm_angle_deg": app["sadm_angle_deg"],
         "span_direction": app["span_direction"], "segments": segments,
         "length_m": app["length_m"], "width_m": app["width_m"],
         "thickness_m": app["thickness_m"], "surface_density_kg_m2": app["surface_density_kg_m2"],

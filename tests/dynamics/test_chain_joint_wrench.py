@@ -20,6 +20,7 @@ from typing import Literal
 import numpy as np
 import pytest
 from pydantic import Field
+from scipy.spatial.transform import Rotation
 
 from flexsat.config import nominal, validate_config
 from flexsat.dynamics.appendages import ChainModel, register_appendage_model
@@ -63,7 +64,8 @@ def _satellite(segments: int, root: dict, model: str = "chain", locked=None) -> 
     non-diagonal hub inertia so that every component of the wrench is exercised."""
     chain = {
         "name": "wing", "model": model, "mount_point_m": [0.6, 0.25, -0.15],
-        "mount_zyx_deg": [20.0, 10.0, -5.0], "span_direction": "+x", "segments": segments,
+        "mount_matrix": Rotation.from_euler("ZYX", [20.0, 10.0, -5.0], degrees=True).as_matrix(
+        ).tolist(), "span_direction": "+x", "segments": segments,
         "length_m": 2.4, "width_m": 0.8, "thickness_m": 0.02, "mass_kg": 14.0,
         "joint": HINGE, "root_joint": {**root, "initial": {"ry": 12.0}},
     }  # fmt: skip

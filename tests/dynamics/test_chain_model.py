@@ -174,3 +174,81 @@ def test_a_frequency_factor_moves_every_clamped_mode_of_its_kind(kind, dof):
     expected = np.sort(np.where(np.array(kinds) == dof, 1.2, 1.0) * before)
     assert kinds.count(dof) == 16  # 8 segments x 2 panels
     np.testing.assert_allclose(after, expected, rtol=1e-10)
+
+
+# -- the mount: one vocabulary for every appendage model --------------------------------
+
+
+def _rz_ry(yaw_deg: float, sadm_deg: float) -> np.ndarray:
+    """Rz(yaw) Ry(sadm) written out (the plate's mount, docs/model.md)."""
+    a, b = np.radians(yaw_deg), np.radians(sadm_deg)
+    rz = np.array([[np.cos(a), -np.sin(a), 0.0], [np.sin(a), np.cos(a), 0.0], [0.0, 0.0, 1.0]])
+    ry = np.array([[np.cos(b), 0.0, np.sin(b)], [0.0, 1.0, 0.0], [-np.sin(b), 0.0, np.cos(b)]])
+    return rz @ ry
+
+
+def test_every_appendage_model_names_its_mount_with_the_same_keys():
+    # A plate, its twin as a chain and its modal export, each given mount_yaw_deg = 30
+    # and sadm_angle_deg = 20: the same mount frame, Rz(30) Ry(20) written out, to
+    # 1e-15 (round-off of one product of two rotations).
+    from flexsat.dynamics.appendages.modal import ModalAppendageConfig
+    from flexsat.linear.export import modal_satellite, mount_rotation
+    from tests.conftest import nominal_dict
+    from tests.dynamics.chain_satellites import plate_as_chain
+
+    data = nominal_dict()
+    data["appendages"][0].update(mount_yaw_deg=30.0, sadm_angle_deg=20.0)
+    plate = validate_config(data)
+    chain = plate_as_chain(data["appendages"][0])
+    assert (chain["mount_yaw_deg"], chain["sadm_angle_deg"]) == (30.0, 20.0)
+    modal = modal_satellite(Plant.from_config(plate), n_modes=2).appendages[0].model_dump()
+    modal.pop("mount_matrix")  # the export states R_BM; given here by the two angles
+    modal.update(mount_yaw_deg=30.0, sadm_angle_deg=20.0)
+    expected = _rz_ry(30.0, 20.0)
+    plant = Plant.from_config(plate)
+    rotations = {
+        "plate": mount_rotation(plant.models[0], plant.params[0]),
+        "chain": validate_config({**data, "appendages": [chain, data["appendages"][1]]})
+        .appendages[0].mount_rotation(),
+        "modal": ModalAppendageConfig.model_validate(modal).mount_rotation(),
+    }  # fmt: skip
+    for model, rotation in rotations.items():
+        np.testing.assert_allclose(rotation, expected, rtol=0, atol=1e-15, err_msg=model)
+
+
+def test_the_chains_former_mount_key_is_read_with_one_warning(monkeypatch):
+    # mount_zyx_deg = (a, b, 0) on a chain spanning Y is the yaw and SADM angles
+    # exactly; (a, b, c) any other orientation, read as mount_matrix = Rz(a) Ry(b) Rx(c)
+    # (written out, 1e-15). One FutureWarning in the process, naming the old key and
+    # the new ones; a second config reads without another.
+    import warnings
+
+    from flexsat.config.load import ConfigError
+    from flexsat.dynamics.appendages import chain_config
+    from tests.conftest import nominal_dict
+    from tests.dynamics.chain_satellites import plate_as_chain
+
+    monkeypatch.setattr(chain_config, "_RENAMED_WARNED", set())
+    data = nominal_dict()
+    new = plate_as_chain(data["appendages"][0])
+    new.update(mount_yaw_deg=30.0, sadm_angle_deg=20.0)
+    old = {k: v for k, v in new.items() if k not in ("mount_yaw_deg", "sadm_angle_deg")}
+
+    def mount(table: dict) -> np.ndarray:
+        satellite = validate_config({**data, "appendages": [table, data["appendages"][1]]})
+        return satellite.appendages[0].mount_rotation()
+
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        first = mount({**old, "mount_zyx_deg": [30.0, 20.0, 0.0]})
+        roll = np.radians(-10.0)
+        rx = np.array([[1.0, 0.0, 0.0], [0.0, np.cos(roll), -np.sin(roll)],
+                       [0.0, np.sin(roll), np.cos(roll)]])  # fmt: skip
+        np.testing.assert_allclose(mount({**old, "mount_zyx_deg": [30.0, 20.0, -10.0]}),
+                                   _rz_ry(30.0, 20.0) @ rx, rtol=0, atol=1e-15)  # fmt: skip
+    np.testing.assert_array_equal(first, mount(new))
+    messages = [str(w.message) for w in caught if issubclass(w.category, FutureWarning)]
+    assert len(messages) == 1, messages
+    assert "mount_zyx_deg is deprecated, read as mount_yaw_deg and sadm_angle_deg" in messages[0]
+    with pytest.raises(ConfigError, match=r"give mount_zyx_deg \(deprecated\) or mount_yaw_deg"):
+        mount({**new, "mount_zyx_deg": [30.0, 20.0, 0.0]})

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from scipy.spatial.transform import Rotation
 
 from flexsat.dynamics.plant import Plant
 from flexsat.simulate import run_openloop
@@ -105,7 +106,9 @@ def test_two_unlike_chains_in_one_group_satisfy_the_equations_of_motion():
     SIX = ["x", "y", "z", "rx", "ry", "rz"]
     data = cantilever_chain(3, dofs=("rx", "rz"))
     other = dict(data["appendages"][0], name="other", segments=5, mount_point_m=[0.2, -0.5, 0.1],
-                 mount_zyx_deg=[30.0, 10.0, -20.0], span_direction="-y", tip_mass_kg=0.3,
+                 mount_matrix=Rotation.from_euler("ZYX", [30.0, 10.0, -20.0], degrees=True
+                                                  ).as_matrix().tolist(),
+                 span_direction="-y", tip_mass_kg=0.3,
                  width_m=0.3, thickness_m=0.02, beam=None,
                  joint={"dofs": ["y", "rx", "ry"], "damping_ratio": 0.01,
                         "stiffness": {"y": 1e4, "rx": 300.0, "ry": 200.0}},

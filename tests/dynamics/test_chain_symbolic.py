@@ -13,19 +13,22 @@ from __future__ import annotations
 import numpy as np
 import pytest
 import sympy as sp
+from scipy.spatial.transform import Rotation
 
 from flexsat.config import validate_config
 from flexsat.dynamics.plant import Plant
 
 J0 = [[0.9, 0.05, -0.02], [0.05, 0.4, 0.03], [-0.02, 0.03, 1.1]]
 J1 = [[0.5, -0.04, 0.01], [-0.04, 0.3, 0.02], [0.01, 0.02, 0.7]]
+MOUNT_ZYX_DEG = (20.0, -35.0, 10.0)  # R_BM = Rz(a) Ry(b) Rx(c), given to the chain as its matrix
+MOUNT_MATRIX = Rotation.from_euler("ZYX", MOUNT_ZYX_DEG, degrees=True).as_matrix()
 CONFIG = {
     "name": "two-segment",
     "hub": {"mass_kg": 80.0, "inertia_kg_m2": [[30.0, 1.0, -0.5], [1.0, 25.0, 0.8],
                                                [-0.5, 0.8, 20.0]]},
     "appendages": [{
         "name": "arm", "model": "chain", "mount_point_m": [0.3, 0.7, -0.2],
-        "mount_zyx_deg": [20.0, -35.0, 10.0],
+        "mount_matrix": MOUNT_MATRIX.tolist(),
         "segment_list": [
             {"mass_kg": 3.0, "inertia_kg_m2": J0, "com_m": [0.05, 0.6, 0.02],
              "next_joint_m": [0.0, 1.2, 0.05],
@@ -63,7 +66,7 @@ def _reference():
     q = sp.symbols("q0:10")
     r_N = sp.Matrix(q[0:3])
     R_NB = _rz(q[5]) * _ry(q[4]) * _rx(q[3])
-    yaw, pitch, roll = (sp.rad(sp.Float(a)) for a in CONFIG["appendages"][0]["mount_zyx_deg"])
+    yaw, pitch, roll = (sp.rad(sp.Float(a)) for a in MOUNT_ZYX_DEG)
     R_BM = _rz(yaw) * _ry(pitch) * _rx(roll)
     mount = sp.Matrix(CONFIG["appendages"][0]["mount_point_m"])
     # Joint 0 frees rx, rz (R = Rz Rx), joint 1 frees y, ry (origin moved along y, R = Ry).

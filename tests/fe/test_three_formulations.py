@@ -43,7 +43,7 @@ def chain_satellite(segments: int) -> Plant:
         "appendages": [
             {**wing, "name": "wing_1", "mount_point_m": [0.0, ROOT, 0.0]},
             {**wing, "name": "wing_2", "mount_point_m": [0.0, -ROOT, 0.0],
-             "mount_zyx_deg": [180.0, 0.0, 0.0]},
+             "mount_yaw_deg": 180.0},
         ],
     }))  # fmt: skip
 

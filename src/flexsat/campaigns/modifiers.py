@@ -8,8 +8,9 @@ read: ``hub.inertia`` (scales the hub's inertia tensor, turning a cylinder into 
 explicit inertia), ``appendages[*].inertia`` (scales a panel's mass and so its
 inertia; the joints are re-tuned to keep their target frequencies, as the thesis
 does), and each appendage model's own (:class:`~flexsat.dynamics.appendages.DerivedPath`):
-a chain takes the plate's ``damping_ratio``, ``target_frequencies_hz.<kind>`` and
-``sadm_angle_deg``, so the thesis's campaigns disperse it too.
+a chain takes the plate's ``damping_ratio`` and ``target_frequencies_hz.<kind>``
+(its ``sadm_angle_deg`` is a field, as the plate's), so the thesis's campaigns
+disperse it too.
 """
 
 from __future__ import annotations

@@ -16,7 +16,6 @@ docs/model.md, 'Chain appendages'.
 
 from __future__ import annotations
 
-import warnings
 from typing import ClassVar
 
 import numpy as np
@@ -125,23 +124,6 @@ def _frequency_scaler(kind: str):
     return scale
 
 
-def _set_sadm_angle(table: dict, angle_deg: float) -> None:
-    """Campaign path ``appendages[*].sadm_angle_deg`` on a chain: the mount turned by
-    the angle about its span axis, from the mount the config gives (the plate's SADM
-    angle turns its mount about +Y_M, its span axis, the same way)."""
-    mount = ChainConfig.model_validate(table).mount_rotation()
-    axis = np.zeros(3)
-    axis[AXES[table.get("span_direction", "+y")[1]]] = 1.0
-    turned = mount @ Rotation.from_rotvec(np.radians(angle_deg) * axis).as_matrix()
-    if table.get("mount_matrix") is not None:
-        table["mount_matrix"] = turned.tolist()
-    else:
-        with warnings.catch_warnings():  # at 90 deg about Y the ZYX angles are a family
-            warnings.simplefilter("ignore", UserWarning)  # of which scipy picks one: exact
-            angles = Rotation.from_matrix(turned).as_euler("ZYX", degrees=True)
-        table["mount_zyx_deg"] = np.round(angles, 9).tolist()  # 45, not 45.00000000000003
-
-
 class ChainModel(AppendageModel):
     """Serial chain of rigid segments on elastic joints (:class:`ChainConfig`)."""
 
@@ -152,7 +134,6 @@ class ChainModel(AppendageModel):
     modifiers: ClassVar[dict] = {
         "inertia": DerivedPath(_scale_mass),
         "damping_ratio": DerivedPath(_set_damping_ratio, ops=("set",), factor=False),
-        "sadm_angle_deg": DerivedPath(_set_sadm_angle, ops=("set",), factor=False),
         **{f"target_frequencies_hz.{kind}": DerivedPath(_frequency_scaler(kind), ops=("scale",))
            for kind in _BEAM_PROPERTY},
     }  # fmt: skip

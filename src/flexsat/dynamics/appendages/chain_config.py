@@ -5,8 +5,12 @@ Validated at the boundary (frozen pydantic, field-path errors) and resolved into
 packing in :mod:`flexsat.dynamics.appendages.chain` reads. See docs/model.md,
 'Chain appendages'.
 
-Frames: the mount frame M is the hub frame B rotated by ``mount_zyx_deg`` (R_BM =
-Rz(a) Ry(b) Rx(c)) or given as ``mount_matrix``, its origin at ``mount_point_m``.
+Frames: the mount frame M is named as every appendage model names it: the hub frame
+B rotated by ``mount_yaw_deg`` about Z_B, then by ``sadm_angle_deg`` about the span
+axis (Y_M for the default span, as the plate's SADM angle), or given as
+``mount_matrix`` (any R_BM; the SADM angle then turns from it), its origin at
+``mount_point_m``. The former ``mount_zyx_deg`` = (a, b, c), R_BM = Rz(a) Ry(b) Rx(c),
+is still read, with a deprecation warning (:func:`renamed_mount`).
 Joint 0 sits at the mount; joint k > 0 at the previous segment's ``next_joint_m``,
 its axes those of the previous segment's frame. Each joint frees a subset of the six
 relative DOFs ``x, y, z`` (translation of the segment's origin along the joint's axes
@@ -280,10 +284,11 @@ class ChainConfig(_Frozen):
     name: Name = Field(description="unique name of the appendage")
     model: Literal["chain"] = Field(description="appendage model (registry key)")
     mount_point_m: Point3 = Field(description="root joint position from hub centre of mass, B [m]")
-    mount_zyx_deg: tuple[Angle, Angle, Angle] = Field(
-        (0.0, 0.0, 0.0), description="mount orientation, R_BM = Rz(a) Ry(b) Rx(c) [deg]"
+    mount_yaw_deg: Angle = Field(0.0, description="mount frame rotation about Z_B [deg]")
+    sadm_angle_deg: Angle = Field(0.0, description="SADM angle about the span axis [deg]")
+    mount_matrix: Matrix3 | None = Field(
+        None, description="R_BM (mount -> hub) [-], instead of mount_yaw_deg"
     )
-    mount_matrix: Matrix3 | None = Field(None, description="R_BM (mount -> hub) [-], instead")
     span_direction: _SPAN = Field("+y", description="span axis of the segment frames")
     segments: Annotated[int, Strict(), Field(ge=1, le=512)] | None = Field(
         None, description="segment count N of a uniform chain"
@@ -303,12 +308,17 @@ class ChainConfig(_Frozen):
         0.0, description="point mass at the free end [kg]"
     )
 
+    @model_validator(mode="before")
+    @classmethod
+    def _renamed_mount(cls, value):
+        return renamed_mount(value)
+
     @model_validator(mode="after")
     def _one_form(self) -> ChainConfig:
         uniform = ("segments", "length_m", "width_m", "thickness_m", "joint")
         if self.mount_matrix is not None:
-            if any(self.mount_zyx_deg):
-                raise ValueError("give either mount_zyx_deg or mount_matrix, not both")
+            if self.mount_yaw_deg:
+                raise ValueError("give either mount_yaw_deg or mount_matrix, not both")
             R = np.array(self.mount_matrix, dtype=float)
             if not np.allclose(R @ R.T, np.eye(3), atol=1e-9) or np.linalg.det(R) < 0.0:
                 raise ValueError("mount_matrix must be a rotation (orthonormal, det +1)")
@@ -372,10 +382,17 @@ class ChainConfig(_Frozen):
         return out
 
     def mount_rotation(self) -> np.ndarray:
-        """R_BM (mount frame -> hub frame), shape (3, 3)."""
+        """R_BM (mount frame -> hub frame), shape (3, 3): ``mount_matrix`` or
+        Rz(``mount_yaw_deg``), then turned by ``sadm_angle_deg`` about the span axis."""
         if self.mount_matrix is not None:
-            return np.array(self.mount_matrix, dtype=float)
-        return Rotation.from_euler("ZYX", np.radians(self.mount_zyx_deg)).as_matrix()
+            base = np.array(self.mount_matrix, dtype=float)
+        else:
+            base = Rotation.from_euler("Z", np.radians(self.mount_yaw_deg)).as_matrix()
+        if not self.sadm_angle_deg:
+            return base
+        axis = np.zeros(3)
+        axis[self.span_axis()[0]] = 1.0
+        return base @ Rotation.from_rotvec(np.radians(self.sadm_angle_deg) * axis).as_matrix()
 
     def resolved_segments(self) -> list[Segment]:
         """One :class:`Segment` per body, root first (SI)."""
@@ -402,3 +419,59 @@ class ChainConfig(_Frozen):
                 stiffness = self._beam_stiffness(joint, 2.0 if k == 0 else 1.0)
             out.append(Segment(mass, inertia, 0.5 * step, step, joint, stiffness))
         return out
+
+
+_RENAMED_WARNED: set[str] = set()
+"""Former keys already warned of in this process (each is warned of once)."""
+
+
+def renamed_mount(value):
+    """A chain table's former ``mount_zyx_deg`` = (a, b, c), R_BM = Rz(a) Ry(b) Rx(c), in
+    the keys every appendage model names its mount with.
+
+    (a, b, 0) on a chain spanning +-Y is ``mount_yaw_deg`` = a, ``sadm_angle_deg`` = b
+    exactly (the plate's Rz(yaw) Ry(sadm)); (a, 0, 0) on any span, ``mount_yaw_deg`` =
+    a; any other orientation, ``mount_matrix``. A :class:`FutureWarning` naming the old
+    and the new key is issued once per process.
+
+    Parameters
+    ----------
+    value : Any
+        The table as given (a dict; anything else is returned as it is).
+
+    Returns
+    -------
+    Any
+        The table without ``mount_zyx_deg``.
+    """
+    import warnings
+
+    if not isinstance(value, dict) or "mount_zyx_deg" not in value:
+        return value
+    table = dict(value)
+    old = table.pop("mount_zyx_deg")
+    try:
+        a, b, c = (float(x) for x in old)
+    except (TypeError, ValueError):
+        raise ValueError(f"mount_zyx_deg (deprecated): three angles [deg], got {old!r}") from None
+    given = [key for key in ("mount_yaw_deg", "sadm_angle_deg", "mount_matrix") if key in table]
+    if given:
+        raise ValueError(f"give mount_zyx_deg (deprecated) or {', '.join(given)}, not both")
+    span = str(table.get("span_direction", "+y"))[-1:]
+    if c == 0.0 and (b == 0.0 or span == "y"):
+        table["mount_yaw_deg"], table["sadm_angle_deg"] = a, b
+        new = "mount_yaw_deg and sadm_angle_deg"
+    else:
+        R_BM = Rotation.from_euler("ZYX", np.radians([a, b, c])).as_matrix()
+        table["mount_matrix"] = R_BM.tolist()
+        new = "mount_matrix"
+    if "mount_zyx_deg" not in _RENAMED_WARNED:
+        _RENAMED_WARNED.add("mount_zyx_deg")
+        warnings.warn(
+            f"appendages: mount_zyx_deg is deprecated, read as {new} (the keys every "
+            f"appendage model names its mount with: mount_yaw_deg, sadm_angle_deg or "
+            f"mount_matrix); write {new} instead",
+            FutureWarning,
+            stacklevel=2,
+        )
+    return table

@@ -88,7 +88,7 @@ def driven_plate(plate: AppendageConfig, stiffness: np.ndarray, damping: np.ndar
     }  # fmt: skip
     return ChainConfig.model_validate({
         "name": plate.name, "model": "chain", "mount_point_m": plate.mount_point_m,
-        "mount_zyx_deg": (plate.mount_yaw_deg, 0.0, 0.0), "span_direction": plate.span_direction,
+        "mount_yaw_deg": plate.mount_yaw_deg, "span_direction": plate.span_direction,
         "segment_list": [rotor, panel],
     })  # fmt: skip
 
