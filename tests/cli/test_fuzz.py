@@ -306,10 +306,12 @@ def _hostile_modifier(rng: np.random.Generator) -> dict:
     """A modifier of a random path, op and value source, each possibly hostile."""
     modifier = {"path": _PATHS[rng.integers(len(_PATHS))]}
     if rng.random() < 0.7:
-        modifier["op"] = ["set", "scale", "add", 3][rng.integers(4)]
+        modifier["op"] = ["set", "scale", "set", "scale", "set", "scale", "add", 3][rng.integers(8)]
     source = _SOURCES[rng.integers(len(_SOURCES))]
     sizes = {"value": None, "uniform": 2, "normal": 2, "truncnormal": 4}
-    if sizes[source] is None or rng.random() < 0.2:
+    if sizes[source] is None and rng.random() < 0.5:  # a plausible number
+        modifier[source] = float(rng.choice([-1.0, 1.0]) * 10.0 ** rng.uniform(-3, 3))
+    elif sizes[source] is None or rng.random() < 0.2:
         modifier[source] = _hostile(rng)
     else:
         modifier[source] = [_NUMBERS[rng.integers(len(_NUMBERS))] if rng.random() < 0.4
@@ -322,7 +324,23 @@ def _mutate_campaign(rng: np.random.Generator, bases: list[dict]) -> str:
     import copy
 
     data = copy.deepcopy(bases[rng.integers(len(bases))])
-    for _ in range(rng.integers(1, 4)):
+    lists = [p for p in _leaf_paths(data) if p[-1] in ("plant", "scenario", "parameters")]
+    if lists and rng.random() < 0.5:  # one modifier added or replaced, the rest intact
+        where = lists[rng.integers(len(lists))]
+        node = data
+        for part in where:
+            node = node[part]
+        modifier = _hostile_modifier(rng)
+        if where[-1] == "parameters":  # a search's parameter: a path, an op and bounds
+            low = float(rng.normal() * 10.0 ** rng.uniform(-3, 3))
+            modifier = {"path": modifier["path"], "op": modifier.get("op", "set"),
+                        "bounds": [low, low + 10.0 ** rng.uniform(-3, 3)]}  # fmt: skip
+        if node and rng.random() < 0.5:
+            node[rng.integers(len(node))] = modifier
+        else:
+            node.append(modifier)
+        return to_toml(data)
+    for _ in range(rng.integers(1, 3)):
         paths = _leaf_paths(data)
         path = paths[rng.integers(len(paths))]
         node = data

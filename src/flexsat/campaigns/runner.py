@@ -130,6 +130,7 @@ SUMMARY_ROWS = (
     ("worst_final_pointing_error_deg", "worst final pointing error [deg]"),
     ("cpu_time_s", "CPU time of the stored cases [s]"),
     ("campaign_wall_time_s", "wall time of every run into the store [s]"),
+    ("runs", "runs recorded in the store"),
     ("run_wall_time_s", "wall time of this run [s]"),
 )
 """The rows of a campaign's summary table (CLI and report): key in the summary, and
