@@ -749,8 +749,8 @@ def _print_config(payload: dict) -> None:
     top = {k: v for k, v in config.items() if k not in ("name", "appendages")}
     print_table(_console, f"Satellite {config['name']}", ("parameter", "value"),
                 list(_flat(top).items()))  # fmt: skip
-    _print_per_appendage("Appendages (- : not a parameter of that appendage's model)",
-                         "parameter", config["appendages"])  # fmt: skip
+    _print_per_appendage("Appendages (-: not set, n/a: not a parameter of that "
+                         "appendage's model)", "parameter", config["appendages"])  # fmt: skip
     inertia = derived["hub_inertia_kg_m2"]
     rows = [[a, *row] for a, row in zip("xyz", inertia, strict=True)]
     print_table(_console, "Derived: hub inertia about the hub centre of mass [kg m^2]",
@@ -763,7 +763,7 @@ def _print_config(payload: dict) -> None:
 def _print_per_appendage(title: str, label: str, appendages: list[dict]) -> None:
     flat = [_flat({k: v for k, v in a.items() if k != "name"}) for a in appendages]
     keys = list(dict.fromkeys(key for item in flat for key in item))
-    rows = [[key, *(item.get(key, "-") for item in flat)] for key in keys]
+    rows = [[key, *(item.get(key, "n/a") for item in flat)] for key in keys]
     print_table(_console, title, (label, *(a["name"] for a in appendages)), rows)
 
 
