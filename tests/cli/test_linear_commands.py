@@ -63,6 +63,15 @@ def test_margins_table_and_files(tmp_path):
     assert "delay margin" in result.stdout
     summary = json.loads((tmp_path / "margins.json").read_text())
     assert set(summary["axes"]) == {"x", "y", "z"}
+    # Every crossover and flexible peak is printed: the x loop's three crossovers and
+    # its phase-stabilized 0.521 Hz mode (+28.46 dB; against python-control in
+    # tests/linear/test_frequency.py).
+    x = summary["axes"]["x"]
+    assert [c["frequency_hz"] for c in x["crossovers"]] == x["crossovers_hz"]
+    assert len(x["crossovers"]) == 3
+    phase = [p for p in x["flexible_peaks"] if p["stabilized"] == "phase"]
+    assert [round(p["peak_gain_db"], 2) for p in phase] == [28.46]
+    assert "28.46" in result.stdout and "phase" in result.stdout and "sets it" in result.stdout
     assert (tmp_path / "loop_gain.png").exists() and (tmp_path / "nichols.png").exists()
 
 
