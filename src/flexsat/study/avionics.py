@@ -417,6 +417,10 @@ def _delay_figure(sweep: list[dict], margin: dict | None, path: Path) -> Path:
         ax.set_ylabel(label)
         ax.legend()
     axes[1, 0].set_xscale("symlog", linthresh=0.01)  # 0 s and the margin's neighbours apart
+    ticks = [d for d in (0.0, 0.01, 0.02, 0.05, 0.1, 0.2, 0.5, 1.0)
+             if delay.min() * 0.8 <= d <= delay.max() * 1.2]  # fmt: skip
+    axes[1, 0].set_xticks(ticks, [f"{d:g}" for d in ticks])
+    axes[1, 0].set_xlim(0.8 * delay.min() if delay.min() > 0.0 else -0.002, 1.1 * delay.max())
     axes[1, 0].set_xlabel("computational delay [s]")
     axes[0, 0].set_title("45/45/45 deg ASMC slew: stability boundary against delay")
     return save_figure(fig, path, dpi=110)
