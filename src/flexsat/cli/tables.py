@@ -31,7 +31,7 @@ def format_number(value: float | int, digits: int = SIGNIFICANT_DIGITS) -> str:
     Parameters
     ----------
     value : float or int
-        The number; integers are printed whole.
+        The number, in whatever unit its column names [any]; integers are printed whole.
     digits : int
         Significant digits of a float.
 

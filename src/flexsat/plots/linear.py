@@ -76,7 +76,7 @@ def phase_deg(response: np.ndarray) -> np.ndarray:
     Parameters
     ----------
     response : ndarray, shape (n_f,) or (n_f, ...)
-        Complex response, frequency along the first axis.
+        Complex response, frequency along the first axis [output unit / input unit].
 
     Returns
     -------
