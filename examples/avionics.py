@@ -70,7 +70,11 @@ metrics = {"ideal": slew_metrics(ideal.dataset), "avionics": slew_metrics(avioni
 # %%
 # The verdicts, side by side
 # --------------------------
-# R1 holds with the avionics; R2 is lost. The residual rate is set by the gyro's
+# R1 holds with the avionics; R2 is lost, and so is R3: at the slew's start the law's
+# command is clipped to 1.9 N m on every axis, and the pyramid's pseudo-inverse asks
+# the wheel on (1, 1, 1)/sqrt(3) for 3/4 sqrt(3) 1.9 = 2.47 N m, more than its
+# 2 N m motor gives (R3 judges a wheel cluster on what each wheel is asked, not on
+# the hub torque, which holds the wheels' gyroscopic torque). The residual rate is set by the gyro's
 # angle random walk: each 100 Hz rate sample carries N / sqrt(0.01 s) = 1.7e-3
 # deg/s (1 sigma) of white noise, which the MEKF passes on (it removes the bias,
 # not the noise) and the law turns into torque; a gyro with a third of that angle
@@ -119,8 +123,10 @@ avionics.plot("mekf")
 # is at rest its momentum grows by the environment torque, 0.005 N m per axis, to
 # about 0.6 N m s per axis after 120 s. Middle: the fullest wheel against its speed
 # limit; a wheel at 99.9 % of it is saturated, R3 then fails and the metric
-# ``actuator_saturation_s`` says when each wheel first was. Bottom: the wheels'
-# kinetic energy, the motor work and the friction loss.
+# ``actuator_saturation_s`` says when each wheel first was. Third: each wheel's
+# speed against +-6000 rpm, with its zero crossings (where the bearing friction
+# changes sign) and the largest motor torque asked of a wheel, R3's ratio. Bottom:
+# the wheels' kinetic energy, the motor work and the friction loss.
 
 fullest = avionics.dataset["wheel_speed_ratio"].values  # max |h_i| / (I_s Omega_max) [-]
 cluster = avionics.dataset["wheel_momentum_B"].values  # sum a_i h_i, hub frame [N m s]
