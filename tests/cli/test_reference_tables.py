@@ -7,6 +7,8 @@ import json
 from tests.cli.harness import flexsat
 
 SCENARIO = """duration_s = 5.0
+[requirements]
+settling_deadline_s = 4.0
 [reference]
 kind = "eigenaxis"
 profile = "polynomial"

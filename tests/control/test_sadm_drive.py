@@ -79,7 +79,9 @@ def test_bad_settings_give_one_message_and_exit_code_2(fields, fragment, tmp_pat
             return "[" + ", ".join(toml(v) for v in value) + "]"
         return repr(value)
 
-    body = "duration_s = 0.01\n[joint_actuator]\nkind = \"sadm_drive\"\n" + "".join(
+    # a 10 ms run that holds its observation window (a run must, test_bad_inputs.py)
+    body = ("duration_s = 0.01\n[requirements]\nsettling_deadline_s = 0.005\n"
+            "[joint_actuator]\nkind = \"sadm_drive\"\n") + "".join(
         f"{key} = {toml(value)}\n" for key, value in table.items())  # fmt: skip
     (tmp_path / "s.toml").write_text(body)
     outcome = flexsat(["slew", "--scenario", str(tmp_path / "s.toml"), "--out",

@@ -228,7 +228,7 @@ def test_the_chains_former_mount_key_is_read_with_one_warning(monkeypatch):
     from tests.conftest import nominal_dict
     from tests.dynamics.chain_satellites import plate_as_chain
 
-    monkeypatch.setattr(chain_config, "_RENAMED_WARNED", set())
+    monkeypatch.setattr(chain_config, "_RENAMED_WARNED", set(), raising=False)
     data = nominal_dict()
     new = plate_as_chain(data["appendages"][0])
     new.update(mount_yaw_deg=30.0, sadm_angle_deg=20.0)

@@ -115,21 +115,23 @@ def test_the_slew_states_how_r1_and_r2_are_judged(report):
 # -- satellites of several appendage models -------------------------------------------
 
 
-def _mixed_satellites() -> dict:
-    """The nominal satellite with its first plate replaced, by its twin as a chain, and
-    by its modal export (3 modes): each keeps the second plate beside it."""
+def _mixed_satellite(kind: str):
+    """The nominal satellite with its first plate replaced, by its twin as a chain
+    (``"chain + plate"``) or by its modal export, 3 modes (``"modal + plate"``): the
+    second plate stays beside it."""
     from flexsat import Plant
     from flexsat.config import validate_config
     from flexsat.linear.export import modal_satellite
     from tests.conftest import nominal_dict
     from tests.dynamics.chain_satellites import plate_as_chain
 
-    chain = nominal_dict()
-    chain["appendages"][0] = plate_as_chain(chain["appendages"][0])
-    exported = modal_satellite(Plant.from_config(validate_config(nominal_dict())), n_modes=3)
-    modal = nominal_dict()
-    modal["appendages"][0] = exported.model_dump(mode="json")["appendages"][0]
-    return {"chain + plate": validate_config(chain), "modal + plate": validate_config(modal)}
+    data = nominal_dict()
+    if kind == "chain + plate":
+        data["appendages"][0] = plate_as_chain(data["appendages"][0])
+    else:
+        exported = modal_satellite(Plant.from_config(validate_config(data)), n_modes=3)
+        data["appendages"][0] = exported.model_dump(mode="json")["appendages"][0]
+    return validate_config(data)
 
 
 def _configuration_report(config, out) -> tuple[str, dict]:
@@ -152,7 +154,7 @@ def test_the_configuration_of_mixed_appendage_models_is_drawn(tmp_path, kind):
     # A parameter one model has and the other lacks (the chain's segment count, the modal
     # appendage's mode-shape data) is a row with the value where the model has it and
     # "—" where it does not; every value shown is the one configuration.json holds.
-    config = _mixed_satellites()[kind]
+    config = _mixed_satellite(kind)
     text, manifest = _configuration_report(config, tmp_path / "study")
     assert "could not be drawn" not in text and "This part failed" not in text
     assert manifest["parts"][0]["status"] == "ok"
@@ -178,7 +180,7 @@ def test_a_section_that_cannot_be_drawn_fails_its_part(tmp_path):
     # study.json (status, error, traceback), never listed "ok".
     from flexsat.study.report import write_report
 
-    config = _mixed_satellites()["chain + plate"]
+    config = _mixed_satellite("modal + plate")
     out = tmp_path / "study"
     _configuration_report(config, out)
     path = out / "configuration" / "configuration.json"
