@@ -40,6 +40,8 @@ def test_a_resumed_campaign_counts_its_stored_cases_and_their_time(tmp_path):
     assert all(c > 0.0 for c in cpu)  # each case was flown, by some process
     # a sum of the same two floats: equal to rounding (1e-12 relative)
     assert third["cpu_time_s"] == pytest.approx(sum(cpu), rel=1e-12)
+    own = [row["case_wall_time_s"] for row in stored]
+    assert third["case_wall_time_s"] == pytest.approx(sum(own), rel=1e-12)
     walls = [first["wall_time_s"], second["wall_time_s"], third["run_wall_time_s"]]
     assert third["runs"] == 3
     assert third["campaign_wall_time_s"] == pytest.approx(sum(walls), rel=1e-12)
@@ -107,7 +109,7 @@ def test_the_worst_cases_are_listed_per_requirement(tmp_path):
     pointing = [c["case_id"] for c in worst["pointing"]["cases"]]
     assert pointing == ["c099", "c098", "c097", "c096", "c095"]
     assert len(pointing) == WORST_CASES
-    assert [w["case_id"] for w in summary["worst_cases"]] == pointing  # as before
+    assert [w["case_id"] for w in summary["worst_cases"]] == pointing  # the figure's list
     assert math.isclose(summary["worst_final_pointing_error_deg"], 1e-3 + 99e-5)
 
 
