@@ -233,15 +233,18 @@ def test_the_study_writes_no_byte_through_a_link_and_shows_the_name(tmp_path, ca
     victim = _victim(tmp_path)
     planted = [Path(p) for p in _STUDY_FILES]
     _plant_links(out, planted, victim)
+    # A part's folder that is a link: refused before any part runs, nothing written.
     (out / "avionics").symlink_to(outside, target_is_directory=True)
-    outcome = flexsat(["study", "--quick", "--config", str(config), "--out", str(out)], capsys,
-                      _LIMIT_S)  # fmt: skip
-    # The linked part folder fails its part (exit code 1, the part named), the rest runs.
-    assert outcome.code == 1, outcome.stderr
-    assert "failed parts: Avionics" in outcome.stderr
-    assert victim.read_bytes() == VICTIM
+    argv = ["study", "--quick", "--config", str(config), "--out", str(out)]
+    outcome = flexsat(argv, capsys, _LIMIT_S)
+    assert outcome.code == 2, outcome.stderr
+    assert "avionics is a symbolic link inside the output folder" in outcome.stderr
     assert list(outside.iterdir()) == []
+    assert _replaced(out, planted) == planted  # not one written
+    # Without it, the study replaces every link by its own file.
+    (out / "avionics").unlink()
+    outcome = flexsat(argv, capsys, _LIMIT_S)
+    assert outcome.code == 0, outcome.stderr
+    assert victim.read_bytes() == VICTIM
     assert _replaced(out, planted) == []
-    report = (out / "report.html").read_text()
-    assert "avionics is a symbolic link inside the output folder" in report
-    assert _STUDY_NAME in report
+    assert _STUDY_NAME in (out / "report.html").read_text()

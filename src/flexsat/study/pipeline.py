@@ -37,6 +37,7 @@ from flexsat import __version__
 from flexsat._compiled_cache import kernels_cached
 from flexsat.config.models import SatelliteConfig
 from flexsat.control.laws import LAWS
+from flexsat.files import ensure_dir
 from flexsat.parallel import (
     figure_workers,
     forked_map,
@@ -354,10 +355,19 @@ def run_study(
     dict
         The manifest (also in ``out/study.json``) with ``report`` added: the
         report's path.
+
+    Raises
+    ------
+    ConfigError
+        ``out`` cannot be written, or a part's folder in it is a symbolic link
+        (:func:`flexsat.files.ensure_dir`), before any part runs.
     """
     from flexsat.study.report import write_report
 
     out = prepare_output_dir(out)
+    for part in PARTS:  # a part's folder that is a link is refused before any work
+        if (out / part.name).is_symlink():
+            ensure_dir(out / part.name)
     console = console or Console(stderr=True)
     ctx = StudyContext(config, out, quick, progress, workers, tuple(controllers))
     manifest = {
