@@ -20,6 +20,8 @@ from pydantic import Field, model_validator
 from flexsat.config.models import Positive, _Frozen
 
 __all__ = [
+    "DECAY_RATIO",
+    "GROWTH_RATIO",
     "Requirements",
     "absolute_performance_error",
     "actuator_saturation_times",
