@@ -295,8 +295,8 @@ SPECIAL_FILES = [
     Bad("slew scenario is /dev/zero", ["slew", "--scenario", "/dev/zero"], f"cannot read scenario file /dev/zero: {_NOT_REGULAR}", {}, 10),
     Bad("campaign is a FIFO", ["campaign", "{tmp}/k.toml", "--out", "{tmp}/store"], f"cannot read campaign file {{tmp}}/k.toml: {_NOT_REGULAR}", {"k.toml": FIFO}, 10),
     Bad("campaign is /dev/zero", ["campaign", "/dev/zero", "--out", "{tmp}/store"], f"cannot read campaign file /dev/zero: {_NOT_REGULAR}", {}, 10),
-    Bad("modal data TOML is a FIFO", ["modal", "--config", "{tmp}/c.toml"], f"cannot read modal data file m.toml: {_NOT_REGULAR}", {"c.toml": _modal_file("m.toml"), "m.toml": FIFO}, 10),
-    Bad("modal data NPZ is a FIFO", ["modal", "--config", "{tmp}/c.toml"], f"cannot read modal data file m.npz: {_NOT_REGULAR}", {"c.toml": _modal_file("m.npz"), "m.npz": FIFO}, 10),
+    Bad("modal data TOML is a FIFO", ["modal", "--config", "{tmp}/c.toml"], f"cannot read modal data file {{tmp}}/m.toml: {_NOT_REGULAR}", {"c.toml": _modal_file("m.toml"), "m.toml": FIFO}, 10),
+    Bad("modal data NPZ is a FIFO", ["modal", "--config", "{tmp}/c.toml"], f"cannot read modal data file {{tmp}}/m.npz: {_NOT_REGULAR}", {"c.toml": _modal_file("m.npz"), "m.npz": FIFO}, 10),
     Bad("plot a FIFO", ["plot", "{tmp}/r.nc"], f"cannot read RESULT file {{tmp}}/r.nc: {_NOT_REGULAR}", {"r.nc": FIFO}, 10),
     Bad("animate a FIFO", ["animate", "{tmp}/r.nc"], f"cannot read RESULT file {{tmp}}/r.nc: {_NOT_REGULAR}", {"r.nc": FIFO}, 10),
 ]  # fmt: skip
