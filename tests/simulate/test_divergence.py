@@ -70,9 +70,7 @@ _HUGE_DISTURBANCE = {
 }  # fmt: skip
 
 
-def test_a_diverging_slew_keeps_its_history_and_metrics_of_its_finite_part(
-    nominal_plant, tmp_path
-):
+def test_a_diverging_slew_keeps_its_history_and_metrics_of_its_finite_part(nominal_plant, tmp_path):
     from flexsat.simulate import SlewScenario
     from flexsat.study.outputs import fly_slew
 
@@ -86,7 +84,68 @@ def test_a_diverging_slew_keeps_its_history_and_metrics_of_its_finite_part(
     assert not stored["r1_pass"] and not stored["r2_pass"]  # stopped before the window
     # NaN is a quantity that does not exist (a settling time, the APE of a window the run
     # never reached); nothing is infinite: the metrics read the finite records only.
-    numbers = [v for value in metrics.values()
-               for v in (value if isinstance(value, list) else [value]) if isinstance(v, float)]
+    numbers = [
+        v
+        for value in metrics.values()
+        for v in (value if isinstance(value, list) else [value])
+        if isinstance(v, float)
+    ]
     assert not any(math.isinf(v) for v in numbers)
     assert math.isnan(metrics["ape_deg"]) and math.isnan(metrics["settling_time_s"])
+
+
+# DOP853 on a diverging run: the child process builds the plant and compiles first
+# (its "ready" line), then flies 1e9, 1e12 and 1e200 N m about Z; the adaptive steps
+# shrink as the hub spins up until they fall below 1e-2 dt_s (1e9, 1e12) or the first
+# step fails (1e200). It must stop with its history instead of stepping on (it ran
+# past 60 s at 1e9 and 120 s at 1e12 before) or raising (1e200).
+_DOP853_CHILD = """
+import json, sys
+from flexsat import Plant, load_config
+from flexsat.config import validate_config
+from flexsat.simulate import OpenLoopScenario
+from flexsat.simulate.openloop import run_openloop
+
+plant = Plant.from_config(load_config())
+def scenario(torque, duration):
+    return validate_config({"solver": "dop853", "duration_s": duration,
+                            "torque": [{"start_s": 0.0, "torque_nm": [0, 0, torque]}]},
+                           model=OpenLoopScenario)
+run_openloop(plant, scenario(1.0, 0.05), progress=False)  # compile and warm up
+print("ready", flush=True)
+out = []
+for torque in (1e9, 1e12, 1e200):
+    ds = run_openloop(plant, scenario(torque, 20.0), progress=False).dataset
+    out.append({"torque": torque, "status": ds.attrs["status"], "message": ds.attrs["message"],
+                "failure_time_s": ds.attrs["failure_time_s"], "records": ds.sizes["time"],
+                "t_last": float(ds["time"].values[-1])})
+print(json.dumps(out), flush=True)
+"""
+
+
+def test_dop853_stops_a_diverging_run_with_its_history():
+    import select
+    import subprocess
+    import sys
+
+    child = subprocess.Popen([sys.executable, "-c", _DOP853_CHILD], stdout=subprocess.PIPE,
+                             stderr=subprocess.PIPE, text=True)  # fmt: skip
+    try:
+        ready, _, _ = select.select([child.stdout], [], [], 600)  # start-up: compile, load
+        assert ready and child.stdout.readline().strip() == "ready", child.stderr.read()
+        # The bound of the three diverging runs: a hang is a failure, not a slow pass.
+        out, err = child.communicate(timeout=10)
+    except subprocess.TimeoutExpired:
+        child.kill()
+        child.communicate()
+        pytest.fail("DOP853 on a diverging run did not stop within 10 s")
+    assert child.returncode == 0, err
+    for run in json.loads(out):
+        assert run["status"] == "failed", run
+        t_fail = run["failure_time_s"]
+        assert 0.0 <= t_fail < 20.0 and f"stopped at t = {t_fail:.6g} s" in run["message"], run
+        assert run["records"] >= 1 and run["t_last"] == pytest.approx(t_fail), run
+    stopped = {run["torque"]: run["message"] for run in json.loads(out)}
+    assert "adaptive step fell below 1e-2 of dt_s" in stopped[1e9]
+    assert "adaptive step fell below 1e-2 of dt_s" in stopped[1e12]
+    assert "non-finite" in stopped[1e200]

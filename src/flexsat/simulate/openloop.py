@@ -22,6 +22,7 @@ from flexsat.dynamics.integrators import (
 from flexsat.dynamics.kernels import STATUS_OK, hub_cs
 from flexsat.dynamics.linalg3 import euler_rate_matrix_inv
 from flexsat.dynamics.plant import Plant
+from flexsat.dynamics.status import STATUS_STEP_BUDGET, STATUS_STEP_TOO_SMALL
 from flexsat.errors import ConfigError
 from flexsat.simulate.common import (
     PROGRESS_MIN_STEPS,
@@ -35,8 +36,18 @@ from flexsat.simulate.scenario import OpenLoopScenario, thesis_openloop
 from flexsat.simulate.stream import RecordStream, check_disk_space
 from flexsat.simulate.typed_call import typed_list
 
-__all__ = ["initial_state", "listed_derivative", "run_openloop"]
+__all__ = [
+    "DOP853_MIN_STEP_FRACTION",
+    "DOP853_STEP_BUDGET",
+    "initial_state",
+    "listed_derivative",
+    "run_openloop",
+]
 
+DOP853_MIN_STEP_FRACTION = 1e-2
+"""An accepted DOP853 step below this fraction of ``dt_s`` stops the run as diverging."""
+DOP853_STEP_BUDGET = 4
+"""DOP853 may take at most this many times the run's fixed-step count (duration / dt_s)."""
 
 
 def initial_state(plant: Plant, scenario: OpenLoopScenario) -> tuple[np.ndarray, np.ndarray]:
@@ -234,8 +245,12 @@ def _run_rk4(plant, scenario, q0, qd0, profile, progress, keep, capacity=None):
             steps = min(chunk, n_steps - done)
             row = done // every + 1 - base
             if row + -(-steps // every) > size:  # the buffer is full: hand it over
-                keep(rec_t[:row].copy(), rec_x[:row].copy(), rec_tau[:row].copy(),
-                     rec_frame[:row].copy())
+                keep(
+                    rec_t[:row].copy(),
+                    rec_x[:row].copy(),
+                    rec_tau[:row].copy(),
+                    rec_frame[:row].copy(),
+                )
                 handed_t = float(rec_t[row - 1])
                 base += row
                 row = 0
@@ -293,16 +308,22 @@ def listed_derivative(x, torque_B, n, Q, dx, plants):
 
 
 def _run_dop853(plant, scenario, q0, qd0, profile):
-    """Adaptive DOP853 (scipy), integrated piecewise between torque switching times.
+    """Adaptive DOP853 (scipy), stepped piecewise between torque switching times.
 
-    Each piece also ends where |pitch| reaches ``SWITCH_PITCH`` (a terminal event):
-    the attitude is re-based there (:func:`flexsat.dynamics.attitude.rebase`) and the
-    piece continues from the event. A run that diverges stops there, like RK4: the
-    records up to the failure and the last good state are kept, with its status.
+    Each piece also ends where |pitch| reaches ``SWITCH_PITCH`` (a terminal event,
+    located on the step's dense output): the attitude is re-based there
+    (:func:`flexsat.dynamics.attitude.rebase`) and the piece continues from the event.
+    A run that diverges stops there, like RK4: the records up to the failure and the
+    last good state are kept, with its status. It diverges when a step fails (a
+    non-finite state or a kernel's singularity), when an accepted step falls below
+    ``DOP853_MIN_STEP_FRACTION`` of ``dt_s`` (the motion is then far faster than the
+    run's time step resolves: RK4 at ``dt_s`` would overflow), or when the steps
+    exceed ``DOP853_STEP_BUDGET`` times the run's fixed-step count.
     """
     # imported here: scipy.integrate costs 0.2 s to import, and every process that
     # imports the simulator (a campaign worker, any CLI command) would pay it
-    from scipy.integrate import solve_ivp
+    from scipy.integrate import DOP853
+    from scipy.optimize import brentq
 
     n = plant.n_dof
     seg_start, seg_end, _, _ = profile
@@ -317,15 +338,17 @@ def _run_dop853(plant, scenario, q0, qd0, profile):
     X[0] = x
     frame = identity_frame()
     F = np.empty((t_rec.size, 9))
+    F[0] = frame
     Q = np.zeros(n)  # no joint actuators
     evaluations = 0
     kernel_status = STATUS_OK
+    h_min = DOP853_MIN_STEP_FRACTION * scenario.dt_s
+    budget = DOP853_STEP_BUDGET * max(scenario.n_steps, 1)
+    accepted = 0
 
-    def switch(t, y, torque=None):  # positive after each rebase
+    def switch(y):  # positive after each rebase
         return SWITCH_PITCH - abs(y[4])
 
-    switch.terminal = True
-    switch.direction = -1.0
     status, t_fail = STATUS_OK, -1.0
     pieces = list(itertools.pairwise(breaks))
     while pieces and not status:
@@ -343,23 +366,44 @@ def _run_dop853(plant, scenario, q0, qd0, profile):
                 dy[:] = np.nan
             return dy
 
-        sol = solve_ivp(
-            rhs, (a, b), x, method="DOP853", rtol=scenario.rtol, atol=scenario.atol,
-            dense_output=True, events=switch,
-        )  # fmt: skip
-        t_end = float(sol.t[-1])
-        inside = (t_rec >= a) & (t_rec <= t_end)
-        if inside.any():  # a piece cut short by a switch may hold no record
-            X[inside] = sol.sol(t_rec[inside]).T
-            F[inside] = frame
-        x = sol.y[:, -1].copy()
-        if sol.status == 1:  # the switching event: re-base, go on to b
-            rebase(x, n, frame, 0.0)
-            if t_end < b:
-                pieces.insert(0, (t_end, b))
-        elif sol.status == -1:  # the steps failed (diverged)
-            status = kernel_status or STATUS_NOT_FINITE
-            t_fail = t_end
+        with np.errstate(over="ignore", invalid="ignore"):  # its first step's guess
+            solver = DOP853(rhs, a, x, b, rtol=scenario.rtol, atol=scenario.atol)
+        t_end, first = a, True
+        while solver.status == "running":
+            t_old, g_old = solver.t, switch(solver.y)
+            with np.errstate(over="ignore", invalid="ignore"):  # a diverging step: refused
+                solver.step()
+            if solver.status == "failed" or not np.all(np.isfinite(solver.y)):
+                status = kernel_status or STATUS_NOT_FINITE
+                break
+            accepted += 1
+            dense = solver.dense_output()
+            t_end = solver.t
+            event = g_old > 0.0 and switch(solver.y) <= 0.0
+            if event:  # the pitch switch: end the piece there
+                t_end = brentq(lambda s, dense=dense: switch(dense(s)), t_old, solver.t,
+                               xtol=1e-12 * max(1.0, abs(solver.t)))  # fmt: skip
+            inside = (t_rec > t_old) & (t_rec <= t_end)
+            if inside.any():
+                X[inside] = dense(t_rec[inside]).T
+                F[inside] = frame
+            if event:
+                x = dense(t_end)
+                rebase(x, n, frame, 0.0)
+                if t_end < b:
+                    pieces.insert(0, (t_end, b))
+                break
+            x = solver.y.copy()
+            # (a piece's first step is the starting guess's: it may be far below the rest)
+            if not first and solver.t < b and solver.step_size < h_min:
+                status = STATUS_STEP_TOO_SMALL
+            elif accepted > budget:
+                status = STATUS_STEP_BUDGET
+            if status:
+                break
+            first = False
+        if status:
+            t_fail = float(t_end)
     if status:
         kept = int(np.searchsorted(t_rec, t_fail, side="right"))
         t_rec = np.append(t_rec[:kept], t_fail) if t_fail > t_rec[kept - 1] else t_rec[:kept]
