@@ -110,3 +110,29 @@ def test_docs_citations_name_existing_sections(path):
     for single, double in CHANGELOG_CITATION.findall(flat):
         heading = single or double
         assert heading in changelog, f"{path}: no entry {heading!r} in CHANGELOG.md"
+
+
+def _mapped_modules() -> set[str]:
+    """The modules docs/architecture.md's module map lists, as dotted names."""
+    text = (DOCS / "architecture.md").read_text(encoding="utf-8")
+    section = text.split("\n## Module map\n", 1)[1].split("\n## ", 1)[0]
+    listed, package = set(), None
+    for line in section.splitlines():
+        if match := re.fullmatch(r"### `([\w.]+)`", line):
+            package = match.group(1)
+        elif match := re.match(r"- `([\w.]+)`: \S", line):
+            listed.add(f"{package}.{match.group(1)}")
+    return listed
+
+
+def test_the_module_map_lists_every_module_once():
+    source = ROOT / "src"
+    modules = set()
+    for path in (source / "flexsat").rglob("*.py"):
+        if "presets" in path.parts:
+            continue
+        parts = path.with_suffix("").relative_to(source).parts
+        # a subpackage's modules are listed under their top-level package
+        package = ".".join(parts[:2]) if len(parts) > 2 else "flexsat"
+        modules.add(f"{package}.{'.'.join(parts[len(package.split('.')):])}")
+    assert _mapped_modules() == modules
