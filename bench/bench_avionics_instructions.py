@@ -63,9 +63,7 @@ import tempfile
 import time
 from pathlib import Path
 
-from rich.console import Console
-from rich.table import Table
-
+import harness
 from bench_avionics import CASES, TARGET  # the benchmarks run with bench/ on sys.path
 
 SHIM = r"""
@@ -166,6 +164,12 @@ def native_warm_up() -> tuple[str, str]:
     return cpu_name, features
 
 
+@harness.register(
+    "the four cases of bench_avionics in executed instructions (valgrind's callgrind) instead "
+    "of wall time: instructions per step of the compiled loop, against the 1.3x goal; "
+    "repeatable under any load; needs valgrind and gcc",
+    full=False,
+)
 def main(argv: list[str] | None = None) -> dict:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--short", type=float, default=1.0, help="shorter slew [s]")
@@ -233,14 +237,12 @@ def main(argv: list[str] | None = None) -> dict:
         call = ir[case, first] - rows[case]["check_ir_per_step"] * steps[case, first]
         rows[case]["call_ir"] = call
     ideal, ideal_check = rows[IDEAL]["ir_per_step"], rows[IDEAL]["check_ir_per_step"]
-    table = Table(title=f"closed loop with avionics, instructions (callgrind Ir) per step, "
-                        f"dt = 1 ms, from the {first:g} s to the {last:g} s slew "
-                        f"({first:g}-{check:g} s: the {first:g} s to the {check:g} s one); "
-                        f"{version}")  # fmt: skip
-    columns = ("case", "Ir / step", "x ideal", "target", "verdict",
-               f"Ir / step {first:g}-{check:g} s", f"x ideal {first:g}-{check:g} s")  # fmt: skip
-    for column in columns:
-        table.add_column(column, justify="left" if column == "case" else "right")
+    span = f"{first:g}-{check:g} s"
+    table = harness.table(f"closed loop with avionics, instructions (callgrind Ir) per step, "
+                          f"dt = 1 ms, from the {first:g} s to the {last:g} s slew "
+                          f"({span}: the {first:g} s to the {check:g} s one); {version}",
+                          ("case", "Ir / step", "x ideal", "target", "verdict",
+                           f"Ir / step {span}", f"x ideal {span}"))  # fmt: skip
     for case, row in rows.items():
         row["ratio"] = row["ir_per_step"] / ideal
         row["check_ratio"] = row["check_ir_per_step"] / ideal_check
@@ -252,12 +254,13 @@ def main(argv: list[str] | None = None) -> dict:
         table.add_row(case, f"{row['ir_per_step']:,.1f}", f"{row['ratio']:.4f}", target,
                       verdict, f"{row['check_ir_per_step']:,.1f}",
                       f"{row['check_ratio']:.4f}")  # fmt: skip
-    flown = Table(title="instructions per flight (one call of the compiled loop)")
-    for column in ("case", *(f"{d:g} s" for d in durations), "call alone"):
-        flown.add_column(column, justify="left" if column == "case" else "right")
+    flown = harness.table(
+        "instructions per flight (one call of the compiled loop)",
+        ("case", *(f"{d:g} s" for d in durations), "call alone"),
+    )
     for case, row in rows.items():
         flown.add_row(case, *(f"{row['ir'][d]:,}" for d in durations), f"{row['call_ir']:,.0f}")
-    console = Console()
+    console = harness.console()
     console.print(table)
     console.print(flown)
     console.print(f"[dim]{wall:.0f} s in all[/dim]")

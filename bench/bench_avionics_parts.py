@@ -22,13 +22,11 @@ Nanoseconds per call; the last column is the piece's share of the ideal step.
 from __future__ import annotations
 
 import argparse
-import time
 
 import numpy as np
 from numba import njit
-from rich.console import Console
-from rich.table import Table
 
+import harness
 from flexsat import Plant, nominal
 from flexsat.control.stages.registry import DERIVATIVE_SIGNATURE, no_derivative
 from flexsat.dynamics.borrowed import borrowed
@@ -66,15 +64,15 @@ def _sense(x, n_steps, n, stages, d):
 def _best(call, x0: np.ndarray, calls: int, batches: int) -> float:
     """Minimum over the batches of one call's time [ns]; each batch from ``x0``."""
     call(x0.copy(), 2)  # compile
-    best = np.inf
-    for _ in range(batches):
-        x = x0.copy()
-        start = time.perf_counter()
-        call(x, calls)
-        best = min(best, time.perf_counter() - start)
+    best, _ = harness.best_of(lambda x: call(x, calls), batches, setup=x0.copy)
     return best / calls * 1e9
 
 
+@harness.register(
+    "the avionics chain's pieces apart, in compiled loops (minimum of many batches): the RK4 "
+    "plant step, the coupled step with an idle derivative and with the wheels, the sensing "
+    "chain stage by stage"
+)
 def main(argv: list[str] | None = None) -> dict[str, float]:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--calls", type=int, default=2000, help="calls per batch")
@@ -120,14 +118,15 @@ def main(argv: list[str] | None = None) -> dict[str, float]:
         "sensing: + star tracker": "sensing: + gyro",
         "sensing: + MEKF": "sensing: + star tracker",
     }
-    table = Table(title=f"avionics pieces, ns per call (min of {args.batches} batches)")
-    for column in ("piece", "ns / call", "added", "added / plant step"):
-        table.add_column(column, justify="left" if column == "piece" else "right")
+    table = harness.table(
+        f"avionics pieces, ns per call (min of {args.batches} batches)",
+        ("piece", "ns / call", "added", "added / plant step"),
+    )
     for name, value in ns.items():
         added = value - ns[against[name]] if name in against else None
         table.add_row(name, f"{value:.0f}", "" if added is None else f"{added:+.0f}",
                       "" if added is None else f"{added / step:+.1%}")  # fmt: skip
-    Console().print(table)
+    harness.console().print(table)
     return ns
 
 

@@ -77,19 +77,16 @@ that a passing load on the machine hits both alike:
 
 from __future__ import annotations
 
-import os
-import platform
 import sys
-import time
 from dataclasses import dataclass
 from types import SimpleNamespace
 
 import numpy as np
 import scipy.linalg
-from rich.console import Console
 from rich.table import Table
 from scipy import signal
 
+import harness
 from flexpanels import import_basilisk
 from flexsat import Plant
 from flexsat.analysis.modal import modal_analysis
@@ -174,9 +171,8 @@ def modal_yaw_frequencies(plant: Plant) -> tuple[float, float]:
 
 def run_flexsat(plant: Plant, scenario: OpenLoopScenario) -> dict:
     """One timed ``run_openloop`` call: integration and whole-call wall times, hub rate."""
-    start = time.perf_counter()
-    result = run_openloop(plant, scenario, progress=False)
-    whole = time.perf_counter() - start
+    timed = harness.stopwatch(lambda: run_openloop(plant, scenario, progress=False))
+    whole, result = timed.wall_s, timed.value
     result.raise_for_status()
     ds = result.dataset
     return {
@@ -274,21 +270,24 @@ def build_basilisk(bsk: SimpleNamespace, plant: Plant, scenario: OpenLoopScenari
 def run_basilisk(bsk: SimpleNamespace, plant: Plant, scenario: OpenLoopScenario) -> dict:
     """Build, initialize and run the Basilisk model; setup and execution timed apart."""
     _, t_off = _torque_pulse(scenario)
-    start = time.perf_counter()
-    model = build_basilisk(bsk, plant, scenario)
-    model.sim.InitializeSimulation()
-    setup = time.perf_counter() - start
 
-    start = time.perf_counter()
-    model.sim.ConfigureStopTime(bsk.macros.sec2nano(t_off))
-    model.sim.ExecuteSimulation()
-    model.torque.extTorquePntB_B = _column(np.zeros(3))
-    model.sim.ConfigureStopTime(bsk.macros.sec2nano(scenario.duration_s))
-    model.sim.ExecuteSimulation()
-    execute = time.perf_counter() - start
+    def build() -> BasiliskModel:
+        model = build_basilisk(bsk, plant, scenario)
+        model.sim.InitializeSimulation()
+        return model
+
+    def fly() -> None:
+        model.sim.ConfigureStopTime(bsk.macros.sec2nano(t_off))
+        model.sim.ExecuteSimulation()
+        model.torque.extTorquePntB_B = _column(np.zeros(3))
+        model.sim.ConfigureStopTime(bsk.macros.sec2nano(scenario.duration_s))
+        model.sim.ExecuteSimulation()
+
+    built = harness.stopwatch(build)
+    model = built.value
     return {
-        "execute_s": execute,
-        "setup_s": setup,
+        "execute_s": harness.stopwatch(fly).wall_s,
+        "setup_s": built.wall_s,
         "steps": round(scenario.duration_s / scenario.dt_s),
         "t": np.asarray(model.recorder.times(), dtype=float) * 1e-9,
         "omega": np.array(model.recorder.omega_BN_B, dtype=float),
@@ -335,10 +334,14 @@ def compare(repeats: int = 3) -> dict:
     _, t_off = _torque_pulse(scenario)
 
     run_flexsat(plant, scenario)  # compile (or load the compiled cache) first
-    flex_runs, bsk_runs = [], []
-    for _ in range(repeats):
-        flex_runs.append(run_flexsat(plant, scenario))
-        bsk_runs.append(run_basilisk(bsk, plant, scenario))
+    runs = harness.interleave(
+        {
+            "flexsat": lambda: run_flexsat(plant, scenario),
+            "basilisk": lambda: run_basilisk(bsk, plant, scenario),
+        },
+        repeats,
+    )
+    flex_runs, bsk_runs = runs["flexsat"], runs["basilisk"]
 
     flex_last, bsk_last = flex_runs[-1], bsk_runs[-1]
     if flex_last["t"].shape != bsk_last["t"].shape or not np.allclose(
@@ -414,24 +417,13 @@ def _table(out: dict) -> Table:
         (bsk["engine"], f"ExecuteSimulation; hub + {n} spinningBodyNDOF panels, 3 rot. DOFs",
          bsk["dof"], bsk["execute_s"], bsk["us_per_step"], bsk),
     ]  # fmt: skip
-    table = Table(
-        title=(
-            f"Open loop, thesis scenario: 1 N m yaw torque for {sc['torque_off_s']:g} s, free "
-            f"to {sc['duration_s']:g} s, RK4 dt {1e3 * sc['dt_s']:g} ms (best of {sc['repeats']})"
-        ),
+    table = harness.table(
+        f"Open loop, thesis scenario: 1 N m yaw torque for {sc['torque_off_s']:g} s, free "
+        f"to {sc['duration_s']:g} s, RK4 dt {1e3 * sc['dt_s']:g} ms (best of {sc['repeats']})",
+        ("engine", "model", "DOF", "wall s per 120 s", "µs per step", "yaw-mode frequency Hz",
+         "final yaw rate deg/s", "ratio vs flexsat"), left=2, no_wrap=True,
         caption="ratio: wall time / flexsat RK4 integration wall time",
-    )
-    for column, justify in (
-        ("engine", "left"),
-        ("model", "left"),
-        ("DOF", "right"),
-        ("wall s per 120 s", "right"),
-        ("µs per step", "right"),
-        ("yaw-mode frequency Hz", "right"),
-        ("final yaw rate deg/s", "right"),
-        ("ratio vs flexsat", "right"),
-    ):
-        table.add_column(column, justify=justify, no_wrap=True)
+    )  # fmt: skip
     for engine, model, dof, wall, us, run in rows:
         table.add_row(
             engine,
@@ -446,9 +438,13 @@ def _table(out: dict) -> Table:
     return table
 
 
+@harness.register(
+    "the open-loop run against Basilisk (optional dependency; skipped with a line when absent)",
+    optional=True,
+)
 def main() -> int:
     """Print the comparison table; 0 on success, 1 if the frequencies disagree."""
-    console = Console() if sys.stdout.isatty() else Console(width=200)
+    console = harness.console(200)
     try:
         import_basilisk()
     except ImportError:
@@ -475,10 +471,7 @@ def main() -> int:
         f"Largest yaw-rate difference between the two histories: "
         f"{out['max_yaw_rate_difference_deg_s']:.2e} deg/s."
     )
-    console.print(
-        f"Machine: {platform.processor() or platform.machine()}, {os.cpu_count()} CPUs, "
-        f"Python {platform.python_version()}, NumPy {np.__version__}."
-    )
+    console.print(f"Machine: {harness.machine()}.")
     return 0 if out["frequencies_agree"] else 1
 
 

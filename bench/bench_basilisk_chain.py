@@ -21,13 +21,11 @@ Run ``python bench/bench_basilisk_chain.py`` (Basilisk: ``pip install -e '.[benc
 from __future__ import annotations
 
 import sys
-import time
 
 import numpy as np
-from rich.console import Console
-from rich.table import Table
 
 import flexpanels as fp
+import harness
 from flexsat.config import validate_config
 from flexsat.dynamics.plant import Plant
 from flexsat.simulate import OpenLoopScenario, run_openloop
@@ -65,9 +63,7 @@ def time_basilisk(bsk, build, n: int) -> float:
     for _ in range(fp.TIMING_TRIALS):
         model = build(bsk, n, dt, False)
         model.sim.ConfigureStopTime(bsk.macros.sec2nano(fp.TIMING_STEPS * dt))
-        start = time.perf_counter()
-        model.sim.ExecuteSimulation()
-        walls.append(time.perf_counter() - start)
+        walls.append(harness.stopwatch(model.sim.ExecuteSimulation).wall_s)
     return float(np.median(walls))
 
 
@@ -97,8 +93,14 @@ def compare(counts: tuple[int, ...] = fp.SEGMENT_COUNTS) -> dict:
     return {"version": bsk.version, "engines": list(engines), "rows": rows, "fits": fits}
 
 
+@harness.register(
+    "chains of N = 1 ... 32 hinged segments (Basilisk's flexible-panel comparison scenario) "
+    "per RK4 step against Basilisk's nHingedRigidBodyStateEffector, "
+    "spinningBodyNDOFStateEffector and MuJoCo; ratio against the 10x goal",
+    optional=True,
+)
 def main() -> int:
-    console = Console() if sys.stdout.isatty() else Console(width=200)
+    console = harness.console(200)
     try:
         fp.import_basilisk()
     except ImportError:
@@ -106,14 +108,12 @@ def main() -> int:
         return 0
     out = compare()
     engines = out["engines"]
-    table = Table(
-        title=(f"Hinged flexible panels (Basilisk's comparison scenario), µs per RK4 step: "
-               f"median of {fp.TIMING_TRIALS} x {fp.TIMING_STEPS} steps, Basilisk "
-               f"{out['version']}"),
+    table = harness.table(
+        f"Hinged flexible panels (Basilisk's comparison scenario), µs per RK4 step: "
+        f"median of {fp.TIMING_TRIALS} x {fp.TIMING_STEPS} steps, Basilisk {out['version']}",
+        ("N", "DOF", "dt ms", "flexsat", *engines, "ratio", "goal"), left=0, no_wrap=True,
         caption=f"ratio: fastest Basilisk engine / flexsat; goal >= {GOAL_RATIO:g}x",
     )  # fmt: skip
-    for column in ("N", "DOF", "dt ms", "flexsat", *engines, "ratio", "goal"):
-        table.add_column(column, justify="right", no_wrap=True)
     for r in out["rows"]:
         table.add_row(
             str(r["N"]), str(r["dof"]), f"{1e3 * r['dt_s']:.4g}", f"{r['flexsat']:.2f}",

@@ -21,9 +21,8 @@ import time
 from pathlib import Path
 
 import psutil
-from rich.console import Console
-from rich.table import Table
 
+import harness
 from flexsat.campaigns import load_campaign, run_campaign
 from flexsat.campaigns.definition import CampaignDefinition
 from flexsat.config import nominal, validate_config
@@ -52,12 +51,17 @@ def _sample(store: Path, stop: threading.Event, samples: list) -> None:
         stop.wait(0.2)
 
 
+@harness.register(
+    "a 2000-case campaign on two workers: resident memory of the parent and the workers "
+    "against the cases stored",
+    full=False,
+)
 def main(argv: list[str] | None = None) -> dict:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--cases", type=int, default=1999, help="random cases (+ the nominal)")
     parser.add_argument("--duration", type=float, default=0.5, help="slew length [s]")
     args = parser.parse_args(argv)
-    console = Console()
+    console = harness.console()
     samples: list = []
     with tempfile.TemporaryDirectory() as tmp:
         store = Path(tmp) / "store"
@@ -73,9 +77,11 @@ def main(argv: list[str] | None = None) -> dict:
             sampler.join()
         wall = time.perf_counter() - start
     total = run["cases"]
-    table = Table(title=f"Memory of a {total}-case campaign (2 local workers, {wall:.0f} s)")
-    for column in ("stored cases", "parent RSS [MB]", "workers RSS [MB]"):
-        table.add_column(column, justify="right")
+    table = harness.table(
+        f"Memory of a {total}-case campaign (2 local workers, {wall:.0f} s)",
+        ("stored cases", "parent RSS [MB]", "workers RSS [MB]"),
+        left=0,
+    )
     marks = [round(total * k / 8) for k in range(9)]
     shown = []
     for mark in marks:

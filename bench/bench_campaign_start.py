@@ -19,19 +19,27 @@ import time
 from pathlib import Path
 
 import psutil
-from rich.console import Console
-from rich.table import Table
+
+import harness
 
 START_GOAL_S = 10.0  # launch to first stored case (a fresh process: imports included)
 MB = 2**20
 
 
+@harness.register(
+    "a campaign of 1e6 cases: time from launch to the first stored case, and the parent's "
+    "memory then and later",
+    targets=[harness.Target(
+        f"a 1e6-case campaign: launch to first stored case <= {START_GOAL_S:g} s", START_GOAL_S,
+        "s", lambda r: r["first_case_s"], "{:.1f} s",
+        note=lambda r, _: f"parent RSS {r['rss_first_mb']:.0f} MB at the first case")],
+)  # fmt: skip
 def main(argv: list[str] | None = None) -> dict:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--cases", type=int, default=1_000_000)
     parser.add_argument("--watch", type=int, default=50, help="stored cases to watch")
     args = parser.parse_args(argv)
-    console = Console(width=150)
+    console = harness.console(150)
     with tempfile.TemporaryDirectory(prefix="flexsat-bench-start-") as tmp:
         store = Path(tmp) / "big"
         command = [sys.executable, "-m", "flexsat", "campaign", "montecarlo-random",
@@ -51,10 +59,9 @@ def main(argv: list[str] | None = None) -> dict:
             time.sleep(0.02)
         process.send_signal(signal.SIGINT)
         process.communicate(timeout=120)
-    table = Table(title=f"Start of a {args.cases + 1}-case campaign")
-    for column in ("launch -> first stored case (s)", "goal (s)", "RSS at case 1 (MB)",
-                   f"RSS at case {args.watch} (MB)"):  # fmt: skip
-        table.add_column(column, justify="right")
+    table = harness.table(f"Start of a {args.cases + 1}-case campaign",
+                          ("launch -> first stored case (s)", "goal (s)", "RSS at case 1 (MB)",
+                           f"RSS at case {args.watch} (MB)"), left=0)  # fmt: skip
     table.add_row(f"{first_s:.1f}", f"<= {START_GOAL_S:g}", f"{rss_first / MB:.0f}",
                   f"{rss_last / MB:.0f}" if rss_last else "-")  # fmt: skip
     console.print(table)

@@ -17,17 +17,15 @@ pool only. Run with ``make bench`` or ``python bench/bench_campaigns.py``.
 from __future__ import annotations
 
 import argparse
-import sys
 import tempfile
 from pathlib import Path
 
-from rich.console import Console
-from rich.table import Table
-
+import harness
 from flexsat.campaigns import load_campaign, run_campaign, summarize
 from flexsat.config import nominal
 
 CAMPAIGNS = ("sensitivity", "montecarlo-critical", "deployment-shock")
+CAMPAIGNS_MAX_S = 30.0  # the target: the three campaigns, local pool, 2 workers
 
 
 def _warm_up() -> None:
@@ -37,6 +35,22 @@ def _warm_up() -> None:
     run_slew(Plant.from_config(nominal()), SlewScenario(duration_s=0.1), progress=False)
 
 
+def _note(out: dict, _results: dict) -> str:
+    local = out["scaling"]["local"]
+    note = (f"{out['cases']} cases, {local['cases_per_s_2']:.2f} cases/s; "
+            f"1 -> 2 workers efficiency {local['efficiency']:.0%}")  # fmt: skip
+    if "dask" in out["scaling"]:
+        note += f" (Dask {out['scaling']['dask']['efficiency']:.0%})"
+    return note
+
+
+@harness.register(
+    "the three thesis campaigns on the local pool and Dask, 1 and 2 workers: wall time, "
+    "cases/s, scaling efficiency",
+    targets=[harness.Target(
+        f"3 campaigns (68 runs), 2 workers, local pool <= {CAMPAIGNS_MAX_S:g} s", CAMPAIGNS_MAX_S,
+        "s", lambda r: r["totals"]["local x2"], "{:.1f} s", note=_note)],
+)  # fmt: skip
 def main(argv: list[str] | None = None) -> dict:
     """Print the tables; return wall times, cases/s and the scaling of each backend."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
@@ -45,7 +59,7 @@ def main(argv: list[str] | None = None) -> dict:
     backends = [("local", 1), ("local", 2)]
     if not args.quick:
         backends += [("dask", 1), ("dask", 2)]
-    console = Console() if sys.stdout.isatty() else Console(width=160)
+    console = harness.console()
     _warm_up()
     walls = {(b, w): {} for b, w in backends}
     cases, summaries = {}, {}
@@ -61,11 +75,10 @@ def main(argv: list[str] | None = None) -> dict:
     n_cases = sum(cases.values())
     totals = {key: sum(per.values()) for key, per in walls.items()}
 
-    timing = Table(title="Thesis campaigns: wall time (s) and cases per second")
-    timing.add_column("campaign")
-    timing.add_column("cases", justify="right")
-    for backend, workers in backends:
-        timing.add_column(f"{backend} x{workers}", justify="right")
+    timing = harness.table(
+        "Thesis campaigns: wall time (s) and cases per second",
+        ("campaign", "cases", *(f"{b} x{w}" for b, w in backends)),
+    )
     for name in CAMPAIGNS:
         timing.add_row(name, str(cases[name]), *(
             f"{walls[key][name]:.1f} ({cases[name] / walls[key][name]:.2f}/s)" for key in walls
@@ -75,10 +88,9 @@ def main(argv: list[str] | None = None) -> dict:
     console.print(timing)
 
     scaling = {}
-    table = Table(title=f"Worker scaling over the {n_cases} cases, 1 -> 2 workers")
-    for column in ("backend", "1 worker (s)", "2 workers (s)", "cases/s x1", "cases/s x2",
-                   "speed-up", "efficiency (speed-up / 2)"):  # fmt: skip
-        table.add_column(column, justify="left" if column == "backend" else "right")
+    table = harness.table(f"Worker scaling over the {n_cases} cases, 1 -> 2 workers",
+                          ("backend", "1 worker (s)", "2 workers (s)", "cases/s x1",
+                           "cases/s x2", "speed-up", "efficiency (speed-up / 2)"))  # fmt: skip
     for backend in dict.fromkeys(b for b, _ in backends):
         one, two = totals[backend, 1], totals[backend, 2]
         scaling[backend] = {
@@ -91,10 +103,9 @@ def main(argv: list[str] | None = None) -> dict:
                       f"{s['efficiency']:.0%}")  # fmt: skip
     console.print(table)
 
-    summary = Table(title="Campaign summaries (120 s slews, disturbances at maximum)")
-    columns = ("campaign", "cases", "failed", "R1", "R2", "R3", "worst error (deg)", "worst case")
-    for column in columns:
-        summary.add_column(column)
+    summary = harness.table("Campaign summaries (120 s slews, disturbances at maximum)",
+                            ("campaign", "cases", "failed", "R1", "R2", "R3",
+                             "worst error (deg)", "worst case"), right=())  # fmt: skip
     for name, s in summaries.items():
         worst = s["worst_cases"][0]["case_id"] if s["worst_cases"] else "-"
         summary.add_row(name, str(s["cases"]), str(s["failed"]), f"{s['r1_pass_rate']:.0%}",

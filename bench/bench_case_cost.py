@@ -19,18 +19,14 @@ inflates it (shared caches); the load average is printed beside the table.
 from __future__ import annotations
 
 import argparse
-import os
-import statistics
 import time
 from collections import defaultdict
-
-from rich.console import Console
-from rich.table import Table
 
 import flexsat.analysis.effort as effort
 import flexsat.analysis.requirements as requirements
 import flexsat.simulate.closedloop as closedloop
 import flexsat.simulate.result as result
+import harness  # the benchmarks run with bench/ on sys.path
 from flexsat.campaigns import runner
 from flexsat.campaigns.definition import CaseStream, Reduced
 from flexsat.config import nominal, validate_config
@@ -73,12 +69,21 @@ def _instrument(spent: dict[str, float]) -> None:
         setattr(module, name, timed)
 
 
+@harness.register(
+    "CPU time of one campaign case (120 s thesis slew), full and reduced model, part by part "
+    "(compiled loop, derived records, dataset, metrics, history, rest) against 0.06 CPU-s per "
+    "reduced case",
+    targets=[harness.Target(
+        f"one reduced campaign case <= {GOAL_S} CPU-s", GOAL_S, "CPU-s",
+        lambda r: r["results"]["reduced"]["total"], "{:.4f} CPU-s",
+        note=lambda r, _: f"median of {r['cases']}; full {r['results']['full']['total']:.4f}")],
+)  # fmt: skip
 def main(argv: list[str] | None = None) -> dict:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--cases", type=int, default=5, help="cases per model")
     parser.add_argument("--duration", type=float, default=120.0, help="slew length [s]")
     args = parser.parse_args(argv)
-    console = Console(width=150)
+    console = harness.console(150)
     models = ("reduced", "full")
     streams = {m: list(CaseStream(_definition(args.duration, m == "reduced"), nominal(),
                                   args.cases)) for m in models}  # fmt: skip
@@ -86,32 +91,28 @@ def main(argv: list[str] | None = None) -> dict:
         runner.run_case(streams[m][0])  # warm-up: compiled code loaded
     spent: dict[str, float] = defaultdict(float)
     _instrument(spent)
-    samples: dict[str, dict[str, list[float]]] = {m: defaultdict(list) for m in models}
-    for k in range(1, args.cases + 1):
-        for m in models:  # interleaved: both models see the same load
-            spent.clear()
-            start = time.process_time()
-            row = runner.run_case(streams[m][k])
-            total = time.process_time() - start
-            assert row["status"] == "ok", row["error"]
-            parts = dict(spent)
-            parts["dataset"] -= parts["derived records"]  # derive_records runs inside it
-            parts["other"] = total - sum(parts.values())
-            for part, value in parts.items():
-                samples[m][part].append(value)
-            samples[m]["total"].append(total)
-    load = ", ".join(f"{x:.2f}" for x in os.getloadavg())
-    table = Table(title=f"CPU-s per case, median of {args.cases} ({args.duration:g} s slews, "
-                        f"load {load})")  # fmt: skip
+    remaining = {m: iter(streams[m][1:]) for m in models}
+
+    def case(m: str) -> dict[str, float]:
+        """The next case of model ``m``: CPU s of each part and in all."""
+        spent.clear()
+        timed = harness.stopwatch(lambda: runner.run_case(next(remaining[m])))
+        assert timed.value["status"] == "ok", timed.value["error"]
+        parts = dict(spent)
+        parts["dataset"] -= parts["derived records"]  # derive_records runs inside it
+        parts["other"] = timed.cpu_s - sum(parts.values())
+        return {**parts, "total": timed.cpu_s}
+
+    # interleaved: both models see the same load
+    rounds = harness.interleave({m: lambda m=m: case(m) for m in models}, args.cases)
+    load = harness.load()
     names = ["compiled loop", "derived records", "dataset", "metrics", "history", "other",
              "total"]  # fmt: skip
-    table.add_column("model")
-    for name in names:
-        table.add_column(name, justify="right")
-    table.add_column(f"<= {GOAL_S} s", justify="right")
+    table = harness.table(f"CPU-s per case, median of {args.cases} ({args.duration:g} s slews, "
+                          f"load {load})", ("model", *names, f"<= {GOAL_S} s"))  # fmt: skip
     results = {}
     for m in models:
-        median = {name: statistics.median(samples[m][name]) for name in names}
+        median = harness.median({name: [r[name] for r in rounds[m]] for name in names})
         goal = ("met" if median["total"] <= GOAL_S else "not met") if m == "reduced" else "-"
         table.add_row(m, *(f"{median[name]:.4f}" for name in names), goal)
         results[m] = median

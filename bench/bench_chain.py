@@ -15,13 +15,14 @@ Run with ``python bench/bench_chain.py`` (``--quick`` for fewer steps). Prints:
 
 from __future__ import annotations
 
+import argparse
 import sys
-import time
 from pathlib import Path
 
 import numpy as np
 from rich.console import Console
-from rich.table import Table
+
+import harness
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))  # the cantilever definitions are the tests' own
@@ -42,6 +43,7 @@ from flexsat.linear import linearize  # noqa: E402
 def _two_arrays(n: int) -> Plant:
     """Hub 600 kg, diag(400, 380, 360) kg m^2; two 60 kg, 3 m arrays of n segments on
     hinges about Y at +-0.8 m on X, k = 600 N m/rad, c = 5 N m s/rad per hinge."""
+
     def array(name, x, span):
         return {"name": name, "model": "chain", "mount_point_m": [x, 0.0, 0.0],
                 "span_direction": span, "segments": n, "length_m": 3.0, "width_m": 1.0,
@@ -65,22 +67,25 @@ def step_cost_table(console: Console, steps: int) -> None:
         x[plant.n_dof + 3 : plant.n_dof + 6] = (0.01, -0.02, 0.015)
         # The cost of a step does not depend on dt; 1 us keeps every N far from the RK4
         # stability limit of its stiffest hinge mode, so every step is a full one.
-        rk4_hold(x.copy(), 1e-6, 10, (0.0, 0.0, 0.0), plant.packed,
-                 identity_frame())  # compile, warm
-        best = np.inf
-        for _ in range(5):
-            trial = x.copy()
-            start = time.perf_counter()
-            status, done = rk4_hold(trial, 1e-6, steps, (0.0, 0.0, 0.0), plant.packed,
-                                    identity_frame())
+        rk4_hold(
+            x.copy(), 1e-6, 10, (0.0, 0.0, 0.0), plant.packed, identity_frame()
+        )  # compile, warm
+
+        def run(trial, plant=plant, n=n):
+            status, done = rk4_hold(
+                trial, 1e-6, steps, (0.0, 0.0, 0.0), plant.packed, identity_frame()
+            )
             if status != 0 or done != steps:
                 raise RuntimeError(f"N = {n}: the run stopped at step {done} (status {status})")
-            best = min(best, (time.perf_counter() - start) / steps)
-        costs.append(1e6 * best)
+
+        best, _ = harness.best_of(run, 5, setup=x.copy)
+        costs.append(1e6 * best / steps)
     slope, intercept = np.polyfit(sizes, costs, 1)
-    table = Table(title="RK4 step cost, two chains of N hinged segments (best of 5)")
-    for column in ("N", "us per step", "linear fit", "deviation"):
-        table.add_column(column, justify="right")
+    table = harness.table(
+        "RK4 step cost, two chains of N hinged segments (best of 5)",
+        ("N", "us per step", "linear fit", "deviation"),
+        left=0,
+    )
     for n, c in zip(sizes, costs, strict=True):
         fit = slope * n + intercept
         table.add_row(str(n), f"{c:.2f}", f"{fit:.2f}", f"{(c - fit) / fit:+.1%}")
@@ -91,9 +96,9 @@ def step_cost_table(console: Console, steps: int) -> None:
 
 def beam_table(console: Console) -> None:
     reference = np.array([beam_frequency_hz(n) for n in (1, 2, 3)])
-    table = Table(title="Clamped cantilever as a chain: error against Euler-Bernoulli")
-    for column in ("N", "mode 1", "mode 2", "mode 3", "order 1", "order 2", "order 3"):
-        table.add_column(column, justify="right")
+    table = harness.table("Clamped cantilever as a chain: error against Euler-Bernoulli",
+                          ("N", "mode 1", "mode 2", "mode 3", "order 1", "order 2", "order 3"),
+                          left=0)  # fmt: skip
     previous = None
     for n in (2, 4, 8, 16, 32, 64):
         plant = Plant.from_config(validate_config(cantilever_chain(n)))
@@ -145,10 +150,17 @@ def spin_figure(console: Console) -> None:
     console.print(f"wrote {out.relative_to(ROOT)}")
 
 
-def main() -> None:
-    console = Console()
-    quick = "--quick" in sys.argv
-    step_cost_table(console, 2_000 if quick else 20_000)
+@harness.register(
+    "chain appendages: cost per RK4 step against N = 1 ... 32 segments, bending frequencies "
+    "against Euler-Bernoulli with the convergence order, centrifugal stiffening",
+    full=False,
+)
+def main(argv: list[str] | None = None) -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--quick", action="store_true", help="fewer steps in the cost table")
+    args = parser.parse_args(argv)
+    console = harness.console()
+    step_cost_table(console, 2_000 if args.quick else 20_000)
     beam_table(console)
     spin_figure(console)
 

@@ -22,13 +22,11 @@ import multiprocessing
 import os
 import statistics
 import sys
-import time
 from pathlib import Path
 
-from rich.console import Console
-from rich.table import Table
+sys.path.insert(0, str(Path(__file__).parent))  # the spawned workers import bench_scale
 
-sys.path.insert(0, str(Path(__file__).parent))
+import harness
 
 
 def _serve(conn, core: int, n_cases: int) -> None:
@@ -43,18 +41,20 @@ def _serve(conn, core: int, n_cases: int) -> None:
     run_case(cases[0])  # compiled code loaded
     conn.send("ready")
     while (k := conn.recv()) is not None:
-        start = time.perf_counter()
-        for case in cases[:k]:
-            run_case(case)
-        conn.send((time.perf_counter() - start) / k)
+        conn.send(harness.stopwatch(lambda k=k: [run_case(c) for c in cases[:k]]).wall_s / k)
 
 
+@harness.register(
+    "the same reduced cases in two processes, one per core, alone and together, rounds "
+    "alternated: what a second busy core costs the first, the ceiling of a two-worker run's "
+    "efficiency"
+)
 def main(argv: list[str] | None = None) -> dict:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--cases", type=int, default=30, help="cases per round")
     parser.add_argument("--rounds", type=int, default=12, help="alternated rounds")
     args = parser.parse_args(argv)
-    console = Console()
+    console = harness.console()
     if not hasattr(os, "sched_setaffinity") or len(os.sched_getaffinity(0)) < 2:
         console.print("bench_contention: needs Linux and two cores; skipped")
         return {}
@@ -69,10 +69,10 @@ def main(argv: list[str] | None = None) -> dict:
         workers.append(worker)
     for conn in conns:
         conn.recv()
-    table = Table(title=f"reduced case, wall ms per case: one core busy, then both "
-                        f"({args.cases} cases each, rounds alternated)")  # fmt: skip
-    for column in ("round", "alone (ms)", "together (ms)", "together / alone"):
-        table.add_column(column, justify="right")
+    table = harness.table(f"reduced case, wall ms per case: one core busy, then both "
+                          f"({args.cases} cases each, rounds alternated)",
+                          ("round", "alone (ms)", "together (ms)", "together / alone"),
+                          left=0)  # fmt: skip
     ratios = []
     for r in range(args.rounds):
         conns[r % 2].send(args.cases)

@@ -12,13 +12,11 @@ import os
 import subprocess
 import sys
 import tempfile
-import time
 import tomllib
 
 import numpy as np
-from rich.console import Console
-from rich.table import Table
 
+import harness
 from flexsat.config import preset_path, validate_config
 from flexsat.dynamics import kernels
 from flexsat.dynamics.packed import only
@@ -45,27 +43,6 @@ def _config(n_appendages: int):
     return validate_config(data)
 
 
-def _per_call_us(fn, repeats: int = 5, target_s: float = 0.2) -> float:
-    """Best-of-``repeats`` mean wall time of one call [us]."""
-    fn()
-    loops = 1
-    while True:
-        start = time.perf_counter()
-        for _ in range(loops):
-            fn()
-        elapsed = time.perf_counter() - start
-        if elapsed > target_s / repeats:
-            break
-        loops *= 2
-    best = elapsed
-    for _ in range(repeats - 1):
-        start = time.perf_counter()
-        for _ in range(loops):
-            fn()
-        best = min(best, time.perf_counter() - start)
-    return 1e6 * best / loops
-
-
 def measure(n_appendages: int) -> dict[str, float]:
     plant = Plant.from_config(_config(n_appendages))
     rng = np.random.default_rng(0)
@@ -76,13 +53,19 @@ def measure(n_appendages: int) -> dict[str, float]:
     h = np.empty(plant.n_dof)
     qdd = np.empty(plant.n_dof)
     # Each evaluation gets the plant with only its own kernels, as Plant's methods do.
-    views = {k: only(plant.packed, *v) for k, v in
-             (("M", ("mass_matrix",)), ("h", ("bias_forces",)), ("qdd", ("pass1", "pass2")))}
+    views = {
+        k: only(plant.packed, *v)
+        for k, v in (
+            ("M", ("mass_matrix",)),
+            ("h", ("bias_forces",)),
+            ("qdd", ("pass1", "pass2", "mass_matrix")),
+        )
+    }
     return {
-        "M(q)": _per_call_us(lambda: kernels.mass_matrix(q, views["M"], M)),
-        "h(q, qd)": _per_call_us(lambda: kernels.bias_forces(q, qd, views["h"], h)),
-        "q_ddot": _per_call_us(lambda: kernels.accelerations(q, qd, Q, views["qdd"], qdd)),
-        "q_ddot via M, h + np.linalg.solve": _per_call_us(
+        "M(q)": harness.per_call_us(lambda: kernels.mass_matrix(q, views["M"], M)),
+        "h(q, qd)": harness.per_call_us(lambda: kernels.bias_forces(q, qd, views["h"], h)),
+        "q_ddot": harness.per_call_us(lambda: kernels.accelerations(q, qd, Q, views["qdd"], qdd)),
+        "q_ddot via M, h + np.linalg.solve": harness.per_call_us(
             lambda: np.linalg.solve(
                 plant.mass_matrix(q),
                 Q - plant.bias_forces(q, qd) - plant.damping_forces(qd) - plant.elastic_forces(q),
@@ -114,16 +97,19 @@ def startup_seconds(cache_dir: str) -> float:
     return float(result.stdout.strip())
 
 
+@harness.register(
+    "us per evaluation of M(q), h(q, q_dot), q_ddot, and q_ddot through M, h and "
+    "np.linalg.solve, for 2 and 8 appendages; kernel compile and cached load"
+)
 def main(argv: list[str] | None = None) -> dict:
     """Print the table and the start-up times; return them (us per call, s)."""
     del argv  # no options
-    console = Console()
-    table = Table(title="flexsat dynamics kernels: microseconds per evaluation (one core)")
-    table.add_column("evaluation")
+    console = harness.console()
     sizes = (2, 8)
     results = {n: measure(n) for n in sizes}
-    for n in sizes:
-        table.add_column(f"{n} appendages ({6 + 6 * n} DOF), us", justify="right")
+    table = harness.table("flexsat dynamics kernels: microseconds per evaluation (one core)",
+                          ("evaluation", *(f"{n} appendages ({6 + 6 * n} DOF), us"
+                                           for n in sizes)))  # fmt: skip
     for name in results[sizes[0]]:
         table.add_row(name, *(f"{results[n][name]:.2f}" for n in sizes))
     console.print(table)

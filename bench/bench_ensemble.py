@@ -14,13 +14,9 @@ wall times do. ``--cases N`` (default 16), ``--trials T`` (default 3),
 from __future__ import annotations
 
 import argparse
-import os
 import statistics
-import time
 
-from rich.console import Console
-from rich.table import Table
-
+import harness
 from bench_scale import GOAL_EFFICIENCY, GOAL_S, definition
 from flexsat.campaigns.definition import CaseStream
 from flexsat.campaigns.ensemble import run_ensemble
@@ -28,12 +24,10 @@ from flexsat.campaigns.runner import run_case
 from flexsat.config import nominal
 
 
-def _timed(fn) -> tuple[float, float]:
-    wall, cpu = time.perf_counter(), time.process_time()
-    fn()
-    return time.perf_counter() - wall, time.process_time() - cpu
-
-
+@harness.register(
+    "the ensemble runner against the same cases run one by one, in one process, on 1 and 2 "
+    "numba threads: CPU and wall time per case, medians of interleaved trials"
+)
 def main(argv: list[str] | None = None) -> dict:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--cases", type=int, default=16)
@@ -41,31 +35,30 @@ def main(argv: list[str] | None = None) -> dict:
     parser.add_argument("--duration", type=float, default=120.0, help="slew length [s]")
     parser.add_argument("--only", choices=("full", "reduced"), default=None)
     args = parser.parse_args(argv)
-    console = Console(width=150)
-    load = ", ".join(f"{x:.2f}" for x in os.getloadavg())
-    console.print(f"{args.cases} cases of {args.duration:g} s, {args.trials} trials, load {load}")
+    console = harness.console(150)
+    console.print(f"{args.cases} cases of {args.duration:g} s, {args.trials} trials, "
+                  f"load {harness.load()}")  # fmt: skip
     ways = {
         "one by one": lambda cases: [run_case(c) for c in cases],
         "ensemble x1": lambda cases: list(run_ensemble(cases, threads=1)),
         "ensemble x2": lambda cases: list(run_ensemble(cases, threads=2)),
     }
-    table = Table(title="Ensemble runner against one case at a time (median of trials)")
-    for column in ("model", "runner", "wall/case (s)", "CPU/case (s)", "CPU vs one by one",
-                   "1000 cases, 2 cores (s)", "<= 30 s"):  # fmt: skip
-        table.add_column(column, justify="left" if column in ("model", "runner") else "right")
+    table = harness.table("Ensemble runner against one case at a time (median of trials)",
+                          ("model", "runner", "wall/case (s)", "CPU/case (s)",
+                           "CPU vs one by one", "1000 cases, 2 cores (s)", "<= 30 s"),
+                          left=2)  # fmt: skip
     results = {}
     for model in [args.only] if args.only else ["reduced", "full"]:
         campaign = definition(args.duration, model == "reduced")
         cases = list(CaseStream(campaign, nominal(), args.cases - 1))
         for way in ways.values():
             way(cases[:2])  # warm up: compiled code loaded, modules imported
-        samples = {name: [] for name in ways}
-        for _ in range(args.trials):
-            for name, way in ways.items():
-                samples[name].append(_timed(lambda way=way, cases=cases: way(cases)))
+        samples = harness.interleave(
+            {name: lambda way=way, cases=cases: harness.stopwatch(lambda: way(cases))
+             for name, way in ways.items()}, args.trials)  # fmt: skip
         n = len(cases)
-        medians = {name: (statistics.median(w for w, _ in s) / n,
-                          statistics.median(c for _, c in s) / n)
+        medians = {name: (statistics.median(t.wall_s for t in s) / n,
+                          statistics.median(t.cpu_s for t in s) / n)
                    for name, s in samples.items()}  # fmt: skip
         base_cpu = medians["one by one"][1]
         for name, (wall, cpu) in medians.items():
@@ -76,10 +69,12 @@ def main(argv: list[str] | None = None) -> dict:
             results[f"{model} {name}"] = {"wall_per_case_s": wall, "cpu_per_case_s": cpu}
         efficiency = medians["ensemble x1"][0] / medians["ensemble x2"][0] / 2
         results[f"{model} efficiency"] = efficiency
-        console.print(f"{model}: ensemble 1 -> 2 threads, wall efficiency {efficiency:.0%} "
-                      f"(goal >= {GOAL_EFFICIENCY:.0%}; meaningful on a quiet machine only)")
+        console.print(
+            f"{model}: ensemble 1 -> 2 threads, wall efficiency {efficiency:.0%} "
+            f"(goal >= {GOAL_EFFICIENCY:.0%}; meaningful on a quiet machine only)"
+        )
     console.print(table)
-    console.print(f"load {', '.join(f'{x:.2f}' for x in os.getloadavg())}")
+    console.print(f"load {harness.load()}")
     return results
 
 

@@ -18,12 +18,9 @@ with them. Run with ``python bench/bench_linear.py``.
 
 from __future__ import annotations
 
-import time
-
 import numpy as np
-from rich.console import Console
-from rich.table import Table
 
+import harness
 from flexsat.config import load_config, nominal, preset_path
 from flexsat.dynamics.plant import Plant
 from flexsat.linear import linearize
@@ -34,15 +31,15 @@ REPEATS = 5
 
 
 def _best(fn) -> tuple[float, object]:
-    fn()
-    times, out = [], None
-    for _ in range(REPEATS):
-        start = time.perf_counter()
-        out = fn()
-        times.append(time.perf_counter() - start)
-    return min(times), out
+    """Best of :data:`REPEATS` after a warm-up call [s], and the last call's value."""
+    return harness.best_of(fn, REPEATS, warm_up=True)
 
 
+@harness.register(
+    "linearizing the thesis model (analytic and by differences, about rest and a steady "
+    "spin), balanced truncation, margins, and a 198-DOF chain model",
+    full=False,
+)
 def main() -> None:
     plant = Plant.from_config(nominal())
     rows = []
@@ -67,12 +64,14 @@ def main() -> None:
     err = np.max(np.abs(chain_fd.A - chain_exact.A)) / np.max(np.abs(chain_exact.A))
     rows.append(("2 x 32-segment chains, rest, Richardson", t_chain_fd,
                  f"max rel. diff. to analytic {err:.1e}"))  # fmt: skip
-    table = Table(title=f"Linear analysis, nominal satellite ({exact.n_states} states)")
-    for column in ("what", "time [ms]", "note"):
-        table.add_column(column)
+    table = harness.table(
+        f"Linear analysis, nominal satellite ({exact.n_states} states)",
+        ("what", "time [ms]", "note"),
+        right=(),
+    )
     for what, t, note in rows:
         table.add_row(what, f"{1e3 * t:.2f}", note)
-    Console().print(table)
+    harness.console().print(table)
 
 
 def _chain_plant(segments: int) -> Plant:

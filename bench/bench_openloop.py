@@ -27,15 +27,10 @@ yaw rate of a shorter run is given at its end, next to flexsat RK4's at that tim
 from __future__ import annotations
 
 import argparse
-import os
-import platform
-import sys
-import time
 
 import numpy as np
-from rich.console import Console
-from rich.table import Table
 
+import harness
 from baseline_numpy import (
     TORQUE_END_S,
     run_baseline_rk4,
@@ -59,10 +54,7 @@ def _final(result):
 
 
 def _flexsat_rk4(plant):
-    run_openloop(plant)  # compile (or load the compiled cache) first
-    start = time.perf_counter()
-    result = run_openloop(plant)
-    whole = time.perf_counter() - start
+    whole, result = harness.best_of(lambda: run_openloop(plant), 1, warm_up=True)
     result.raise_for_status()
     rate, h_z = _final(result)
     attrs = result.dataset.attrs
@@ -78,9 +70,8 @@ def _flexsat_rk4(plant):
 
 def _flexsat_dop853(plant, duration_s):
     scenario = OpenLoopScenario(solver="dop853", rtol=1e-10, atol=1e-12, duration_s=duration_s)
-    start = time.perf_counter()
-    result = run_openloop(plant, scenario)
-    whole = time.perf_counter() - start
+    timed = harness.stopwatch(lambda: run_openloop(plant, scenario))
+    whole, result = timed.wall_s, timed.value
     result.raise_for_status()
     rate, h_z = _final(result)
     return {
@@ -118,14 +109,18 @@ def _rate_cell(out, reference):
     return f"{rate} at t = {out['simulated_s']:g} s (flexsat RK4: {ref:.7f})"
 
 
+@harness.register(
+    "the thesis's 120 s open-loop run: flexsat RK4 and DOP853 against a NumPy + SciPy "
+    "baseline (RK4 Python loop, solve_ivp)",
+    quick_argv=["--quick"],
+)
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument(
         "--quick", action="store_true", help="time shorter runs and extrapolate them to 120 s"
     )
     args = parser.parse_args(argv)
-    # Wide enough for the table when the output goes to a file or a pipe.
-    console = Console() if sys.stdout.isatty() else Console(width=240)
+    console = harness.console(240)  # the table's width to a file or a pipe
     plant = Plant.from_config(nominal())
 
     dop_s = 20.0 if args.quick else FULL_S
@@ -154,27 +149,23 @@ def main(argv=None):
          "quick: shorter run" if args.quick else ""),
     ]  # fmt: skip
 
-    table = Table(
-        title=(
-            "Open loop, thesis scenario: 1 N m yaw torque for "
-            f"{TORQUE_END_S:g} s, free to {FULL_S:g} s (nominal satellite, 18 DOF)"
-        ),
-        caption=(
-            "speed-up: how many times faster flexsat RK4 (integration) is, per simulated "
-            "120 s; '~' marks a shorter run extrapolated linearly to 120 s"
-        ),
+    columns = (
+        "implementation",
+        "simulated s",
+        "wall s",
+        "wall per simulated 120 s",
+        "speed-up vs flexsat RK4",
+        "final yaw rate deg/s",
+        "H_z N m s",
+        "note",
     )
-    for column, justify in (
-        ("implementation", "left"),
-        ("simulated s", "right"),
-        ("wall s", "right"),
-        ("wall per simulated 120 s", "right"),
-        ("speed-up vs flexsat RK4", "right"),
-        ("final yaw rate deg/s", "right"),
-        ("H_z N m s", "right"),
-        ("note", "left"),
-    ):
-        table.add_column(column, justify=justify, no_wrap=True)
+    table = harness.table(
+        "Open loop, thesis scenario: 1 N m yaw torque for "
+        f"{TORQUE_END_S:g} s, free to {FULL_S:g} s (nominal satellite, 18 DOF)",
+        columns, right=columns[1:-1], no_wrap=True,
+        caption="speed-up: how many times faster flexsat RK4 (integration) is, per simulated "
+        "120 s; '~' marks a shorter run extrapolated linearly to 120 s",
+    )  # fmt: skip
     for name, out, key, note in rows:
         wall = out[key]
         per_120 = wall * FULL_S / out["simulated_s"]
@@ -205,10 +196,7 @@ def main(argv=None):
         f"{flex_dop['evaluations']}, baseline RK4 {base_rk4['evaluations']}, baseline "
         f"solve_ivp {base_ivp['evaluations']} ({base_ivp['steps']} accepted steps)."
     )
-    console.print(
-        f"Machine: {platform.processor() or platform.machine()}, {os.cpu_count()} CPUs, "
-        f"Python {platform.python_version()}, NumPy {np.__version__}."
-    )
+    console.print(f"Machine: {harness.machine()}.")
     return {
         "quick": args.quick,
         "flexsat_rk4": flex_rk4,

@@ -15,9 +15,7 @@ from __future__ import annotations
 import argparse
 import tempfile
 
-from rich.console import Console
-from rich.table import Table
-
+import harness
 from flexsat.campaigns import load_campaign
 from flexsat.campaigns.definition import CampaignDefinition, Reduced
 from flexsat.campaigns.reduction import compare_reduction
@@ -34,24 +32,27 @@ def _definition(name: str, duration_s: float | None) -> CampaignDefinition:
     return validate_config(data, model=CampaignDefinition)
 
 
+@harness.register(
+    "the reduced model against the full one on the 69 thesis cases at full length: verdicts "
+    "changed and largest differences, metric by metric"
+)
 def main(argv: list[str] | None = None) -> dict:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--duration", type=float, default=None, help="slew length [s]")
     parser.add_argument("--workers", type=int, default=2)
     args = parser.parse_args(argv)
-    console = Console(width=150)
+    console = harness.console(150)
     results = {}
     with tempfile.TemporaryDirectory(prefix="flexsat-bench-reduction-") as tmp:
         for label, names in SETS.items():
             definitions = [_definition(name, args.duration) for name in names]
             frame, wall = compare_reduction(definitions, nominal(), tmp, Reduced(),
                                             workers=args.workers)  # fmt: skip
-            table = Table(title=f"Reduced vs full model, {label} "
-                          f"({int(frame['cases'].iloc[0])} cases); wall: full "
-                          f"{wall['full']:.0f} s, reduced {wall['reduced']:.0f} s")  # fmt: skip
-            for column in ("metric", "units", "verdicts changed", "max |diff|",
-                           "max rel. diff", "worst case"):  # fmt: skip
-                table.add_column(column)
+            table = harness.table(f"Reduced vs full model, {label} "
+                                  f"({int(frame['cases'].iloc[0])} cases); wall: full "
+                                  f"{wall['full']:.0f} s, reduced {wall['reduced']:.0f} s",
+                                  ("metric", "units", "verdicts changed", "max |diff|",
+                                   "max rel. diff", "worst case"), right=())  # fmt: skip
             for row in frame.to_dict("records"):
                 changed = row.get("verdicts_changed")
                 table.add_row(row["metric"], row["units"],

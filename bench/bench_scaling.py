@@ -24,15 +24,12 @@ through the normal validation and joint tuning. Run with ``python bench/bench_sc
 from __future__ import annotations
 
 import copy
-import sys
-import time
 import tomllib
 
 import numpy as np
 from numba import njit
-from rich.console import Console
-from rich.table import Table
 
+import harness
 from flexsat.config import SatelliteConfig, preset_path, validate_config
 from flexsat.dynamics import kernels
 from flexsat.dynamics.plant import Plant
@@ -43,6 +40,7 @@ REPEATS = 3
 MOUNT_RADIUS_M = 0.8  # the nominal mount points' distance from the hub axis
 PAIR_SPACING_M = 0.3  # height between neighbouring pairs on the hub (H_hub = 1.5 m)
 MODES = ("plant only", "ASMC", "PD")
+LINEAR_R2 = 0.99  # the target: a straight line explains at least this share of the variance
 
 
 def scaled_config(n_appendages: int) -> SatelliteConfig:
@@ -84,15 +82,6 @@ def _evaluate(q, qd, Q, args, qdd, n_calls):
     return status
 
 
-def _best_of(fn, repeats: int) -> float:
-    best = float("inf")
-    for _ in range(repeats):
-        start = time.perf_counter()
-        fn()
-        best = min(best, time.perf_counter() - start)
-    return best
-
-
 def evaluation_us(plant: Plant) -> tuple[float, float]:
     """One ``accelerations`` call (us): from a compiled loop, and from Python."""
     rng = np.random.default_rng(0)
@@ -103,24 +92,22 @@ def evaluation_us(plant: Plant) -> tuple[float, float]:
     args = plant.packed
     n_calls = 100_000
     _evaluate(q, qd, Q, args, qdd, 10)  # compile (numba specializes on types, not sizes)
-    compiled = _best_of(lambda: _evaluate(q, qd, Q, args, qdd, n_calls), 5) / n_calls
+    compiled = harness.best_of(lambda: _evaluate(q, qd, Q, args, qdd, n_calls), 5)[0] / n_calls
     n_py = 20_000
 
     def from_python():
         for _ in range(n_py):
             kernels.accelerations(q, qd, Q, args, qdd)
 
-    python = _best_of(from_python, 5) / n_py
+    python = harness.best_of(from_python, 5)[0] / n_py
     return 1e6 * compiled, 1e6 * python
 
 
 def _timed(run) -> tuple[float, float, object]:
     """One run: whole call [s], integration per RK4 step (us), the result."""
-    start = time.perf_counter()
-    result = run()
-    whole = time.perf_counter() - start
-    attrs = result.dataset.attrs
-    return whole, 1e6 * float(attrs["wall_time_s"]) / int(attrs["steps"]), result
+    timed = harness.stopwatch(run)
+    attrs = timed.value.dataset.attrs
+    return timed.wall_s, 1e6 * float(attrs["wall_time_s"]) / int(attrs["steps"]), timed.value
 
 
 def measure() -> dict:
@@ -137,17 +124,13 @@ def measure() -> dict:
         runs[n, "plant only"] = lambda p=plant: run_openloop(p, OpenLoopScenario(), progress=False)
         runs[n, "ASMC"] = lambda p=plant: run_slew(p, asmc, progress=False)
         runs[n, "PD"] = lambda p=plant: run_slew(p, pd, progress=False)
-    for (n, mode), run in runs.items():
-        _timed(run)  # warm-up
-        sizes[n][mode] = {"whole_s": float("inf"), "us_per_step": float("inf")}
-    for _ in range(REPEATS):
-        for (n, mode), run in runs.items():
-            whole, per_step, result = _timed(run)
-            out = sizes[n][mode]
-            out["whole_s"] = min(out["whole_s"], whole)
-            out["us_per_step"] = min(out["us_per_step"], per_step)
-            out["ok"] = result.ok
-            out["simulated_s"] = float(result.dataset["time"].values[-1])
+    samples = harness.interleave({key: lambda run=run: _timed(run) for key, run in runs.items()},
+                                 REPEATS, warm_up=True)  # fmt: skip
+    for (n, mode), timed in samples.items():
+        result = timed[-1][2]
+        sizes[n][mode] = {"whole_s": min(t[0] for t in timed),
+                          "us_per_step": min(t[1] for t in timed), "ok": result.ok,
+                          "simulated_s": float(result.dataset["time"].values[-1])}  # fmt: skip
     return sizes
 
 
@@ -159,25 +142,40 @@ def linear_fit(n: np.ndarray, cost: np.ndarray) -> tuple[float, float, float]:
     return float(a), float(b), r2
 
 
+def _linearity(result: dict) -> float:
+    """The worst R^2 of the per-step cost lines (us/step) of the three modes."""
+    return min(fit["r2"] for k, fit in result["fits"].items() if k.endswith("(us/step)"))
+
+
+def _slopes(result: dict, _results: dict) -> str:
+    fits = {k: v for k, v in result["fits"].items() if k.endswith("(us/step)")}
+    slopes = ", ".join(f"{k.split(' (')[0]} {v['a']:.2f} + {v['b']:.2f} n us"
+                       for k, v in fits.items())  # fmt: skip
+    return f"R^2 >= {LINEAR_R2} required; per step: {slopes}"
+
+
+@harness.register(
+    "us per RK4 step and s per 120 s run for 1, 2, 4 and 8 appendages (plant only, ASMC, "
+    "PD), q_ddot alone, and a least-squares line cost = a + b n",
+    targets=[harness.Target("cost linear in the number of appendages (1, 2, 4, 8)", LINEAR_R2,
+                            "R^2", _linearity, "min R^2 = {:.4f}", at_most=False,
+                            note=_slopes)],
+)  # fmt: skip
 def main(argv: list[str] | None = None) -> dict:
     """Print the tables; return the numbers (``sizes``: per n, ``fits``: per mode)."""
     del argv  # no options
-    console = Console() if sys.stdout.isatty() else Console(width=160)
+    console = harness.console()
     sizes = measure()
 
-    table = Table(
-        title=f"Cost against the number of appendages: 120 s runs, RK4 dt = 1 ms, one core, "
+    table = harness.table(
+        f"Cost against the number of appendages: 120 s runs, RK4 dt = 1 ms, one core, "
         f"best of {REPEATS}",
+        ("appendages", "DOF", "q_ddot compiled (us)", "q_ddot from Python (us)",
+         *(f"{mode} {unit}" for mode in MODES for unit in ("us/step", "s/120 s"))),
+        left=0,
         caption="us/step: integration only (4 evaluations + law + recording); "
         "s/120 s: whole call incl. the recorded dataset",
-    )
-    table.add_column("appendages", justify="right")
-    table.add_column("DOF", justify="right")
-    table.add_column("q_ddot compiled (us)", justify="right")
-    table.add_column("q_ddot from Python (us)", justify="right")
-    for mode in MODES:
-        table.add_column(f"{mode} us/step", justify="right")
-        table.add_column(f"{mode} s/120 s", justify="right")
+    )  # fmt: skip
     for n, out in sizes.items():
         cells = [str(n), str(out["n_dof"]), f"{out['eval_compiled_us']:.2f}",
                  f"{out['eval_python_us']:.2f}"]  # fmt: skip
@@ -190,12 +188,11 @@ def main(argv: list[str] | None = None) -> dict:
 
     n = np.array(SIZES, dtype=float)
     fits = {}
-    growth = Table(
-        title="Growth per appendage: least-squares line cost = a + b n over n = 1, 2, 4, 8"
-    )
-    for column in ("cost", "a", "b per appendage", "R^2", "b / cost(n=2)",
-                   "increment 1->2", "2->4", "4->8"):  # fmt: skip
-        growth.add_column(column, justify="left" if column == "cost" else "right")
+    growth = harness.table(
+        "Growth per appendage: least-squares line cost = a + b n over n = 1, 2, 4, 8",
+        ("cost", "a", "b per appendage", "R^2", "b / cost(n=2)", "increment 1->2", "2->4",
+         "4->8"),
+    )  # fmt: skip
     series = {"q_ddot compiled (us)": [sizes[k]["eval_compiled_us"] for k in SIZES]}
     for mode in MODES:
         series[f"{mode} (us/step)"] = [sizes[k][mode]["us_per_step"] for k in SIZES]

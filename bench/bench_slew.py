@@ -6,18 +6,18 @@ into the loop), for a user's own compiled law (the quaternion PID of
 (target: within 1.2x per step), every registered law against the ASMC (the same
 target), and for the ASMC called through the plain-Python
 controller path, beside the plant-only open-loop run. Run with ``make bench``.
+``--duration S`` shortens the runs (default the thesis's 120 s; the Python path flies
+at most 10 s); "wall per 120 s" scales a run linearly.
 """
 
 from __future__ import annotations
 
+import argparse
 import importlib.util
 import sys
-import time
 from pathlib import Path
 
-from rich.console import Console
-from rich.table import Table
-
+import harness
 from flexsat import Plant, nominal
 from flexsat.control.laws import CompiledLaw, get_law, law_names
 from flexsat.control.quaternion import target_quaternion
@@ -27,6 +27,8 @@ PYTHON_PATH_DURATION_S = 10.0  # the Python-callback path is timed on 10 s, scal
 USER_LAW = Path(__file__).resolve().parents[1] / "examples" / "compiled_law.py"
 USER_LAW_TARGET = 1.2  # a user's compiled law per step / the built-in PD's
 LAW_TARGET = 1.2  # each registered law per step / the ASMC's
+OPENLOOP_MAX_S = 0.6  # the plant-only open loop, whole call per 120 s
+SLEW_MAX_S = 0.7  # the ASMC slew, whole call per 120 s
 
 
 def _register_user_law() -> str:
@@ -38,40 +40,67 @@ def _register_user_law() -> str:
     return module.QPID.name
 
 
-def _best(fn, repeats: int = 3) -> float:
-    return interleaved_best([fn], repeats)[0]
+def _whole_call(row: str, mode: str):
+    """The note of a whole-call target: us/step, and bench_scaling's integration alone."""
+
+    def note(result: dict, results: dict) -> str:
+        text = f"whole call, best of 3; {result[row]['us_per_step']:.2f} us/step"
+        scaling = results.get("bench_scaling")
+        if scaling is not None:
+            text += f"; integration alone {scaling['sizes'][2][mode]['us_per_step']:.2f} us/step"
+        return text
+
+    return note
 
 
-def interleaved_best(fns, repeats: int = 3) -> list[float]:
-    """Best wall time of each function, the repeats taken in turn (a load change on a
-    shared machine then affects every function alike, not the last one timed)."""
-    for fn in fns:
-        fn()  # compile / warm up
-    best = [float("inf")] * len(fns)
-    for _ in range(repeats):
-        for k, fn in enumerate(fns):
-            start = time.perf_counter()
-            fn()
-            best[k] = min(best[k], time.perf_counter() - start)
-    return best
+TARGETS = (
+    harness.Target(
+        f"plant-only open loop, 120 s, nominal <= {OPENLOOP_MAX_S} s", OPENLOOP_MAX_S, "s",
+        lambda r: r["plant only (open loop)"]["wall_per_120_s"], "{:.3f} s",
+        note=_whole_call("plant only (open loop)", "plant only"),
+    ),
+    harness.Target(
+        f"ASMC slew, 120 s, nominal <= {SLEW_MAX_S} s", SLEW_MAX_S, "s",
+        lambda r: r["ASMC, compiled"]["wall_per_120_s"], "{:.3f} s",
+        note=_whole_call("ASMC, compiled", "ASMC"),
+    ),
+    harness.Target(
+        f"a user's compiled law per step <= {USER_LAW_TARGET}x the built-in PD", USER_LAW_TARGET,
+        "x", lambda r: r["user_law_ratio"], "{:.3f}x",
+        note=lambda r, _: "examples/compiled_law.py, 120 s",
+    ),
+)  # fmt: skip
 
 
+@harness.register(
+    "the thesis's 120 s slew with each compiled law, and with the ASMC as a Python callback",
+    targets=TARGETS,
+)
 def main(argv: list[str] | None = None) -> dict:
     """Print the table; return each row's wall time per 120 s [s] and us per step."""
-    del argv  # no options
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--duration", type=float, default=120.0, help="simulated s per run")
+    args = parser.parse_args(argv)
     plant = Plant.from_config(nominal())
     rows = []
-    wall = _best(lambda: run_openloop(plant, OpenLoopScenario()))
-    rows.append(("plant only (open loop)", 120.0, wall))
+    openloop = OpenLoopScenario(duration_s=args.duration)
+    wall, _ = harness.best_of(lambda: run_openloop(plant, openloop), 3, warm_up=True)
+    rows.append(("plant only (open loop)", args.duration, wall))
     builtin = law_names()
     user = _register_user_law()
     kinds = (*builtin, user)
-    scenarios = [SlewScenario.model_validate({"controller": {"kind": k}}) for k in kinds]
-    walls = interleaved_best([lambda s=s: run_slew(plant, s) for s in scenarios])
-    for kind, wall in zip(kinds, walls, strict=True):
+    scenarios = [
+        SlewScenario.model_validate({"duration_s": args.duration, "controller": {"kind": k}})
+        for k in kinds
+    ]
+    walls = harness.best(harness.interleave(
+        {k: harness.wall(lambda s=s: run_slew(plant, s)) for k, s in zip(kinds, scenarios,
+                                                                          strict=True)},
+        3, warm_up=True))  # fmt: skip
+    for kind, wall in walls.items():
         origin = "user's own law" if kind == user else "compiled"
-        rows.append((f"{get_law(kind).label}, {origin}", 120.0, wall))
-    short = SlewScenario(duration_s=PYTHON_PATH_DURATION_S)
+        rows.append((f"{get_law(kind).label}, {origin}", args.duration, wall))
+    short = SlewScenario(duration_s=min(PYTHON_PATH_DURATION_S, args.duration))
 
     def python_path():
         q_d = target_quaternion(short.target_euler_deg)
@@ -80,10 +109,12 @@ def main(argv: list[str] | None = None) -> dict:
         )
         run_slew(plant, short, controller=law)
 
-    rows.append(("ASMC, Python callback", PYTHON_PATH_DURATION_S, _best(python_path, 1)))
-    table = Table(title="Closed-loop slew, nominal case, RK4 dt = 1 ms, whole run incl. recording")
-    for column in ("run", "simulated s", "wall s", "wall per 120 s", "us per step"):
-        table.add_column(column, justify="right" if column != "run" else "left")
+    rows.append(("ASMC, Python callback", short.duration_s,
+                 harness.best_of(python_path, 1, warm_up=True)[0]))  # fmt: skip
+    table = harness.table(
+        "Closed-loop slew, nominal case, RK4 dt = 1 ms, whole run incl. recording",
+        ("run", "simulated s", "wall s", "wall per 120 s", "us per step"),
+    )
     numbers = {}
     for name, simulated, wall in rows:
         per_120 = wall * 120.0 / simulated
@@ -91,7 +122,7 @@ def main(argv: list[str] | None = None) -> dict:
         numbers[name] = {"wall_per_120_s": per_120, "us_per_step": per_step}
         table.add_row(name, f"{simulated:.0f}", f"{wall:.3f}", f"{per_120:.3f}",
                       f"{per_step:.2f}")  # fmt: skip
-    console = Console()
+    console = harness.console()
     console.print(table)
     ratio = numbers[f"{get_law(user).label}, user's own law"]["us_per_step"] / numbers[
         "PD, compiled"]["us_per_step"]  # fmt: skip

@@ -17,12 +17,14 @@ from __future__ import annotations
 import argparse
 import json
 import os
-import resource
 import statistics
 import subprocess
 import sys
 import tempfile
+import time
 from pathlib import Path
+
+import harness
 
 BEFORE = "7108d3f"
 """The commit the fixed figure layout started from."""
@@ -30,9 +32,8 @@ ROOT = Path(__file__).resolve().parents[1]
 
 
 def _cpu_s() -> float:
-    own = resource.getrusage(resource.RUSAGE_SELF)
-    kids = resource.getrusage(resource.RUSAGE_CHILDREN)
-    return own.ru_utime + own.ru_stime + kids.ru_utime + kids.ru_stime
+    """CPU seconds of this process and its finished children."""
+    return time.process_time() + harness.children_cpu_s()
 
 
 def _draw_sets(study: Path, scratch: Path) -> dict:
@@ -70,30 +71,36 @@ def _draw_sets(study: Path, scratch: Path) -> dict:
 def _trial(src: Path, study: Path) -> dict:
     env = {**os.environ, "PYTHONPATH": f"{src}{os.pathsep}{ROOT / 'bench'}"}
     with tempfile.TemporaryDirectory(prefix="flexsat-bench-figures-") as scratch:
-        code = ("import json, sys; from pathlib import Path; import bench_study_figures as b; "
-                "print(json.dumps(b._draw_sets(Path(sys.argv[1]), Path(sys.argv[2]))))")
+        code = (
+            "import json, sys; from pathlib import Path; import bench_study_figures as b; "
+            "print(json.dumps(b._draw_sets(Path(sys.argv[1]), Path(sys.argv[2]))))"
+        )
         out = subprocess.run([sys.executable, "-c", code, str(study), scratch], env=env,
                              check=True, capture_output=True, text=True).stdout  # fmt: skip
     return json.loads(out.strip().splitlines()[-1])
 
 
+@harness.register(
+    "CPU time of the quick study's figure sets (slew, open loop, comparison, frequency, "
+    "modal) drawn from a finished study folder, before (a commit) and after, interleaved, "
+    "median of trials; takes the folder as argument",
+    full=False,
+)
 def main(argv: list[str] | None = None) -> dict:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("study", type=Path, help="folder of a finished quick study")
     parser.add_argument("--trials", type=int, default=3)
     parser.add_argument("--before", default=BEFORE)
     args = parser.parse_args(argv)
-    print("load average before:", ", ".join(f"{x:.2f}" for x in os.getloadavg()))
+    print("load average before:", harness.load())
     with tempfile.TemporaryDirectory(prefix="flexsat-bench-figures-src-") as tmp:
         archive = subprocess.run(["git", "-C", str(ROOT), "archive", args.before, "src"],
                                  check=True, capture_output=True).stdout  # fmt: skip
         subprocess.run(["tar", "-x", "-C", tmp], input=archive, check=True)
         codes = {"before": Path(tmp) / "src", "after": ROOT / "src"}
-        trials: dict[str, list[dict]] = {label: [] for label in codes}
-        for _ in range(args.trials):
-            for label, src in codes.items():
-                trials[label].append(_trial(src, args.study.resolve()))
-    print("load average after:", ", ".join(f"{x:.2f}" for x in os.getloadavg()))
+        trials = harness.interleave({label: lambda src=src: _trial(src, args.study.resolve())
+                                     for label, src in codes.items()}, args.trials)  # fmt: skip
+    print("load average after:", harness.load())
     medians = {label: {name: statistics.median(t[name] for t in runs) for name in runs[0]}
                for label, runs in trials.items()}  # fmt: skip
     print(f"{'figure set':<12} {'before [CPU s]':>15} {'after [CPU s]':>14} {'after/before':>13}")

@@ -18,9 +18,7 @@ import argparse
 import tempfile
 from pathlib import Path
 
-from rich.console import Console
-from rich.table import Table
-
+import harness
 from flexsat.campaigns import CampaignStore, load_campaign, run_campaign
 from flexsat.campaigns.definition import CampaignDefinition, Reduced
 from flexsat.config import nominal, validate_config
@@ -49,6 +47,11 @@ def _worst(store: Path) -> tuple[str, float]:
     return worst["case_id"], worst["metrics"][METRIC]
 
 
+@harness.register(
+    "the worst-case search against the 24 corners and random draws on the reduced model: the "
+    "worst case of each, stored for replay",
+    full=False,
+)
 def main(argv: list[str] | None = None) -> dict:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--duration", type=float, default=120.0)
@@ -58,7 +61,7 @@ def main(argv: list[str] | None = None) -> dict:
     parser.add_argument("--workers", type=int, default=2)
     parser.add_argument("--out", type=Path, default=None)
     args = parser.parse_args(argv)
-    console = Console(width=150)
+    console = harness.console(150)
     with tempfile.TemporaryDirectory(prefix="flexsat-bench-worst-") as tmp:
         out = args.out or Path(tmp)
         stores, found = {}, {}
@@ -75,17 +78,21 @@ def main(argv: list[str] | None = None) -> dict:
         summary = run_campaign(search, nominal(), stores["search"], workers=args.workers,
                                resume=True, progress=False)  # fmt: skip
         found["search"] = (summary["case_id"], summary["value"])
-        table = Table(title=f"Worst {METRIC} (reduced model, {args.duration:g} s slews)")
-        for column in ("set", "cases", "worst case", f"{METRIC}"):
-            table.add_column(column)
+        table = harness.table(
+            f"Worst {METRIC} (reduced model, {args.duration:g} s slews)",
+            ("set", "cases", "worst case", METRIC),
+            right=(),
+        )
         for key, (case_id, value) in found.items():
             table.add_row(key, str(len(CampaignStore(stores[key]).rows())), case_id,
                           f"{value:.6g}")  # fmt: skip
         console.print(table)
         beaten = found["search"][1] > max(found["montecarlo-critical"][1],
                                           found["montecarlo-random"][1])  # fmt: skip
-        console.print(f"the search {'found' if beaten else 'did not find'} a worse case than "
-                      f"the corners and the random draws; parameters: {summary['parameters']}")
+        console.print(
+            f"the search {'found' if beaten else 'did not find'} a worse case than "
+            f"the corners and the random draws; parameters: {summary['parameters']}"
+        )
         return {"found": found, "search_beats_monte_carlo": beaten,
                 "parameters": summary["parameters"]}  # fmt: skip
 
