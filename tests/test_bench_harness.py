@@ -75,3 +75,17 @@ def test_the_markdown_table_drops_colour_and_escapes_pipes():
     assert run_all._cell(harness.verdict(True)) == "met"
     assert run_all._cell(harness.verdict(False)) == "NOT MET"
     assert run_all._cell("a | b") == "a \\| b"
+
+
+def test_the_script_table_of_the_docs_matches_the_registry(registry):
+    # docs/performance.md, 'Running the benchmarks': a row per script, and "not in the
+    # full run" exactly where the registry says so
+    text = (BENCH.parent / "docs" / "performance.md").read_text(encoding="utf-8")
+    rows = {
+        line.split("`")[1].removesuffix(".py"): line
+        for line in text.splitlines()
+        if line.startswith("| `bench_")
+    }
+    assert sorted(rows) == sorted(registry)
+    for name, bench in registry.items():
+        assert ("not in the full run" in rows[name]) == (not bench.full), name
