@@ -17,6 +17,7 @@ overlaps the compiled work. The rows are those of
 from __future__ import annotations
 
 import itertools
+import threading
 import time
 from collections.abc import Iterable, Iterator
 from concurrent.futures import ThreadPoolExecutor
@@ -52,14 +53,14 @@ def run_ensemble(cases: Iterable[ResolvedCase], threads: int = 1,
     """
     size = batch or BATCH_PER_THREAD * max(1, threads)
     source = iter(cases)
+    clock = time.pthread_getcpuclockid(threading.get_ident())  # this thread's CPU clock
     with ThreadPoolExecutor(max_workers=1, thread_name_prefix="flexsat-ensemble") as flyer:
         pending = None  # (batch, future) flying in the background
         while True:
             chunk = _prepare(list(itertools.islice(source, size)))
             flying = None
-            if chunk:  # the clocks: this thread's CPU is not the flight's (_finish)
-                clocks = (time.process_time(), time.thread_time())
-                flying = (chunk, flyer.submit(_fly, chunk, threads, time.perf_counter()), clocks)
+            if chunk:
+                flying = (chunk, flyer.submit(_fly, chunk, threads, clock))
             if pending is not None:
                 yield from _finish(*pending)
             if flying is None:
@@ -97,26 +98,28 @@ def _prepare(cases: list[ResolvedCase]) -> list[_Case]:
     return prepared
 
 
-def _fly(chunk: list[_Case], threads: int, start: float):
-    """The batch's loops in one compiled call (background thread): (flown, wall [s])."""
+def _fly(chunk: list[_Case], threads: int, clock: int):
+    """The batch's loops in one compiled call (background thread): (flown, wall [s],
+    CPU [s]) of the call, from its start (not from its wait behind the previous
+    batch). The CPU is the process's while the call runs, less that of the thread
+    whose CPU clock is ``clock`` (the caller's, which meanwhile stores and prepares
+    the other batches)."""
     from flexsat.simulate.batch import fly_prepared
 
+    start, cpu, other = time.perf_counter(), time.process_time(), time.clock_gettime(clock)
     flown = fly_prepared([c.run for c in chunk if c.run is not None], threads)
-    return flown, time.perf_counter() - start
+    cpu = time.process_time() - cpu - (time.clock_gettime(clock) - other)
+    return flown, time.perf_counter() - start, max(0.0, cpu)
 
 
-def _finish(chunk: list[_Case], future, clocks: tuple[float, float]) -> Iterator[dict]:
-    """Post-process a flown batch. ``clocks``: the process's and this thread's CPU time
-    when the batch was submitted; the process's CPU since then, less this thread's
-    (storing and preparing the other batches meanwhile), is the flight's."""
+def _finish(chunk: list[_Case], future) -> Iterator[dict]:
     from flexsat.simulate.closedloop import finish_slew
 
     failure = None
     try:
-        flown, wall = future.result()
+        flown, wall, flight_cpu = future.result()
     except Exception as exc:  # the compiled call itself failed: every case of it fails
-        flown, wall, failure = None, 0.0, exc
-    flight_cpu = (time.process_time() - clocks[0]) - (time.thread_time() - clocks[1])
+        flown, wall, flight_cpu, failure = None, 0.0, 0.0, exc
     if failure is not None:
         for c in chunk:
             if c.run is not None:
@@ -124,7 +127,7 @@ def _finish(chunk: list[_Case], future, clocks: tuple[float, float]) -> Iterator
                 c.run = None
     ran = [c for c in chunk if c.run is not None]
     share = wall / max(1, len(ran))  # each case's share of the batch's loop time
-    share_cpu = max(0.0, flight_cpu) / max(1, len(ran))
+    share_cpu = flight_cpu / max(1, len(ran))
     for k, c in enumerate(ran):
         start, cpu = time.perf_counter(), time.thread_time()
         status, done, rows = (int(v) for v in flown[k])
