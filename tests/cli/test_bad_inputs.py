@@ -11,13 +11,14 @@ from __future__ import annotations
 import copy
 import math
 import os
+import tomllib
 from dataclasses import dataclass, field
 
+import numpy as np
 import pytest
 
-from tests.cli.harness import flexsat, to_toml
+from tests.cli.harness import flexsat, modal_table, npz_bytes, to_toml
 from tests.conftest import nominal_dict
-
 
 FIFO = object()
 """A file's content in :attr:`Bad.files`: the file is a named pipe (FIFO) no one writes to."""
@@ -301,6 +302,82 @@ SPECIAL_FILES = [
     Bad("animate a FIFO", ["animate", "{tmp}/r.nc"], f"cannot read RESULT file {{tmp}}/r.nc: {_NOT_REGULAR}", {"r.nc": FIFO}, 10),
 ]  # fmt: skip
 
+def _modal_npz(**arrays) -> bytes:
+    """The NPZ of :func:`~tests.cli.harness.modal_table` with ``arrays`` replaced."""
+    from flexsat.config.modal_data import modal_data_from_dict
+
+    return npz_bytes({**modal_data_from_dict(modal_table()).to_arrays(), **arrays})
+
+
+def _forged_npz() -> bytes:
+    """A valid NPZ but for output_mode_shapes: its header asks for (2000, 1000000) float64,
+    14.9 GiB, over 64 KiB of data."""
+    import io
+    import zipfile
+
+    header = io.BytesIO()
+    np.lib.format.write_array_header_1_0(
+        header, {"descr": "<f8", "fortran_order": False, "shape": (2000, 1_000_000)})
+    buffer = io.BytesIO()
+    with zipfile.ZipFile(io.BytesIO(_modal_npz())) as source, zipfile.ZipFile(buffer, "w") as out:
+        for info in source.infolist():
+            forged = info.filename == "output_mode_shapes.npy"
+            out.writestr(info.filename, header.getvalue() + bytes(65536) if forged
+                         else source.read(info))
+    return buffer.getvalue()
+
+
+def _modal_toml(**changes) -> str:
+    return to_toml({**modal_table(), **changes})
+
+
+def _chains(count: int, segments: int) -> str:
+    """``count`` uniform 3-DOF chains of ``segments`` segments around the nominal hub."""
+    data = {"name": "chains", "hub": {"mass_kg": 150.0, "radius_m": 0.6, "height_m": 1.5},
+            "appendages": []}
+    for k in range(count):
+        angle = 2.0 * math.pi * k / count
+        data["appendages"].append({
+            "name": f"c{k}", "model": "chain", "segments": segments, "span_direction": "+y",
+            "mount_point_m": [0.8 * math.sin(-angle), 0.8 * math.cos(angle), 0.0],
+            "mount_yaw_deg": math.degrees(angle), "length_m": 4.5, "width_m": 1.5,
+            "thickness_m": 0.02, "surface_density_kg_m2": 1.0,
+            "joint": {"dofs": ["rx", "ry", "rz"], "damping_ratio": 0.005},
+            "beam": {"EI_flap_N_m2": 123.0, "EI_in_plane_N_m2": 491.0, "GJ_N_m2": 58.3}})
+    return to_toml(data)
+
+
+def _chain_joint(**joint) -> str:
+    data = tomllib.loads(_chains(2, 4))
+    data["appendages"][0]["joint"] = {"dofs": ["x", "rx"], "stiffness": {"x": 1e3, "rx": 10.0},
+                                      "damping_ratio": 0.005, **joint}
+    del data["appendages"][0]["beam"]
+    return to_toml(data)
+
+
+_MODAL = ["modal", "--config", "{tmp}/c.toml"]
+_MEKF_ALONE = '[[sensor_stages]]\nkind = "mekf"\n'
+# Crafted modal data files, huge numbers that reached the solvers, and nonsense the
+# boundary accepted: each now refused with its field and range (docs/modal_format.md,
+# docs/model.md 'Allowed ranges of the physical inputs' and 'Geometric interference').
+ROBUSTNESS = [
+    Bad("truncated modal NPZ", _MODAL, "cannot read modal data file {tmp}/m.npz: File is not a zip file", {"c.toml": _modal_file("m.npz"), "m.npz": _modal_npz()[:700]}),
+    Bad("0-d output_names", _MODAL, "output_names: expected an array of shape (k,), got shape ()", {"c.toml": _modal_file("m.npz"), "m.npz": _modal_npz(output_names=np.array("tip"))}),
+    Bad("0-d output_mode_shapes", _MODAL, "output_mode_shapes: expected an array of shape (k, n, 3), got shape ()", {"c.toml": _modal_file("m.npz"), "m.npz": _modal_npz(output_mode_shapes=np.array(0.5))}),
+    Bad("NPZ header asking 14.9 GiB", _MODAL, "output_mode_shapes: shape (2000, 1000000) holds more than the 6000000 numbers", {"c.toml": _modal_file("m.npz"), "m.npz": _forged_npz()}, 10),
+    Bad("modal frequency 1e200 Hz", _MODAL, "frequencies_hz[1]: Input should be less than or equal to 100000", {"c.toml": _modal_file("m.toml"), "m.toml": _modal_toml(frequencies_hz=[0.8, 1e200])}),
+    Bad("modal frequency 1e-300 Hz", _MODAL, "frequencies_hz[0]: Input should be greater than or equal to 0.001", {"c.toml": _modal_file("m.toml"), "m.toml": _modal_toml(frequencies_hz=[1e-300, 2.5])}),
+    Bad("linearize about a spin of 1e300 rad/s", ["linearize", "--about", "spin:1e300,0,0", "--out", "{tmp}/lin"], "--about: each spin component must be within +-100 rad/s"),
+    Bad("64 chains of 512 segments", ["modal", "--config", "{tmp}/c.toml", "--out", "{tmp}/m"], "coordinates; its dense 98310 x 98310 matrices", {"c.toml": _chains(64, 512)}),
+    _scenario("environment torque 1e300 N m", "[disturbances]\nenvironment_nm = [1e300, 0.0, 0.0]\n", "disturbances.environment_nm: each axis must be within +-actuator.t_max_nm = +-2 N m", command="slew"),
+    _scenario("initial eta_m 1e300 m", '[[initial.appendages]]\nname = "panel_1"\neta_m = [1e300, 0, 0]\n', "initial.appendages[0].eta_m[0]: Input should be less than or equal to 10 (got 1e+300)"),
+    _scenario("initial rate 1e300 deg/s", "[initial]\nrate_deg_s = [0, 0, 1e300]\n", "initial.rate_deg_s[2]: Input should be less than or equal to 10000 (got 1e+300)"),
+    Bad("chain joint initial 1e300 m", ["config", "show", "--config", "{tmp}/c.toml"], "appendages[0].joint: initial.x: 1e+300 m, must be within +-10 m", {"c.toml": _chain_joint(initial={"x": 1e300})}),
+    _config("two panels on one mount point", "appendages.1.mount_point_m", [0.0, 0.8, 0.0], "appendages[1].mount_point_m [0.0, 0.8, 0.0] is the mount point of appendages[0]"),
+    _config("panel spanning through the hub", "appendages.0.span_direction", "-y", "appendages[0] (panel_1) passes through the hub"),
+    _scenario("MEKF without gyro or star tracker", _MEKF_ALONE, "sensor_stages[0].kind: an MEKF needs a gyro or a star tracker", command="slew"),
+]  # fmt: skip
+
 CAMPAIGNS = [
     _campaign("campaign named with ../", 'name = "../../../outside"\n', "name: contains characters"),
     _campaign("campaign named with an absolute path", 'name = "/tmp/outside"\n', "name: contains characters"),
@@ -327,7 +404,7 @@ CAMPAIGNS = [
     Bad("campaign of an unknown law", ["campaign", "sensitivity", "--controller", "lqr", "--out", "{tmp}/s"], "--controller: unknown control law 'lqr'"),
 ]  # fmt: skip
 
-TABLE = CONFIGS + SCENARIOS + PATHS + SPECIAL_FILES + CAMPAIGNS
+TABLE = CONFIGS + SCENARIOS + PATHS + SPECIAL_FILES + ROBUSTNESS + CAMPAIGNS
 
 
 def test_the_table_is_at_least_sixty_rows():

@@ -79,7 +79,7 @@ def test_a_chain_longer_than_the_slots_runs_each_of_its_stages(nominal_plant, ga
         (["gyro", "star_tracker"], False),
         (["gyro"], True),  # the law reads the ideal attitude
         (["star_tracker"], True),  # the law reads the ideal rate
-        (["mekf", "gyro", "star_tracker"], True),  # the estimator reads the ideal ones
+        (["gyro", "mekf", "star_tracker"], True),  # the estimator reads the ideal attitude
     ],
 )
 def test_the_ideal_sensor_runs_only_where_something_reads_it(stages, ideal_runs):

@@ -159,7 +159,7 @@ class ModalAnalysis:
         phi^T C phi / 2 omega (0 for the rigid-body modes) [-]."""
         C = self.plant.damping_matrix()
         omega = 2.0 * np.pi * self.frequencies_hz
-        modal = np.einsum("ik,ij,jk->k", self.shapes, C, self.shapes)
+        modal = np.sum(self.shapes * (C @ self.shapes), axis=0)  # diag(phi^T C phi)
         return np.where(omega > 0.0, modal / np.where(omega > 0.0, 2.0 * omega, 1.0), 0.0)
 
 
@@ -260,6 +260,7 @@ def modal_analysis(plant: Plant) -> ModalAnalysis:
     names = dof_names(plant)
     mirror = mirror_operator(plant)
     paired = _paired_coordinates(plant)
+    kinds = _coordinate_kinds(plant)
     modes = []
     for k in range(plant.n_dof):
         phi = shapes[:, k]
@@ -269,7 +270,7 @@ def modal_analysis(plant: Plant) -> ModalAnalysis:
             Mode(
                 index=k + 1,
                 frequency_hz=float(frequencies[k]),
-                kind="rigid" if rigid else _kind(plant, phi),
+                kind="rigid" if rigid else _kind(plant, phi, kinds),
                 symmetry="none" if rigid else _symmetry(phi, M0, mirror, paired),
                 dominant_dofs=[names[j] for j in order if participation[j, k] >= _DOMINANT_MIN],
                 hub_dof=None if rigid else _hub_dof(participation[:, k]),
@@ -287,11 +288,17 @@ def modal_analysis(plant: Plant) -> ModalAnalysis:
     )
 
 
-def _kind(plant: Plant, phi: np.ndarray) -> str:
-    """The kind (each model labels its coordinates) holding most of the strain energy."""
+def _coordinate_kinds(plant: Plant) -> list[str]:
+    """The kind of each appendage coordinate, as its model labels it."""
+    return [k for app, m in zip(plant.config.appendages, plant.models, strict=True)
+            for k in m.mode_kinds(app)]  # fmt: skip
+
+
+def _kind(plant: Plant, phi: np.ndarray, kinds: list[str] | None = None) -> str:
+    """The kind (each model labels its coordinates) holding most of the strain energy;
+    ``kinds``: :func:`_coordinate_kinds`, computed once for every mode of a plant."""
     strain = plant.stiffness * phi[6:] ** 2
-    kinds = [k for app, m in zip(plant.config.appendages, plant.models, strict=True)
-             for k in m.mode_kinds(app)]  # fmt: skip
+    kinds = _coordinate_kinds(plant) if kinds is None else kinds
     energy: dict[str, float] = {}
     for dof, kind in enumerate(kinds):
         energy[kind] = energy.get(kind, 0.0) + strain[dof]

@@ -354,4 +354,54 @@ class SatelliteConfig(_Frozen):
                         f"hub (radius {hub.radius_m:g} m, height {hub.height_m:g} m); mount "
                         "appendages on or outside its surface"
                     )
+        _check_interference(self)
         return self
+
+
+_MOUNT_SEPARATION_M = 1e-3  # two roots closer than this are one mount point [m]
+
+
+def _check_interference(config: SatelliteConfig) -> None:
+    """Refuse appendages that overlap (docs/model.md, 'Geometric interference').
+
+    Two appendages may not share a mount point (roots closer than 1 mm), and no point
+    of a plate (its mid-plane rectangle, width by length, from its root along its
+    span) may lie inside a cylindrical hub.
+    """
+    roots = [(k, getattr(app, "mount_point_m", None)) for k, app in enumerate(config.appendages)]
+    roots = [(k, np.array(r, dtype=float)) for k, r in roots if r is not None]
+    for i, (k, a) in enumerate(roots):
+        for m, b in roots[i + 1 :]:
+            if np.linalg.norm(a - b) < _MOUNT_SEPARATION_M:
+                raise ValueError(
+                    f"appendages[{m}].mount_point_m {b.tolist()} is the mount point of "
+                    f"appendages[{k}]: two appendages need mount points at least "
+                    f"{_MOUNT_SEPARATION_M * 1e3:g} mm apart"
+                )
+    hub = config.hub
+    if hub.radius_m is None:  # an inertia without a shape: nothing to intersect
+        return
+    u = np.linspace(-0.5, 0.5, 65)[:, None]  # across the chord, times the width
+    v = np.linspace(0.0, 1.0, 257)[None, :]  # along the span, times the length
+    for k, app in enumerate(config.appendages):
+        if not isinstance(app, AppendageConfig):
+            continue
+        yaw, sadm = np.radians(app.mount_yaw_deg), np.radians(app.sadm_angle_deg)
+        # R_BM = Rz(yaw) Ry(sadm): the chord X_M and the span +-Y_M in B.
+        chord = np.array([np.cos(yaw) * np.cos(sadm), np.sin(yaw) * np.cos(sadm), -np.sin(sadm)])
+        span = app.span_sign() * np.array([-np.sin(yaw), np.cos(yaw), 0.0])
+        points = (np.array(app.mount_point_m)[:, None, None] + chord[:, None, None] * u
+                  * app.width_m + span[:, None, None] * v * app.length_m)  # fmt: skip
+        depth_r = hub.radius_m - np.hypot(points[0], points[1])
+        depth_z = 0.5 * hub.height_m - np.abs(points[2])
+        inside = np.minimum(depth_r, depth_z) > 1e-9 * hub.radius_m
+        if inside.any():
+            j = np.argwhere(inside)[0]
+            where = points[:, j[0], j[1]]
+            raise ValueError(
+                f"appendages[{k}] ({app.name}) passes through the hub: its point "
+                f"{np.round(where, 4).tolist()} m of the plate (width {app.width_m:g} m, "
+                f"length {app.length_m:g} m from mount_point_m) is inside the hub (radius "
+                f"{hub.radius_m:g} m, height {hub.height_m:g} m); a plate must lie outside "
+                "the hub"
+            )

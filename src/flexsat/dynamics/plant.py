@@ -109,6 +109,7 @@ class Plant:
             models=models,
             params=tuple(m.pack(app) for m, app in zip(models, config.appendages, strict=True)),
         )
+        _check_dense_size(untuned.n_dof)
         diag = np.diag(untuned.mass_matrix())
         tuned = tuple(
             model.tune(app, row, diag[block.slice])
@@ -408,3 +409,27 @@ class Plant:
         out = np.zeros((self.n_appendages, 3))
         kernels.tip_displacement(self._state(q), self._views["tips"], out)
         return out
+
+
+# The dense n x n float64 arrays the modal analysis holds at once: M, K and C, the
+# eigenvectors and the generalized eigensolver's own copies of M and K.
+_DENSE_COPIES = 6
+
+
+def _check_dense_size(n_dof: int) -> None:
+    """Refuse, before any n x n matrix is built, a plant whose modal analysis cannot fit
+    in half the machine's memory; the message gives the estimate."""
+    import os
+
+    need = _DENSE_COPIES * 8.0 * float(n_dof) ** 2
+    try:
+        memory = float(os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES"))
+    except (ValueError, OSError, AttributeError):  # not reported: assume 8 GiB
+        memory = 8.0 * 2**30
+    if need > 0.5 * memory:
+        raise ConfigError(
+            f"appendages: the satellite has {n_dof} coordinates; its dense {n_dof} x {n_dof} "
+            f"matrices (mass, stiffness, damping, modes) need about {need / 2**30:.1f} GiB, "
+            f"more than half this machine's memory ({0.5 * memory / 2**30:.1f} GiB): use "
+            "fewer appendages or segments"
+        )

@@ -12,6 +12,7 @@ from typing import Annotated, ClassVar, Literal
 
 import numpy as np
 from pydantic import (
+    AllowInfNan,
     BeforeValidator,
     Field,
     SerializeAsAny,
@@ -56,6 +57,13 @@ __all__ = [
 ]
 
 _ZERO3 = (0.0, 0.0, 0.0)
+# Initial states are bounded where they enter, like the config's magnitudes
+# (docs/model.md, 'Allowed ranges of the physical inputs'): far beyond any spacecraft,
+# so that a typo (1e300) is refused here instead of failing the run at t = 0.
+Deflection = Annotated[float, Strict(), AllowInfNan(False), Field(ge=-10.0, le=10.0)]  # [m]
+LinearRate = Annotated[float, Strict(), AllowInfNan(False), Field(ge=-1e3, le=1e3)]  # [m/s]
+AngularRate = Annotated[float, Strict(), AllowInfNan(False), Field(ge=-1e4, le=1e4)]  # [deg/s]
+EulerAngle = Annotated[float, Strict(), AllowInfNan(False), Field(ge=-360.0, le=360.0)]  # [deg]
 _MAX_INERTIA_KG_M2 = 1e9  # a bound far beyond any spacecraft, so J's algebra cannot overflow
 
 
@@ -131,12 +139,18 @@ class AppendageInitialState(_Frozen):
     """
 
     name: str
-    eta_m: Vector3 = _ZERO3
+    eta_m: tuple[Deflection, Deflection, Deflection] = Field(
+        _ZERO3, description="root translation (x, y, z), mount frame, within +-10 m [m]"
+    )
     rho_deg: Annotated[
         tuple[Real, Real, Real], Field(description="ZYX root rotation (x, y, z) [deg]")
     ] = _ZERO3
-    eta_rate_m_s: Vector3 = _ZERO3
-    rho_rate_deg_s: Vector3 = _ZERO3
+    eta_rate_m_s: tuple[LinearRate, LinearRate, LinearRate] = Field(
+        _ZERO3, description="rate of the root translation, within +-1e3 m/s [m/s]"
+    )
+    rho_rate_deg_s: tuple[AngularRate, AngularRate, AngularRate] = Field(
+        _ZERO3, description="rates of the root rotation, within +-1e4 deg/s [deg/s]"
+    )
 
     @model_validator(mode="after")
     def _small(self) -> AppendageInitialState:
@@ -158,8 +172,12 @@ class InitialState(_Frozen):
         One per deformed appendage, by name (others start undeformed).
     """
 
-    attitude_deg: Vector3 = Field(_ZERO3, description="ZYX Euler angles (roll, pitch, yaw) [deg]")
-    rate_deg_s: Vector3 = Field(_ZERO3, description="body rate, hub frame B [deg/s]")
+    attitude_deg: tuple[EulerAngle, EulerAngle, EulerAngle] = Field(
+        _ZERO3, description="ZYX Euler angles (roll, pitch, yaw), within +-360 deg [deg]"
+    )
+    rate_deg_s: tuple[AngularRate, AngularRate, AngularRate] = Field(
+        _ZERO3, description="body rate, hub frame B, within +-1e4 deg/s [deg/s]"
+    )
     appendages: list[AppendageInitialState] = Field(default_factory=list)
 
     @model_validator(mode="after")
@@ -360,6 +378,21 @@ class SlewScenario(_TimedRun):
         if np.linalg.eigvalsh(J).min() <= 0.0:
             raise ValueError("must be positive definite (every eigenvalue > 0 kg m^2)")
         return value
+
+    @model_validator(mode="after")
+    def _disturbances_within_the_actuator(self) -> SlewScenario:
+        # The constant torques are added before the actuator's saturation (docs/control.md,
+        # 'Torque budget, Λ and saturation order'): one beyond T_max would be clipped to it.
+        limit = self.actuator.t_max_nm
+        for field in ("environment_nm", "residual_nm"):
+            values = getattr(self.disturbances, field)
+            if max(abs(v) for v in values) > limit:
+                raise ValueError(
+                    f"disturbances.{field}: each axis must be within +-actuator.t_max_nm = "
+                    f"+-{limit:g} N m (it is added before the actuator's saturation), got "
+                    f"{[float(f'{v:.6g}') for v in values]}"
+                )
+        return self
 
     @model_validator(mode="after")
     def _stages_fit_the_run(self) -> SlewScenario:

@@ -30,6 +30,11 @@ __all__ = [
 _REDUCTIONS = ("modal", "balanced")
 
 
+MAX_SPIN_RAD_S = 100.0
+"""Largest body-rate component of a steady spin to linearize about [rad/s] (about 16
+rev/s, far beyond any spacecraft; a larger one leaves no digit to the joints' motion)."""
+
+
 def parse_about(text: str) -> str | np.ndarray:
     """``"rest"`` or ``"spin:wx,wy,wz"`` (body rate [rad/s]) -> ``"rest"`` or the vector.
 
@@ -52,6 +57,9 @@ def parse_about(text: str) -> str | np.ndarray:
         values = []
     if head != "spin" or len(values) != 3:
         raise ConfigError(f"--about: expected 'rest' or 'spin:wx,wy,wz' [rad/s], got {text!r}")
+    if not all(abs(v) <= MAX_SPIN_RAD_S for v in values):  # NaN fails too
+        raise ConfigError(f"--about: each spin component must be within +-{MAX_SPIN_RAD_S:g} "
+                          f"rad/s, got {text[:80]!r}")  # fmt: skip
     return np.array(values)
 
 

@@ -8,6 +8,7 @@ the one source of the numbers that the CLI prints and the study report shows.
 
 from __future__ import annotations
 
+import sys
 import tempfile
 from collections.abc import Callable
 from pathlib import Path
@@ -21,6 +22,7 @@ if TYPE_CHECKING:  # the CLI imports this module at start-up: keep numba out of 
     from flexsat.dynamics.plant import Plant
 
 __all__ = [
+    "MODAL_PROGRESS_MIN_DOF",
     "derived_properties",
     "fly_campaign",
     "fly_openloop",
@@ -29,6 +31,12 @@ __all__ = [
     "write_json",
     "write_modal",
 ]
+
+
+MODAL_PROGRESS_MIN_DOF = 1000
+"""From this many coordinates on, :func:`write_modal` says on stderr what it is doing
+(two 512-segment chains, 3078 coordinates, take minutes: the eigenproblem, the JSON of
+every mode shape, the figures)."""
 
 
 def prepare_output_dir(path: str | Path, option: str = "--out") -> Path:
@@ -108,7 +116,8 @@ def derived_properties(plant: Plant) -> dict:
     }
 
 
-def write_modal(plant: Plant, out: Path | None = None, animate: list[int] | None = None):
+def write_modal(plant: Plant, out: Path | None = None, animate: list[int] | None = None,
+                progress: bool | None = None):  # fmt: skip
     """Modal analysis; with ``out``, ``modal.json`` and the modal figures there.
 
     Parameters
@@ -119,6 +128,9 @@ def write_modal(plant: Plant, out: Path | None = None, animate: list[int] | None
         Where the files go.
     animate : list of int, optional
         Modes (1-based) to animate as GIFs.
+    progress : bool, optional
+        Say each step on stderr; default: for plants of at least
+        :data:`MODAL_PROGRESS_MIN_DOF` coordinates.
 
     Returns
     -------
@@ -129,12 +141,23 @@ def write_modal(plant: Plant, out: Path | None = None, animate: list[int] | None
     from flexsat.analysis.modal import modal_analysis
     from flexsat.plots.modal import write_modal_figures
 
+    show = plant.n_dof >= MODAL_PROGRESS_MIN_DOF if progress is None else progress
+
+    def step(text: str) -> None:
+        if show:
+            print(f"modal: {text}", file=sys.stderr, flush=True)
+
     if out is not None:
         prepare_output_dir(out)
+    step(f"{plant.n_dof} coordinates: the {plant.n_dof} x {plant.n_dof} eigenproblem and "
+         "each mode's kind")  # fmt: skip
     analysis = modal_analysis(plant)
+    step("effective masses and modal damping ratios")
     summary = analysis.to_dict()
     if out is not None:
+        step(f"writing {Path(out) / 'modal.json'}")
         json_path = write_json(Path(out) / "modal.json", summary)
+        step(f"drawing the figures into {out}")
         written = write_modal_figures(analysis, Path(out), mode_indices=animate)
         summary["files"] = [str(p) for p in [json_path, *written]]
     return analysis, summary

@@ -60,6 +60,9 @@ Dof = Literal["x", "y", "z", "rx", "ry", "rz"]
 NonNegative = Annotated[float, Strict(), AllowInfNan(False), Field(ge=0.0, le=1e12)]
 Ratio = Annotated[float, Strict(), AllowInfNan(False), Field(ge=0.0, lt=1.0)]
 Modulus = Annotated[float, Strict(), AllowInfNan(False), Field(gt=0.0, le=1e15)]
+# Initial joint states, bounded as the scenario's initial states are (docs/model.md,
+# 'Allowed ranges of the physical inputs').
+_MAX_DEFLECTION_M, _MAX_RATE_M_S, _MAX_RATE_DEG_S = 10.0, 1e3, 1e4
 AXES = {"x": 0, "y": 1, "z": 2}
 """Index of each segment-frame axis."""
 
@@ -129,6 +132,15 @@ class JointConfig(_Frozen):
         for dof, value in self.initial.items():
             if _is_rotation(dof) and abs(value) >= 45.0:
                 raise ValueError(f"initial.{dof}: {value} deg, must stay below 45 deg")
+            if not _is_rotation(dof) and abs(value) > _MAX_DEFLECTION_M:
+                raise ValueError(f"initial.{dof}: {value:g} m, must be within "
+                                 f"+-{_MAX_DEFLECTION_M:g} m")  # fmt: skip
+        for dof, value in self.initial_rate.items():
+            rotation = _is_rotation(dof)
+            limit, unit = (_MAX_RATE_DEG_S, "deg/s") if rotation else (_MAX_RATE_M_S, "m/s")
+            if abs(value) > limit:
+                raise ValueError(f"initial_rate.{dof}: {value:g} {unit}, must be within "
+                                 f"+-{limit:g} {unit}")  # fmt: skip
         return self
 
     def free_mask(self) -> np.ndarray:
