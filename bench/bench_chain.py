@@ -23,21 +23,25 @@ import numpy as np
 from rich.console import Console
 
 import harness
+from flexsat.config import validate_config
+from flexsat.dynamics.attitude import identity_frame
+from flexsat.dynamics.integrators import rk4_hold
+from flexsat.dynamics.plant import Plant
+from flexsat.linear import linearize
 
 ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT))  # the cantilever definitions are the tests' own
 
-from tests.dynamics.chain_satellites import (  # noqa: E402
-    beam_frequency_hz,
-    cantilever_chain,
-)
-from tests.dynamics.test_chain_beam import clamped_frequencies_hz  # noqa: E402
 
-from flexsat.config import validate_config  # noqa: E402
-from flexsat.dynamics.attitude import identity_frame  # noqa: E402
-from flexsat.dynamics.integrators import rk4_hold  # noqa: E402
-from flexsat.dynamics.plant import Plant  # noqa: E402
-from flexsat.linear import linearize  # noqa: E402
+def _cantilever():
+    """The tests' cantilever: (beam_frequency_hz, cantilever_chain, clamped_frequencies_hz).
+
+    Imported when a table needs it, so that the script registers without the tests.
+    """
+    sys.path.insert(0, str(ROOT))
+    from tests.dynamics.chain_satellites import beam_frequency_hz, cantilever_chain
+    from tests.dynamics.test_chain_beam import clamped_frequencies_hz
+
+    return beam_frequency_hz, cantilever_chain, clamped_frequencies_hz
 
 
 def _two_arrays(n: int) -> Plant:
@@ -95,6 +99,7 @@ def step_cost_table(console: Console, steps: int) -> None:
 
 
 def beam_table(console: Console) -> None:
+    beam_frequency_hz, cantilever_chain, clamped_frequencies_hz = _cantilever()
     reference = np.array([beam_frequency_hz(n) for n in (1, 2, 3)])
     table = harness.table("Clamped cantilever as a chain: error against Euler-Bernoulli",
                           ("N", "mode 1", "mode 2", "mode 3", "order 1", "order 2", "order 3"),
@@ -117,6 +122,7 @@ def spin_figure(console: Console) -> None:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
+    _, cantilever_chain, clamped_frequencies_hz = _cantilever()
     ratios = np.linspace(0.0, 2.0, 21)
     fig, ax = plt.subplots(figsize=(6.4, 4.2))
     for dof, label in (("rx", "flapwise"), ("rz", "in-plane")):

@@ -30,6 +30,7 @@ from pathlib import Path
 from typing import Any
 
 from rich.console import Console
+from rich.markup import escape
 from rich.table import Table
 
 HERE = Path(__file__).resolve().parent
@@ -195,15 +196,18 @@ def table(
 ) -> Table:
     """A table whose first ``left`` columns are text (left-aligned), the rest numbers.
 
+    The title, caption and column names are shown as written: a unit in brackets
+    ("wall [s]") is not taken for rich's markup.
+
     ``right``, if given, names the right-aligned columns instead. Column names carry
     the units of their numbers ("wall [s]", "us / step"). Extra keywords go to every
     column (``no_wrap=True``).
     """
-    out = Table(title=title, caption=caption)
+    out = Table(title=escape(title), caption=escape(caption) if caption else None)
     numbers = set(right) if right is not None else None
     for k, column in enumerate(columns):
         at_right = column in numbers if numbers is not None else k >= left
-        out.add_column(column, justify="right" if at_right else "left", **kw)
+        out.add_column(escape(column), justify="right" if at_right else "left", **kw)
     return out
 
 

@@ -7,6 +7,7 @@ a run did not measure instead of failing.
 
 from __future__ import annotations
 
+import io
 import sys
 from pathlib import Path
 
@@ -89,3 +90,14 @@ def test_the_script_table_of_the_docs_matches_the_registry(registry):
     assert sorted(rows) == sorted(registry)
     for name, bench in registry.items():
         assert ("not in the full run" in rows[name]) == (not bench.full), name
+
+
+def test_units_in_brackets_are_printed():
+    from rich.console import Console
+
+    table = harness.table("times [s]", ("what", "wall [s]", "time [ms]"))
+    table.add_row("a run", "1.5", "1500")
+    console = Console(record=True, width=80, file=io.StringIO())
+    console.print(table)
+    text = console.export_text()
+    assert "times [s]" in text and "wall [s]" in text and "time [ms]" in text
