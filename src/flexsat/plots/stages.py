@@ -370,12 +370,12 @@ def zero_crossings(values: np.ndarray) -> int:
     Parameters
     ----------
     values : ndarray, shape (m,)
-        A record, any unit; NaN records passed over.
+        A record [any unit: only its sign is read]; NaN records passed over.
 
     Returns
     -------
     int
-        The sign changes between consecutive non-zero records.
+        The sign changes between consecutive non-zero records [-].
     """
     signs = np.sign(np.asarray(values, dtype=float))
     signs = signs[np.isfinite(signs) & (signs != 0.0)]
