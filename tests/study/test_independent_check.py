@@ -1059,7 +1059,8 @@ def test_linearize_json_is_rebuilt_key_by_key(tmp_path, nominal_config):
     plant = ind.state_space(cfg)
     n = plant.A.shape[0] // 2
     dofs = _dof_names(cfg)
-    states = ["r_B_x", "r_B_y", "r_B_z", *dofs[3:]]  # docs/linear.md, 'The state, inputs and outputs'
+    # docs/linear.md, 'The state, inputs and outputs'
+    states = ["r_B_x", "r_B_y", "r_B_z", *dofs[3:]]
     rates = ["v_B_x", "v_B_y", "v_B_z", "omega_x", "omega_y", "omega_z",
              *(f"{d}_dot" for d in dofs[6:])]  # fmt: skip
     units = ["m"] * 3 + ["rad"] * 3 + ["m", "m", "m", "rad", "rad", "rad"] * (n // 6 - 1)
