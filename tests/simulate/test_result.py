@@ -86,6 +86,27 @@ def test_every_figure_kind_draws(openloop, slews):
             assert isinstance(fig, Figure) and fig.axes, kind
 
 
+def test_plot_works_for_a_user_who_imported_only_flexsat(openloop, tmp_path):
+    # The simulation layer names nothing of the figures above it: Result.plot finds
+    # them through its registry, which imports flexsat.plots by name on first use.
+    import subprocess
+    import sys
+
+    path = openloop.to_netcdf(tmp_path / "r.nc")
+    code = (
+        "import sys\n"
+        "import flexsat\n"
+        "from flexsat.simulate.result import Result\n"
+        f"result = Result.from_netcdf({str(path)!r})\n"
+        "print('flexsat.plots' in sys.modules)\n"
+        "fig = result.plot('attitude')\n"
+        "print(type(fig).__name__, len(fig.axes) > 0, result.figure_kinds()[0])\n"
+    )
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.split() == ["False", "Figure", "True", OPENLOOP_FIGURES[0]]
+
+
 def test_a_law_without_a_sliding_surface_has_no_surface_figures(slews):
     kinds = slews["pd"].figure_kinds()
     assert "sliding_variables" not in kinds and "adaptation" not in kinds

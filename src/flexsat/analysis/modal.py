@@ -37,6 +37,7 @@ __all__ = [
     "Mode",
     "dof_names",
     "effective_mass_table",
+    "effective_masses",
     "modal_analysis",
 ]
 
@@ -166,13 +167,43 @@ class ModalAnalysis:
 _DIRECTIONS = ("x", "y", "z", "rx", "ry", "rz")
 
 
+def effective_masses(plant: Plant) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Modal effective masses and inertias of the hub-fixed appendage modes, 6 directions.
+
+    As :func:`flexsat.linear.frequency.effective_inertia` (which reads it from here,
+    as does :func:`effective_mass_table`), for every hub direction: translations x, y, z
+    (L_k,a^2 [kg]) and rotations about the hub centre of mass x, y, z ([kg m^2]).
+
+    Parameters
+    ----------
+    plant : Plant
+        The satellite.
+
+    Returns
+    -------
+    frequencies_hz : ndarray, shape (n_flex,)
+        Frequencies of the hub-fixed appendage modes, ascending [Hz].
+    effective : ndarray, shape (n_flex, 6)
+        L_k,a^2 per mode and direction [kg] x 3, [kg m^2] x 3.
+    residual : ndarray, shape (6,)
+        diag(M_hh - M_hf M_ff^-1 M_fh), what no mode carries [kg] x 3, [kg m^2] x 3.
+    """
+    M0 = plant.mass_matrix()
+    K = plant.stiffness_matrix()
+    M_ff, M_fh, K_ff = M0[6:, 6:], M0[6:, :6], K[6:, 6:]
+    omega2, phi = eigh(K_ff, M_ff)
+    L = phi.T @ M_fh
+    residual = M0[:6, :6] - M_fh.T @ np.linalg.solve(M_ff, M_fh)
+    return np.sqrt(np.clip(omega2, 0.0, None)) / (2 * np.pi), L**2, np.diag(residual).copy()
+
+
 def effective_mass_table(plant: Plant) -> dict:
     """The hub-fixed appendage modes' effective masses and inertias (JSON-ready).
 
     Per mode and hub direction (x, y, z [kg]; rx, ry, rz about the hub centre of mass
     [kg m^2]), with the cumulative fraction of the satellite's total in that direction
     (diag of M(0) at the hub: total mass, locked inertia; modes plus residual), see
-    :func:`flexsat.linear.frequency.effective_masses`.
+    :func:`effective_masses`.
 
     Parameters
     ----------
@@ -184,8 +215,6 @@ def effective_mass_table(plant: Plant) -> dict:
     dict
         Plain lists and numbers, ready for ``json.dumps``.
     """
-    from flexsat.linear.frequency import effective_masses
-
     frequencies, effective, residual = effective_masses(plant)
     total = effective.sum(axis=0) + residual
     cumulative = np.cumsum(effective, axis=0) / np.where(total > 0.0, total, 1.0)

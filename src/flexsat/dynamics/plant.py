@@ -98,7 +98,7 @@ class Plant:
         """
         from flexsat.dynamics.appendages.sadm import expand_drives
 
-        expanded = expand_drives(config)
+        expanded = expand_drives(config, cls.from_config)
         if expanded is not config:
             return cls.from_config(expanded)
         models = tuple(appendage_model(app.model) for app in config.appendages)

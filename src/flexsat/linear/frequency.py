@@ -14,9 +14,9 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.linalg import eigh
 from scipy.optimize import brentq, minimize_scalar
 
+from flexsat.analysis.modal import effective_masses
 from flexsat.control.laws import LawConfig, get_law, law_names
 from flexsat.control.laws.pd import PDConfig
 from flexsat.dynamics.plant import Plant
@@ -102,35 +102,6 @@ def effective_inertia(plant: Plant) -> tuple[np.ndarray, np.ndarray, np.ndarray]
     return frequencies, effective[:, 3:], residual[3:]
 
 
-def effective_masses(plant: Plant) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Modal effective masses and inertias of the hub-fixed appendage modes, 6 directions.
-
-    As :func:`effective_inertia`, for every hub direction: translations x, y, z
-    (L_k,a^2 [kg]) and rotations about the hub centre of mass x, y, z ([kg m^2]).
-
-    Parameters
-    ----------
-    plant : Plant
-        The satellite.
-
-    Returns
-    -------
-    frequencies_hz : ndarray, shape (n_flex,)
-        Frequencies of the hub-fixed appendage modes, ascending [Hz].
-    effective : ndarray, shape (n_flex, 6)
-        L_k,a^2 per mode and direction [kg] x 3, [kg m^2] x 3.
-    residual : ndarray, shape (6,)
-        diag(M_hh - M_hf M_ff^-1 M_fh), what no mode carries [kg] x 3, [kg m^2] x 3.
-    """
-    M0 = plant.mass_matrix()
-    K = plant.stiffness_matrix()
-    M_ff, M_fh, K_ff = M0[6:, 6:], M0[6:, :6], K[6:, 6:]
-    omega2, phi = eigh(K_ff, M_ff)
-    L = phi.T @ M_fh
-    residual = M0[:6, :6] - M_fh.T @ np.linalg.solve(M_ff, M_fh)
-    return np.sqrt(np.clip(omega2, 0.0, None)) / (2 * np.pi), L**2, np.diag(residual).copy()
-
-
 def pd_gains(plant: Plant, pd: PDConfig | None = None) -> np.ndarray:
     """Static gain K, shape (3, 6), of the PD law about rest: tau = -K [theta; omega].
 
@@ -175,8 +146,11 @@ def law_gains(plant: Plant, law: LawConfig | None = None) -> np.ndarray:
     law = law or PDConfig()
     K = law.linear_feedback(rigid_inertia(plant))
     if K is None:
-        linear = [name for name in law_names()  # the laws that say how they linearize
-                  if get_law(name).config.linear_feedback is not LawConfig.linear_feedback]
+        linear = [
+            name
+            for name in law_names()  # the laws that say how they linearize
+            if get_law(name).config.linear_feedback is not LawConfig.linear_feedback
+        ]
         raise ConfigError(
             f"controller.kind: the {law.kind!r} law has no linear form about rest "
             f"(laws with one: {', '.join(linear)})"

@@ -1,5 +1,6 @@
 """Figures of flexsat: satellite geometry for drawing, modal-analysis plots and animations."""
 
+from flexsat.plots import results as _results  # noqa: F401  (registers Result.plot's figures)
 from flexsat.plots.animation import (
     DEFAULT_FPS,
     DEFAULT_MAX_FRAMES,

@@ -21,6 +21,7 @@ from matplotlib.figure import Figure
 
 from flexsat.errors import FlexsatError
 from flexsat.plots import openloop, slew, style
+from flexsat.simulate.result import ResultFigures, register_result_figures
 
 __all__ = ["figure_names", "plot_result", "result_kind", "write_result_figures"]
 
@@ -94,6 +95,9 @@ def plot_result(ds: xr.Dataset, kind: str = "attitude", analysis=None) -> Figure
     if analysis is None and kind in _NEEDS_MODES:
         analysis = _modal_analysis(ds)
     return openloop.OPENLOOP_MAKERS[kind](ds, analysis)
+
+
+register_result_figures(ResultFigures(names=figure_names, plot=plot_result))
 
 
 def write_result_figures(

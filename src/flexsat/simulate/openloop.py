@@ -13,6 +13,7 @@ import xarray as xr
 from numba import njit
 
 from flexsat.dynamics.attitude import SWITCH_PITCH, identity_frame, rebase
+from flexsat.dynamics.initial import initial_state
 from flexsat.dynamics.integrators import (
     STATUS_NOT_FINITE,
     applied_torque,
@@ -20,10 +21,8 @@ from flexsat.dynamics.integrators import (
     rk4_open_loop,
 )
 from flexsat.dynamics.kernels import STATUS_OK, hub_cs
-from flexsat.dynamics.linalg3 import euler_rate_matrix_inv
 from flexsat.dynamics.plant import Plant
 from flexsat.dynamics.status import STATUS_STEP_BUDGET, STATUS_STEP_TOO_SMALL
-from flexsat.errors import ConfigError
 from flexsat.simulate.common import (
     PROGRESS_MIN_STEPS,
     check_run_size,
@@ -48,57 +47,6 @@ DOP853_MIN_STEP_FRACTION = 1e-2
 """An accepted DOP853 step below this fraction of ``dt_s`` stops the run as diverging."""
 DOP853_STEP_BUDGET = 4
 """DOP853 may take at most this many times the run's fixed-step count (duration / dt_s)."""
-
-
-def initial_state(plant: Plant, scenario: OpenLoopScenario) -> tuple[np.ndarray, np.ndarray]:
-    """q(0) and q_dot(0) from the scenario's initial state (degrees converted to radians).
-
-    Parameters
-    ----------
-    plant : Plant
-        The satellite.
-    scenario : OpenLoopScenario or SlewScenario
-        Its ``initial`` table.
-
-    Returns
-    -------
-    q : ndarray, shape (n_dof,)
-        Generalized coordinates [m, rad].
-    q_dot : ndarray, shape (n_dof,)
-        Their rates [m/s, rad/s].
-
-    Raises
-    ------
-    ConfigError
-        If an initial state names an appendage the satellite does not have.
-    """
-    init = scenario.initial
-    q = plant.zeros()
-    qd = plant.zeros()
-    q[3:6] = np.radians(init.attitude_deg)
-    omega_B = np.radians(init.rate_deg_s)
-    qd[3:6] = np.array(euler_rate_matrix_inv(q[3], q[4])) @ omega_B  # Theta_dot = S^-1 omega
-    configs = {a.name: (a, m) for a, m in zip(plant.config.appendages, plant.models, strict=True)}
-    for (config, model), block in zip(configs.values(), plant.layout.blocks, strict=True):
-        q[block.slice], qd[block.slice] = model.default_state(config)
-    for entry in init.appendages:
-        try:
-            block = plant.layout.block(entry.name)
-        except KeyError as exc:
-            raise ConfigError(f"initial.appendages: {exc.args[0]}") from None
-        config, model = configs[entry.name]
-        try:
-            q[block.slice], qd[block.slice] = model.initial_state(config, entry)
-        except ValueError as exc:
-            raise ConfigError(str(exc)) from None
-    names = plant.dof_names()
-    for index in plant.locked_coordinates():  # held at q(0): they cannot move
-        if qd[index] != 0.0:
-            raise ConfigError(
-                f"initial.appendages: {names[index]} is locked (locked_dofs): its initial "
-                "rate must be 0"
-            )
-    return q, qd
 
 
 def _profile(scenario: OpenLoopScenario):

@@ -16,6 +16,7 @@ a result needs neither matplotlib nor the analysis modules.
 
 from __future__ import annotations
 
+import importlib
 import shutil
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -31,9 +32,65 @@ from flexsat.dynamics.plant import Plant
 from flexsat.dynamics.records import derive_records
 from flexsat.errors import SimulationError
 
-__all__ = ["Result", "build_dataset"]
+__all__ = ["FIGURE_PROVIDER", "Result", "ResultFigures", "build_dataset", "register_result_figures",
+           "result_figures"]  # fmt: skip
 
 AXES = ("x", "y", "z")
+
+FIGURE_PROVIDER = "flexsat.plots"
+"""The package that draws a result's figures unless one has registered: imported by name
+when :meth:`Result.plot` is first called (it registers itself on import)."""
+
+
+@dataclass(frozen=True)
+class ResultFigures:
+    """What draws a run's figures: the registry entry :meth:`Result.plot` looks up.
+
+    Parameters
+    ----------
+    names : callable
+        ``names(dataset) -> tuple of str``: the figures a run can draw, in the order
+        they are written.
+    plot : callable
+        ``plot(dataset, kind, analysis) -> matplotlib.figure.Figure``: one figure by
+        name (``analysis``: a :class:`~flexsat.analysis.modal.ModalAnalysis` or None).
+    """
+
+    names: Callable[[xr.Dataset], tuple[str, ...]]
+    plot: Callable
+
+
+_FIGURES: list[ResultFigures] = []
+
+
+def register_result_figures(figures: ResultFigures) -> None:
+    """Make :meth:`Result.plot` and :meth:`Result.figure_kinds` draw with ``figures``.
+
+    :mod:`flexsat.plots` registers its figure sets when it is imported; a later
+    registration replaces it (a package of one's own figures).
+
+    Parameters
+    ----------
+    figures : ResultFigures
+        The figure names and the drawing function.
+    """
+    _FIGURES[:] = [figures]
+
+
+def result_figures() -> ResultFigures:
+    """The registered figures, the figure package (:data:`FIGURE_PROVIDER`) imported by
+    name first if none has registered: a plug-in lookup, so that the simulation layer
+    names nothing of the figures layer above it and reading a result needs no
+    matplotlib.
+
+    Returns
+    -------
+    ResultFigures
+        What :meth:`Result.plot` draws with.
+    """
+    if not _FIGURES:
+        importlib.import_module(FIGURE_PROVIDER)
+    return _FIGURES[0]
 
 
 @dataclass(frozen=True)
@@ -73,9 +130,7 @@ class Result:
 
     def figure_kinds(self) -> tuple[str, ...]:
         """The figures :meth:`plot` can draw for this run, in the order they are written."""
-        from flexsat.plots.results import figure_names
-
-        return figure_names(self.dataset)
+        return result_figures().names(self.dataset)
 
     def plot(self, kind: str = "attitude", *, analysis=None):
         """Draw one of the run's figures.
@@ -105,9 +160,7 @@ class Result:
         FlexsatError
             If ``kind`` is not a figure of this run (the message lists them).
         """
-        from flexsat.plots.results import plot_result
-
-        return plot_result(self.dataset, kind, analysis)
+        return result_figures().plot(self.dataset, kind, analysis)
 
     def to_pandas(self):
         """The records as one tidy table: a row per time, variable and component.
@@ -450,4 +503,3 @@ def _shown(value) -> str:
 def _stack(per_appendage: list[tuple[np.ndarray, np.ndarray]], k: int, m: int) -> np.ndarray:
     """Part k of each appendage's (eta, rho) pair as one (m, n, 3) array."""
     return np.stack([pair[k] for pair in per_appendage], axis=1).reshape(m, -1, 3)
-

@@ -59,6 +59,7 @@ from flexsat.control.stages.registry import (
     JointActuatorConfig,
     StageSpec,
 )
+from flexsat.dynamics.initial import initial_state
 
 __all__ = ["SADM_DRIVE", "SADMDriveConfig", "commanded_angle", "design_coefficients"]
 
@@ -113,8 +114,6 @@ class SADMDriveConfig(JointActuatorConfig):
         coordinate beta_0 [rad] (the run's initial state) and the target [rad], then the
         measured-design flag and, if set, each coordinate's P1..P4 [kg m^2]
         (:func:`design_coefficients`)."""
-        from flexsat.simulate.openloop import initial_state
-
         idx = plant.layout.appendage_indices(self.coordinates, "joint_actuator.coordinates")
         q0 = initial_state(plant, scenario)[0]
         start = [float(q0[j]) for j in idx]
@@ -172,8 +171,10 @@ def design_coefficients(plant, indices: list[int], q0: np.ndarray) -> np.ndarray
             try:
                 samples[k] = rigid_inertia(plant, q).ravel()
             except ValueError as exc:
-                raise ConfigError(f"joint_actuator.design_model: 'measured' cannot freeze "
-                                  f"{plant.layout.dof_names()[j]!r} at an angle: {exc}") from None
+                raise ConfigError(
+                    f"joint_actuator.design_model: 'measured' cannot freeze "
+                    f"{plant.layout.dof_names()[j]!r} at an angle: {exc}"
+                ) from None
         out[i] = np.linalg.solve(basis, samples)[1:].reshape(_HARMONICS, 3, 3)
     return out
 
@@ -187,12 +188,16 @@ def _check_measurable(plant, indices: list[int]) -> None:
     for j in indices:
         block = next(b for b in plant.layout.blocks if b.slice.start <= j < b.slice.stop)
         if block.units[j - block.offset] != "rad":
-            raise ConfigError(f"joint_actuator.design_model: 'measured' follows rotation "
-                              f"angles only, {names[j]!r} is in {block.units[j - block.offset]}")
+            raise ConfigError(
+                f"joint_actuator.design_model: 'measured' follows rotation "
+                f"angles only, {names[j]!r} is in {block.units[j - block.offset]}"
+            )
         owners.append(block.appendage)
     if len(set(owners)) != len(owners):
-        raise ConfigError("joint_actuator.design_model: 'measured' follows one driven "
-                          f"coordinate per appendage (got {[names[j] for j in indices]})")
+        raise ConfigError(
+            "joint_actuator.design_model: 'measured' follows one driven "
+            f"coordinate per appendage (got {[names[j] for j in indices]})"
+        )
 
 
 @njit(cache=True)

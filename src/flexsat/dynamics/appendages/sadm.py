@@ -29,6 +29,9 @@ builds it through :func:`expand_drives`. docs/model.md, 'Driven mount coordinate
 
 from __future__ import annotations
 
+from collections.abc import Callable
+from typing import Any
+
 import numpy as np
 from pydantic import ValidationError
 
@@ -133,7 +136,8 @@ def with_sadm(config: SatelliteConfig, rotor_inertia_kg_m2: float, rotor_mass_kg
     return config.model_copy(update={"appendages": appendages})
 
 
-def expand_drives(config: SatelliteConfig) -> SatelliteConfig:
+def expand_drives(config: SatelliteConfig,
+                  build: Callable[[SatelliteConfig], Any]) -> SatelliteConfig:  # fmt: skip
     """``config`` with each plate on a drive (its ``drive`` key) written as its chain.
 
     The joints take the stiffness and damping the plant tunes the undriven plates to
@@ -144,6 +148,10 @@ def expand_drives(config: SatelliteConfig) -> SatelliteConfig:
     ----------
     config : SatelliteConfig
         The satellite.
+    build : callable
+        The plant of a satellite with no drive, tuned
+        (:meth:`flexsat.dynamics.plant.Plant.from_config`, which calls this function:
+        the plant is passed in so that this module needs no import of it).
 
     Returns
     -------
@@ -156,15 +164,13 @@ def expand_drives(config: SatelliteConfig) -> SatelliteConfig:
     ConfigError
         Naming the plate's ``drive`` when its chain is refused.
     """
-    from flexsat.dynamics.plant import Plant
-
     driven = [isinstance(app, AppendageConfig) and app.drive is not None
               for app in config.appendages]  # fmt: skip
     if not any(driven):
         return config
     fixed = [app.model_copy(update={"drive": None}) if d else app
              for app, d in zip(config.appendages, driven, strict=True)]  # fmt: skip
-    plant = Plant.from_config(config.model_copy(update={"appendages": fixed}))
+    plant = build(config.model_copy(update={"appendages": fixed}))
     appendages = list(config.appendages)
     for k, (app, model, params) in enumerate(zip(config.appendages, plant.models, plant.params,
                                                  strict=True)):  # fmt: skip

@@ -4,15 +4,16 @@ from __future__ import annotations
 
 import textwrap
 from collections.abc import Sequence
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import sympy as sp
 
 from flexsat.dynamics.symbolic.rotations import euler_rate_matrix, rotation
 from flexsat.dynamics.symbolic.symbols import _AXES
 
-if TYPE_CHECKING:
-    from flexsat.dynamics.symbolic.derivation import SymbolicModel
+# A derived model (:class:`flexsat.dynamics.symbolic.derivation.SymbolicModel`), read
+# by its attributes: derivation calls this module, so this module does not import it.
+SymbolicModel = Any
 
 _PRETTY_COLUMNS = 100
 
