@@ -309,7 +309,7 @@ def _wheel_slew(torque_ratio: float, applied_nm: float, saturated: bool = False)
 
 def test_r3_of_a_wheel_cluster_is_judged_on_what_each_wheel_is_asked():
     # 3.1 N m on the hub (the T_max = 2 N m rule's failure, measured on a wheel
-    # cluster biased at 3000 rpm: tests/control/test_wheels.py) with each motor asked
+    # cluster biased at 3000 rpm: tests/control/stages/test_wheels.py) with each motor asked
     # 99 % of its limit and no wheel at its momentum limit: R3 holds.
     metrics = slew_metrics(_wheel_slew(0.99, 3.1))
     assert metrics["r3_pass"] and metrics["max_abs_torque_nm"][0] == 3.1

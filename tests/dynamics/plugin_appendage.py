@@ -8,7 +8,7 @@ from typing import Literal
 from pydantic import Field
 
 from flexsat.dynamics.appendages import register_appendage_model
-from tests.dynamics.test_appendage_models import PointMass, PointMassConfig
+from tests.dynamics.appendages.test_contract import PointMass, PointMassConfig
 
 
 class PluginMassConfig(PointMassConfig):

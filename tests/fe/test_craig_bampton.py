@@ -4,7 +4,7 @@ Two formulations of one uniform beam: the FE beam (Hermite cubics) reduced by
 Craig–Bampton to k clamped modes and coupled to a hub by the modal appendage, and the
 Euler–Bernoulli analytic solution of a hub carrying two cantilevers (a transcendental
 frequency equation solved to 1e-13). The chain of rigid segments is held against the
-same theory in ``tests/dynamics/test_chain_beam.py``.
+same theory in ``tests/dynamics/appendages/test_chain_beam.py``.
 """
 
 from __future__ import annotations

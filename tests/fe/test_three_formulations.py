@@ -76,7 +76,7 @@ def test_chain_and_craig_bampton_responses_agree(analytic):
     # ~3 periods). tau_flex, each model's whole interface load, is not asserted here: it
     # carries the higher modes, where a 32-segment chain and 16 clamped modes differ
     # most (measured 3.3e-2 of its peak); the exact round trip compares it
-    # (tests/dynamics/test_modal_appendage.py).
+    # (tests/dynamics/appendages/test_modal.py).
     scenario = OpenLoopScenario.model_validate({
         "duration_s": 10.0, "dt_s": 4e-4, "record_dt_s": 0.01,
         "torque": [{"start_s": 0.0, "end_s": 1.0, "torque_nm": [0.0, 0.0, 1e-3]}],

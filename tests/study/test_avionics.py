@@ -36,7 +36,7 @@ def test_the_realistic_chain_settles_beside_the_ideal_loop(study):
     # noise (5-30 arcsec star tracker, MEKF) and the 10 ms wheel motors only delay
     # settling by a fraction of a second (measured 0.4 s; bound 2 s).
     # R3: the ideal loop holds it; the wheels are asked 123 % of a motor's limit by
-    # the pseudo-inverse of the law's clipped command (tests/control/test_wheels.py).
+    # the pseudo-inverse of the law's clipped command (tests/control/stages/test_wheels.py).
     _, _, data = study
     ideal, avionics = data["side_by_side"]["ideal"], data["side_by_side"]["avionics"]
     assert ideal["r3_pass"] and not avionics["r3_pass"]

@@ -18,7 +18,7 @@ from flexsat.simulate import initial_state
 from flexsat.simulate.scenario import OpenLoopScenario
 from tests.test_docs import REFERENCE, _resolve
 
-DOCS = Path(__file__).resolve().parents[2] / "docs"
+DOCS = Path(__file__).resolve().parents[3] / "docs"
 
 
 @pytest.fixture(scope="module")
@@ -113,7 +113,7 @@ def test_the_thesis_dispersions_change_a_chain_as_they_change_the_plate():
     # the one-segment chain on a 6-DOF joint tuned to the plate's targets, through the
     # chain's derived paths (joint damping ratio, per-DOF target frequencies of each
     # kind, the mount turned about the span, the mass). Before the change the two are
-    # the same satellite to round-off (tests/dynamics/test_chain_plate.py); so must they
+    # the same satellite to round-off (tests/dynamics/appendages/test_chain_plate.py); so must they
     # be after it: tuned stiffness and damping to 1e-14 (eqs. 2.14-2.15 from the same
     # M(0) entries), M(q) and q_ddot at random states to 1e-13 (about 500 ulp, the bound
     # of test_chain_plate.py for two orders of the same sums; measured 1.3e-15). The

@@ -21,7 +21,7 @@ from flexsat.config import validate_config
 from flexsat.dynamics.plant import Plant
 from flexsat.simulate import OpenLoopScenario, run_openloop
 
-DATA = Path(__file__).resolve().parents[1] / "data"
+DATA = Path(__file__).resolve().parents[2] / "data"
 
 # Both are fixed-step RK4 at the same dt on the same equations of motion, but on
 # different attitude coordinates (Basilisk MRPs or MuJoCo's quaternion, flexsat ZYX

@@ -209,7 +209,7 @@ def _smooth_sign(z):
     of ``math.tanh`` there); above, with e = exp(-2 abs(z)),
     tanh(z) = sign(z) (1 - e) / (1 + e): one exponential;
     from abs(z) = 22 both are exactly +-1. Within 2 ulp of ``math.tanh`` everywhere
-    (``tests/control/test_wheels.py``); zero keeps its sign, NaN stays NaN.
+    (``tests/control/stages/test_wheels.py``); zero keeps its sign, NaN stays NaN.
     """
     a = abs(z)
     if a < 0.55:
