@@ -30,10 +30,10 @@ from flexsat.campaigns.definition import (
     ResolvedCase,
     campaign_fingerprint,
 )
-from flexsat.campaigns.pool import LocalPool
 from flexsat.campaigns.store import HISTORY_UNITS, CampaignStore
 from flexsat.config.models import SatelliteConfig
 from flexsat.errors import ConfigError, FlexsatError, shorten
+from flexsat.pool import LocalPool
 
 __all__ = [
     "HISTORY_DT_S",
@@ -467,7 +467,7 @@ def run_campaign(
                            MofNCompleteColumn(), TextColumn("failed {task.fields[failed]}"),
                            TimeRemainingColumn())  # fmt: skip
                 # Drawn from this thread (no refresh thread), so the local pool can fork
-                # its workers (flexsat.campaigns.pool); at most every 0.1 s, as rich would.
+                # its workers (flexsat.pool); at most every 0.1 s, as rich would.
                 with Progress(*columns, disable=not progress, transient=True,
                               auto_refresh=False) as bar:  # fmt: skip
                     task = bar.add_task("cases", total=len(cases), completed=0, failed=0)

@@ -11,7 +11,7 @@ from pathlib import Path
 
 import pytest
 
-from flexsat.campaigns.pool import DEPTH, LocalPool, safe_start_method
+from flexsat.pool import DEPTH, LocalPool, safe_start_method
 
 # Both ways a worker starts: fork (the default on Linux from a one-thread process) and
 # spawn (elsewhere, and from this test runner's worker, which runs threads).
@@ -81,7 +81,7 @@ def test_an_item_that_always_kills_its_worker_is_handed_to_on_lost(tmp_path, met
 def test_workers_fork_only_from_a_process_with_one_thread():
     # A fresh interpreter runs one thread: on Linux it forks its workers.
     fresh = subprocess.run(
-        [sys.executable, "-c", "from flexsat.campaigns.pool import safe_start_method as m; "
+        [sys.executable, "-c", "from flexsat.pool import safe_start_method as m; "
                                "print(m())"],
         capture_output=True, text=True, check=True,
     )  # fmt: skip

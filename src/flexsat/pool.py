@@ -38,7 +38,7 @@ from collections import deque
 from collections.abc import Callable, Iterable, Iterator
 from multiprocessing.connection import wait
 
-from flexsat.parallel import frozen_heap, signals_deferred, start_child
+from flexsat.processes import frozen_heap, signals_deferred, start_child
 
 __all__ = ["DEPTH", "LocalPool", "safe_start_method"]
 
