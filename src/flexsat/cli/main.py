@@ -843,6 +843,80 @@ def equations(
     typer.echo(model.equations_text(fmt))
 
 
+@app.command()
+def budget(
+    source: Annotated[
+        Path,
+        typer.Argument(
+            metavar="RESULT_OR_CAMPAIGN",
+            help="A slew's result.nc (flexsat slew --out) or a campaign store folder.",
+        ),
+    ],
+    requirements: Annotated[
+        Path, typer.Option("--requirements", help="TOML file with a [pointing] table.")
+    ],
+    json_output: JsonOption = False,
+    out: Annotated[
+        Path | None, typer.Option(help="Write budget.json and budget.csv to this folder.")
+    ] = None,
+) -> None:
+    """Pointing budget (ECSS-E-ST-60-10C): indices measured, contributors summed, verdicts.
+
+    The [pointing] table gives each index's bound, window and confidence, the
+    statistical interpretation and the contributors (docs/pointing.md).
+    """
+    from flexsat.analysis.budget import evaluate, load_requirements, load_runs, to_csv
+
+    chosen = load_requirements(requirements)
+    kind, datasets = load_runs(source)
+    report = {"source": str(source), "kind": kind, **evaluate(datasets, chosen)}
+    if out is not None:
+        from flexsat.files import write_text
+        from flexsat.study.outputs import prepare_output_dir, write_json
+
+        folder = prepare_output_dir(out)
+        write_json(folder / "budget.json", report)
+        rows = [{"table": "measured", **r} for r in report["measured"]]
+        rows += [{"table": "budget", **r} for r in report["budget"]]
+        write_text(folder / "budget.csv", to_csv(rows))
+    if json_output:
+        typer.echo(dumps(report))
+        return
+    _print_budget(report)
+    if out is not None:
+        _console.print(f"wrote {out / 'budget.json'} and {out / 'budget.csv'}")
+
+
+def _print_budget(report: dict) -> None:
+    """The measured indices and the budget as two tables, and the overall verdict."""
+    verdict = {True: "pass", False: "FAIL"}
+    if report["measured"]:
+        print_table(
+            _console,
+            f"Measured on {report['runs']} run(s) from {report['start_s']:g} s, "
+            f"{report['interpretation']} interpretation [deg] (interval: "
+            f"{report['interval']:g} confidence)",
+            ["index", "axis", "P", "value", "low", "high", "bound", "verdict"],
+            [[r["index"], r["axis"], r["confidence"], r["value_deg"], r["ci_low_deg"],
+              r["ci_high_deg"], r["bound_deg"], verdict[r["pass"]]]
+             for r in report["measured"]],
+        )  # fmt: skip
+    if report["budget"]:
+        levels = sorted({r["confidence"] for r in report["budget"]})
+        shared = f" at P = {levels[0]:g}" if len(levels) == 1 else ""
+        columns = ["mean", "sigma", "stat", "worst", "bound", "verdict"]
+        print_table(
+            _console,
+            f"Budget{shared} [deg]: statistical (stat) and worst-case (worst) sums, verdict "
+            f"on the {report['summation'].replace('_', '-')} one",
+            ["index", "axis", *([] if shared else ["P"]), *columns],
+            [[r["index"], r["axis"], *([] if shared else [r["confidence"]]), r["mean_deg"],
+              r["sigma_deg"], r["statistical_deg"], r["worst_case_deg"], r["bound_deg"],
+              verdict[r["pass"]]] for r in report["budget"]],
+        )  # fmt: skip
+    _console.print(f"pointing requirements: {verdict[report['pass']]}")
+
+
 def main() -> None:
     """Entry point: run the app, turning flexsat errors into a message and exit code 2.
 
