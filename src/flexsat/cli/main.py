@@ -60,6 +60,11 @@ ConfigOption = Annotated[
 JsonOption = Annotated[
     bool, typer.Option("--json", help="Print one JSON object (SI units) instead of tables.")
 ]
+DurationOption = Annotated[float | None, typer.Option(help="Override the duration [s].")]
+RunOutOption = Annotated[
+    Path | None,
+    typer.Option(help="Write result.nc, metrics.json and the figures to this folder."),
+]
 
 
 class CampaignRunner(StrEnum):
@@ -264,14 +269,11 @@ def openloop(
         Path | None,
         typer.Option(help="Open-loop scenario (TOML). Default: the thesis's 1 N m yaw pulse."),
     ] = None,
-    duration: Annotated[float | None, typer.Option(help="Override the duration [s].")] = None,
+    duration: DurationOption = None,
     dt: Annotated[float | None, typer.Option(help="Override the RK4 step [s].")] = None,
     solver: Annotated[str | None, typer.Option(help="Override the solver: rk4 or dop853.")] = None,
     json_output: JsonOption = False,
-    out: Annotated[
-        Path | None,
-        typer.Option(help="Write result.nc, metrics.json and the figures to this folder."),
-    ] = None,
+    out: RunOutOption = None,
 ) -> None:
     """Open-loop run: apply a torque profile to the flexible satellite and watch it respond.
 
@@ -327,12 +329,9 @@ def slew(
     target_euler_deg: Annotated[
         str | None, typer.Option(help="Override the target as 'roll,pitch,yaw' [deg].")
     ] = None,
-    duration: Annotated[float | None, typer.Option(help="Override the duration [s].")] = None,
+    duration: DurationOption = None,
     json_output: JsonOption = False,
-    out: Annotated[
-        Path | None,
-        typer.Option(help="Write result.nc, metrics.json and the figures to this folder."),
-    ] = None,
+    out: RunOutOption = None,
 ) -> None:
     """Closed-loop slew: a control law flies the flexible satellite; R1-R3 checked.
 
