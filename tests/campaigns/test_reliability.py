@@ -119,7 +119,7 @@ def test_a_lock_named_for_a_process_that_is_gone_is_waited_for(tmp_path):
     started = time.monotonic()
     with CampaignStore(tmp_path).opened(fingerprint, "x", False):
         waited = time.monotonic() - started
-    assert 0.25 < waited < 2.0  # it waited for the release, no longer
+    assert 0.25 < waited < 2.0  # it waited for the release and returned on it
 
 
 def test_store_files_share_one_mode(small_store):

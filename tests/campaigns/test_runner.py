@@ -68,7 +68,7 @@ def _row(case_id: str, r1: bool, r2: bool, ape: float, rate: float, torque: list
 
 def test_the_worst_cases_are_listed_per_requirement(tmp_path):
     # 100 stored cases, 10 of which fail R2 alone with the smallest pointing errors:
-    # ranked by pointing error only (as before), none of them was named. R2's list
+    # a ranking by pointing error alone would name none of them. R2's list
     # holds its 5 failing cases of the largest residual rate; R3's ranks by the
     # largest axis of the commanded torque; a case that failed to run is in every
     # verdict's failing count.

@@ -156,7 +156,7 @@ assert TIMING  # the columns _table drops: wall times, which differ between runs
 
 def test_a_local_dask_cluster_runs_without_the_dashboard_feeds():
     # The settings reach the worker processes of the LocalCluster (their profiler
-    # sampling every thread every 10 ms was most of an idle cluster's CPU).
+    # sampling every thread every 10 ms would be most of an idle cluster's CPU).
     import dask
 
     from flexsat.campaigns.runner import QUIET_DASK, _dask_client

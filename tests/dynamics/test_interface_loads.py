@@ -129,7 +129,7 @@ def test_joint_wrench_is_the_appendages_inertia_forces(slew):
 
 
 def test_the_mode_displacement_load_misses_the_residual_mass():
-    # The modal appendage's former tau_flex, its modes' elastic and damping load at the
+    # The modes' elastic and damping load at the modal appendage's interface,
     # interface, sum_k l_k (omega_k^2 eta_k + 2 zeta_k omega_k eta_dot_k) moved to the
     # hub centre of mass, leaves out the inertia of the residual mass (M_rr - L^T L)
     # and of the interface's rigid motion: on the slew it misses a good part of the

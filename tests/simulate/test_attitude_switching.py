@@ -59,9 +59,9 @@ def test_the_tumble_passes_the_pole(through_the_pole, away_from_the_pole):
 
 @pytest.mark.parametrize("solver", ["rk4", "dop853"])
 def test_the_energy_balance_stays_at_round_off(nominal_plant, through_the_pole, solver):
-    # Without switching this run's balance error rose to 1.6e-10 J (RK4) and 3.0e-12 J
-    # (DOP853) as the steps crossed 1/cos(pitch) ~ 1e4; measured now 3.3e-14 and
-    # 3.7e-15 J over 120 s (the 0.3 J of energy to a few ulp per step, summed).
+    # Switching keeps the balance error at 3.3e-14 J (RK4) and 3.7e-15 J (DOP853) over
+    # 120 s (measured: the 0.3 J of energy to a few ulp per step, summed); without it
+    # this run reaches 1.6e-10 J and 3.0e-12 J as the steps cross 1/cos(pitch) ~ 1e4.
     # 1e-12 J: 30 times the RK4 figure, 160 times below the unswitched one.
     ds = through_the_pole if solver == "rk4" else _tumble(nominal_plant, solver)
     assert ds.attrs["status"] == "ok"

@@ -92,9 +92,9 @@ def _check(plant: Plant, scenario: SlewScenario) -> None:
 def test_a_driven_array_s_motor_torque_reacts_in_the_records():
     # The thesis plates on drives (0.1 kg m^2 rotors) turned 1 deg at 0.5 deg/s during
     # the 45/45/45 ASMC slew; the PD drive loop of test_sadm_drive, motor torques up
-    # to 0.085 N m. Before the records took the drive's Q, tau_flex missed the motor's
-    # reaction and omega_dot the motor's effect: the Euler residual was 9.5e-2 of the
-    # peak and omega_dot off by 6.7e-2 (measured after: 8.7e-15 and 3.4e-16).
+    # to 0.085 N m. The records take the drive's Q, so tau_flex carries the motor's
+    # reaction and omega_dot its effect: Euler residual 8.7e-15 of the peak, omega_dot
+    # 3.4e-16 (measured); records without Q miss by 9.5e-2 and 6.7e-2.
     plant = Plant.from_config(with_sadm(nominal(), 0.1, 2.0))
     drive = {"kind": "sadm_drive", "coordinates": [DRIVE_COORDINATE], "profile": "to_target",
              "target_deg": 1.0, "rate_deg_s": 0.5, "stiffness_nm_rad": 4.0,
@@ -106,9 +106,9 @@ def test_a_driven_array_s_motor_torque_reacts_in_the_records():
 def test_root_dampers_torques_react_in_the_records(locked):
     # Hybrid damping (tests/simulate/test_hybrid_damping.py) on the thesis plates'
     # root rotations, the first deployment-shock case (deformed panels, the dampers at
-    # their 0.1 N m authority). Before the records took its Q, tau_flex missed the
-    # dampers' torques: the Euler residual was 1.4e-2 of the peak and omega_dot off by
-    # 1.4e-2 (measured after: 3.8e-16 and 2.1e-16). With the root translations locked
+    # their 0.1 N m authority). The records take its Q, so tau_flex carries the
+    # dampers' torques: Euler residual 3.8e-16 of the peak, omega_dot 2.1e-16
+    # (measured); records without Q miss by 1.4e-2 both. With the root translations locked
     # tau_flex adds the dampers' torques to the constraint forces.
     case = resolve_cases(load_campaign("deployment-shock"), nominal())[0]
     config = SatelliteConfig.model_validate(case.plant).model_dump(mode="json")

@@ -187,13 +187,14 @@ def test_r3_counts_what_each_wheel_is_asked_not_the_gyroscopic_torque(nominal_pl
     # motors, the thesis's ASMC slewing through them (10 s: its acceleration). The
     # wheels' gyroscopic torque -omega x sum a_i h_i acts on the hub beside the
     # motors: the applied torque reaches 3.1 N m on X (measured), past T_max = 2 N m,
-    # the old R3 rule's failure; yet no motor is asked more than its limit (measured
-    # 98.7 %) and no wheel nears its 6000 rpm (measured 4008 rpm): R3 holds.
+    # which a rule on |tau_applied| would fail; yet no motor is asked more than its
+    # limit (measured 98.7 %) and no wheel nears its 6000 rpm (measured 4008 rpm): R3
+    # holds.
     scenario = SlewScenario.model_validate({"duration_s": 10.0, "actuator": {
         "kind": "wheels", "initial_speed_rpm": 3000.0, "max_torque_nm": 2.5}})  # fmt: skip
     ds = run_slew(nominal_plant, scenario).dataset
     metrics = slew_metrics(ds)
-    assert max(metrics["max_abs_torque_nm"]) > 2.0  # the old rule: |tau_applied| <= T_max
+    assert max(metrics["max_abs_torque_nm"]) > 2.0  # |tau_applied| <= T_max would fail
     assert metrics["actuator_saturation_s"] == {}
     assert ds["actuator_torque_ratio"].values.max() <= 1.0
     assert metrics["r3_pass"]

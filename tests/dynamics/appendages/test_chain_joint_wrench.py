@@ -178,9 +178,9 @@ def test_hub_momentum_rate_is_the_chain_wrench(segments):
 def test_a_drive_torque_and_the_panels_load_react_on_the_hub():
     # The thesis plates on solar-array drives (two-segment chains whose root frees ry
     # alone, k = c = 0): at a deformed, spinning state with a drive torque on each
-    # drive and a hub torque, the wrench on the hub is what moves the hub alone. Before
-    # the reactions were added it was the drive torque's alone. Round-off: 1e-12 of the
-    # largest term (measured 3.3e-15).
+    # drive and a hub torque, the wrench on the hub is what moves the hub alone: the
+    # drive torque's reaction and the panels' load together, not the drive torque
+    # alone. Round-off: 1e-12 of the largest term (measured 3.3e-15).
     plant = Plant.from_config(with_sadm(nominal(), 0.1, 2.0))
     rng = np.random.default_rng(5)
     q = 0.1 * rng.standard_normal(plant.n_dof)

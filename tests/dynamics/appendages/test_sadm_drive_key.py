@@ -1,8 +1,8 @@
 """A plate's ``drive`` key: a TOML satellite puts its plates on a solar-array drive.
 
 The plant builds a plate with ``drive`` as the driven two-segment chain, its joints
-tuned as the undriven plate's: exactly what ``with_sadm`` built before the key
-existed (the chain written from the tuned plant, then the plant of that chain).
+tuned as the undriven plate's: the same plant, bit for bit, as the chain written out
+by hand from the tuned plant (then the plant of that chain).
 """
 
 from __future__ import annotations
@@ -35,8 +35,8 @@ def _driven_toml(tmp_path) -> str:
     return str(path)
 
 
-def _old_with_sadm(config):
-    """``with_sadm`` as it was before the key: the chains written from the tuned plant."""
+def _hand_written_chains(config):
+    """The driven chains written out from the tuned plant, each plate's joints tuned as its own."""
     plant = Plant.from_config(config)
     chains = [driven_plate(app, model.stiffness(row), model.damping(row), **ROTOR)
               for app, model, row in zip(config.appendages, plant.models, plant.params,
@@ -53,35 +53,35 @@ def _same_plant(a: Plant, b: Plant) -> None:
 
 
 @pytest.fixture(scope="module")
-def before() -> Plant:
-    return Plant.from_config(_old_with_sadm(nominal()))
+def hand_written() -> Plant:
+    return Plant.from_config(_hand_written_chains(nominal()))
 
 
-def test_a_toml_drive_builds_the_plant_with_sadm_built(tmp_path, before):
+def test_a_toml_drive_builds_the_plant_with_sadm_built(tmp_path, hand_written):
     config = load_config(_driven_toml(tmp_path))
     assert [app.drive.model_dump() for app in config.appendages] == [ROTOR, ROTOR]
     assert with_sadm(nominal(), **ROTOR) == config  # with_sadm just sets the key
     plant = Plant.from_config(config)
-    _same_plant(plant, before)
+    _same_plant(plant, hand_written)
     assert f"panel_2.{DRIVE_COORDINATE}" in plant.layout.dof_names()
 
 
-def test_a_driven_slew_is_bit_identical_to_the_old_path(tmp_path, before):
+def test_a_driven_slew_is_bit_identical_to_the_hand_written_chains(tmp_path, hand_written):
     # A short slew with the drive turning: every recorded value equal, bit for bit.
     drive = {"kind": "sadm_drive", "coordinates": [DRIVE_COORDINATE], "stiffness_nm_rad": 4.0,
              "damping_nms_rad": 1.0, "rate_deg_s": 0.5}  # fmt: skip
     scenario = SlewScenario.model_validate({"duration_s": 0.2, "joint_actuator": drive})
     new = run_slew(Plant.from_config(load_config(_driven_toml(tmp_path))), scenario,
                    progress=False).dataset  # fmt: skip
-    old = run_slew(before, scenario, progress=False).dataset
+    old = run_slew(hand_written, scenario, progress=False).dataset
     for name in ("q", "qd", "tau_applied", "sadm_torque", "pointing_error_deg"):
         assert np.array_equal(new[name].values, old[name].values), name
 
 
-def test_the_modal_analysis_counts_each_drive_as_a_rigid_mode(before):
+def test_the_modal_analysis_counts_each_drive_as_a_rigid_mode(hand_written):
     # Each drive angle is a mechanism (no stiffness): 6 + 2 modes at exactly 0 Hz,
     # then the flexible modes, the first the symmetric flapping near 0.25 Hz.
-    analysis = modal_analysis(before)
+    analysis = modal_analysis(hand_written)
     assert [m.kind for m in analysis.modes[:8]] == ["rigid"] * 8
     assert np.all(analysis.frequencies_hz[:8] == 0.0)
     assert analysis.modes[8].kind == "flapping"
