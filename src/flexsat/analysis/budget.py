@@ -165,10 +165,13 @@ def load_requirements(path: str | Path) -> PointingRequirements:
     data = read_toml(path, "requirements")
     if not isinstance(data.get("pointing"), dict):
         raise ConfigError(f"{path}: pointing: no [pointing] table")
-    try:
-        return validate_config(data["pointing"], f"{path}: pointing", PointingRequirements)
-    except ConfigError as exc:
-        raise ConfigError(str(exc).replace(": pointing: ", ": pointing.", 1)) from None
+    return validate_config({"pointing": data["pointing"]}, str(path), _RequirementFile).pointing
+
+
+class _RequirementFile(_Frozen):
+    """A requirement file: its ``[pointing]`` table (other tables are not read)."""
+
+    pointing: PointingRequirements
 
 
 def load_runs(path: str | Path) -> tuple[str, list]:
@@ -424,8 +427,11 @@ def measure(datasets: list, requirements: PointingRequirements) -> list[dict]:
                            for run in runs]  # fmt: skip
             except ConfigError as exc:
                 raise ConfigError(f"pointing.indices.{exc}") from None
-            stat = interpret(samples, requirements.interpretation, confidence,
-                             requirements.interval)  # fmt: skip
+            try:
+                stat = interpret(samples, requirements.interpretation, confidence,
+                                 requirements.interval)  # fmt: skip
+            except ConfigError as exc:
+                raise ConfigError(f"pointing.{exc}") from None
             rows.append({"index": index, "axis": axis, "confidence": confidence,
                          "value_deg": stat.value, "ci_low_deg": stat.low,
                          "ci_high_deg": stat.high, "samples": stat.samples,

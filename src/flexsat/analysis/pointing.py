@@ -104,15 +104,15 @@ def _magnitude(values: np.ndarray) -> np.ndarray:
     return np.abs(values) if values.ndim == 1 else np.linalg.norm(values, axis=1)
 
 
-def _records(seconds: float, dt: float, field: str, length_s: float) -> int:
-    """A duration as a whole number of records, refused when longer than the record."""
+def _records(seconds: float, dt: float, field: str, available: int, span_s: float) -> int:
+    """A duration as a whole number of records, refused when the record is too short."""
     if not (np.isfinite(seconds) and seconds > 0.0):
         raise ConfigError(f"{field}: must be a finite duration > 0 s, got {seconds}")
     count = max(1, round(seconds / dt))
-    if count * dt > length_s + 0.5 * dt:
+    if count > available:
         raise ConfigError(
-            f"{field}: {seconds:g} s is longer than the record ({length_s:g} s); "
-            f"choose at most {length_s:g} s"
+            f"{field}: {seconds:g} s is longer than the record: at most {span_s:g} s "
+            f"(records every {dt:g} s)"
         )
     return count
 
@@ -160,10 +160,10 @@ def index_samples(
     kind = _KIND[index]
     if kind == "A":
         return t, _magnitude(error)
-    length_s = float(t[-1] - t[0]) + dt  # each record stands for one period
+    span_s = float(t[-1] - t[0]) + dt  # n records stand for n periods
     if window_s is None:
         raise ConfigError(f"{index}.window_s: {index} needs a window length")
-    n = _records(window_s, dt, f"{index}.window_s", length_s)
+    n = _records(window_s, dt, f"{index}.window_s", t.size, span_s)
     summed = np.cumsum(np.concatenate([np.zeros((1, *error.shape[1:])), error]), axis=0)
     means = (summed[n:] - summed[:-n]) / n  # means[i]: records i .. i + n - 1
     if kind == "M":
@@ -177,7 +177,7 @@ def index_samples(
         what = "stability_s" if kind == "D" else "observation_s"
         raise ConfigError(f"{index}.{what}: {index} needs the time between its two windows")
     field = f"{index}.{'stability_s' if kind == 'D' else 'observation_s'}"
-    s = _records(separation_s, dt, field, length_s - n * dt)
+    s = _records(separation_s, dt, field, t.size - n, span_s - n * dt)  # after the window
     return t[: means.shape[0] - s], _magnitude(means[s:] - means[:-s])
 
 
