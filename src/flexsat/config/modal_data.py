@@ -40,7 +40,8 @@ FORMAT_VERSION = 1
 # any spacecraft structure.
 Real = Annotated[float, Strict(), AllowInfNan(False), Field(ge=-1e12, le=1e12)]
 Length = Annotated[float, Strict(), AllowInfNan(False), Field(ge=-1e3, le=1e3)]  # [m]
-Frequency = Annotated[float, Strict(), AllowInfNan(False), Field(ge=1e-3, le=1e5)]  # [Hz]
+Finite = Annotated[float, Strict(), AllowInfNan(False)]
+_FREQUENCY_RANGE_HZ = (1e-3, 1e5)  # checked with the ordering, by :class:`ModalData`
 Vector3 = tuple[Real, Real, Real]
 Point3 = tuple[Length, Length, Length]
 Vector6 = tuple[Real, Real, Real, Real, Real, Real]
@@ -91,7 +92,7 @@ class ModalData(_Frozen):
     inertia_interface_kg_m2: Matrix3 = Field(
         description="inertia about the interface point, frame M [kg m^2]"
     )
-    frequencies_hz: Annotated[list[Frequency], Field(max_length=_MAX_MODES)] = Field(
+    frequencies_hz: Annotated[list[Finite], Field(max_length=_MAX_MODES)] = Field(
         description="interface-clamped natural frequencies, ascending, each within "
         "[1e-3, 1e5] Hz [Hz]"
     )
@@ -119,6 +120,12 @@ class ModalData(_Frozen):
         f = np.asarray(self.frequencies_hz, dtype=float)
         if n and f.min() <= 0.0:
             raise ValueError(f"frequencies_hz: must be > 0 Hz, got {f.min():.6g}")
+        low, high = _FREQUENCY_RANGE_HZ
+        outside = np.flatnonzero((f < low) | (f > high))
+        if outside.size:
+            k = int(outside[0])
+            raise ValueError(f"frequencies_hz: each must be within [{low:g}, {high:g}] Hz, "
+                             f"mode {k + 1} is {f[k]:.6g} Hz")  # fmt: skip
         if np.any(np.diff(f) < 0.0):
             k = int(np.argmax(np.diff(f) < 0.0))
             raise ValueError(
