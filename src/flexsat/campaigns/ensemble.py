@@ -22,8 +22,8 @@ import time
 from collections.abc import Iterable, Iterator
 from concurrent.futures import ThreadPoolExecutor
 
+from flexsat.campaigns.cases import case_inputs, case_row, fail_row, finish_row
 from flexsat.campaigns.definition import ResolvedCase
-from flexsat.campaigns.runner import case_inputs, case_row, fail_row, finish_row
 
 __all__ = ["BATCH_PER_THREAD", "run_ensemble"]
 

@@ -17,12 +17,20 @@ import os
 import re
 import signal
 import time
-import traceback
 from collections.abc import Iterable, Iterator
 from pathlib import Path
 
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
 
+from flexsat.campaigns.cases import (
+    HISTORY_DT_S,
+    HISTORY_KEY,
+    case_history,
+    case_inputs,
+    case_row,
+    fail_row,
+    finish_row,
+)
 from flexsat.campaigns.definition import (
     CampaignDefinition,
     CaseDigest,
@@ -232,65 +240,6 @@ def _worst(rows: list[dict], name: str, verdict: str | None, metric: str, unit: 
     }  # fmt: skip
 
 
-HISTORY_KEY = "history"
-"""Key of the decimated time history in a :func:`run_case` row (not stored in the table)."""
-
-HISTORY_DT_S = 0.1
-"""Sampling interval of the stored case histories [s]."""
-
-
-def case_history(ds, dt: float = HISTORY_DT_S) -> dict:
-    """Time history of a slew decimated to every ``dt`` seconds, as float arrays.
-
-    Keys are those of :data:`HISTORY_UNITS` and the law's declared diagnostics
-    (``attrs["law_diagnostics"]``: ``lambda_act`` and ``jk`` for the ASMC, the
-    twisting integral for the STSMC...), whose units and descriptions go under
-    ``channels``; per-axis variables are (samples, 3) arrays,
-    ``tip_displacement_max`` the largest tip-displacement magnitude over the
-    appendages [m]. Variables a dataset lacks are left out. A partial (failed) run
-    gives the history up to where it stopped.
-
-    Parameters
-    ----------
-    ds : xarray.Dataset
-        The slew's dataset (:class:`~flexsat.simulate.result.Result`'s).
-    dt : float
-        Sampling interval [s].
-
-    Returns
-    -------
-    dict
-        Arrays by variable name (own copies, C-contiguous float64: cheap to send
-        between processes), plus ``channels``.
-    """
-    import numpy as np
-
-    # ds.variables: the arrays, without building a DataArray per lookup (tens of us)
-    t = np.asarray(ds.variables["time"].values, dtype=float)
-    if t.size == 0:
-        return {"time": t}
-    grid = np.arange(t[0], t[-1] + 0.5 * dt, dt)
-    index = np.unique(np.clip(np.searchsorted(t, grid - 1e-9 * dt), 0, t.size - 1))
-    history = {"time": t[index]}
-    for name in ("pointing_error_deg", "rate_error_deg_s", "tau_cmd", "total_energy"):
-        if name in ds:
-            history[name] = np.asarray(ds.variables[name].values, dtype=float)[index]
-    channels = {}
-    for name in ds.attrs.get("law_diagnostics", ()):
-        if name in ds:
-            history[name] = np.asarray(ds.variables[name].values, dtype=float)[index]
-            attrs = ds.variables[name].attrs
-            channels[name] = {key: attrs.get(key, "") for key in ("units", "description")}
-    if channels:
-        history["channels"] = channels
-    if "tip_displacement" in ds:
-        tips = np.asarray(ds.variables["tip_displacement"].values, dtype=float)[index]
-        magnitude = np.linalg.norm(tips, axis=-1)  # (time, appendage)
-        if magnitude.ndim == 2 and magnitude.shape[1]:
-            history["tip_displacement_max"] = magnitude.max(axis=1)
-    return history
-
-
 def run_case(case: ResolvedCase) -> dict:
     """Run one resolved case; never raises: failures come back as a failed row.
 
@@ -328,48 +277,6 @@ def run_case(case: ResolvedCase) -> dict:
     # the process's CPU: a worker (or this process) runs one case at a time
     row["case_cpu_time_s"] = time.process_time() - cpu
     return row
-
-
-def case_row(case: ResolvedCase) -> dict:
-    """The head of a case's row: its id, inputs and seeds (what it was run from)."""
-    return {
-        "case_id": case.case_id,
-        "inputs_digest": case.digest,
-        "root_seed": case.root_seed,
-        "stream_index": case.stream_index,
-        "parameters": case.parameters,
-        "inputs": {"plant": case.plant, "scenario": case.scenario},  # for replay
-    }
-
-
-def case_inputs(case: ResolvedCase):
-    """The validated ``(Plant, SlewScenario)`` of a resolved case."""
-    from flexsat.config.models import SatelliteConfig
-    from flexsat.dynamics.plant import Plant
-    from flexsat.simulate import SlewScenario
-
-    plant = Plant.from_config(SatelliteConfig.model_validate(case.plant))
-    return plant, SlewScenario.model_validate(case.scenario)
-
-
-def finish_row(row: dict, result) -> None:
-    """Fill a row from its slew's :class:`~flexsat.simulate.result.Result`: history,
-    status and metrics (the stored scenario's requirements, control effort)."""
-    from flexsat.analysis.effort import effort_metrics
-    from flexsat.analysis.requirements import slew_metrics
-
-    row[HISTORY_KEY] = case_history(result.dataset)
-    metrics = slew_metrics(result.dataset)
-    metrics.update(effort_metrics(result.dataset))
-    metrics.pop("wall_time_s")
-    status, message = metrics.pop("status"), metrics.pop("message")
-    row.update(status=status, error=message, metrics=metrics)
-
-
-def fail_row(row: dict, exc: Exception) -> None:
-    """Mark a row failed by ``exc``: its type, message and the function that raised."""
-    last = traceback.extract_tb(exc.__traceback__)[-1]
-    row.update(status="failed", error=f"{type(exc).__name__}: {exc} ({last.name})", metrics={})
 
 
 class CampaignInterrupted(FlexsatError):
@@ -446,7 +353,8 @@ def run_campaign(
 
         return run_worst_case(definition, definition.worst_case, satellite, out,
                               workers=workers, resume=resume, scheduler=scheduler,
-                              dask_local=dask_local, runner=runner)  # fmt: skip
+                              dask_local=dask_local, runner=runner,
+                              backend=_backend)  # fmt: skip
     store = CampaignStore(out)
     if store.root.exists() and not store.root.is_dir():
         raise ConfigError(f"--out {store.root}: exists and is not a folder")

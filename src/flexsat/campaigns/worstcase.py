@@ -14,11 +14,13 @@ from __future__ import annotations
 import json
 import math
 import time
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
 from scipy.optimize import differential_evolution
 
+from flexsat.campaigns.cases import HISTORY_KEY
 from flexsat.campaigns.definition import (
     CampaignDefinition,
     CaseStream,
@@ -26,7 +28,6 @@ from flexsat.campaigns.definition import (
     WorstCaseSearch,
     dispersed_modifiers,
 )
-from flexsat.campaigns.runner import HISTORY_KEY, _backend
 from flexsat.campaigns.store import CampaignStore, _write_atomic
 from flexsat.config.models import SatelliteConfig
 from flexsat.errors import ConfigError
@@ -44,6 +45,8 @@ def run_worst_case(
     scheduler: str | None = None,
     dask_local: int | None = None,
     runner: str = "pool",
+    *,
+    backend: Callable,
 ) -> dict:
     """Search the dispersion box for the case that maximizes ``search.metric``.
 
@@ -67,6 +70,11 @@ def run_worst_case(
         Evaluate them on a Dask LocalCluster of this many workers.
     runner : {"pool", "ensemble"}
         Local runs only, as for :func:`~flexsat.campaigns.runner.run_campaign`.
+    backend : callable
+        ``backend(workers, scheduler, dask_local, runner)``: a context manager that
+        yields ``execute(cases, size) -> rows``, the one the campaign runner flies its
+        cases with (:func:`~flexsat.campaigns.runner.run_campaign` hands it in: it
+        calls this search, which so needs no import of the runner).
 
     Returns
     -------
@@ -87,7 +95,7 @@ def run_worst_case(
     start = time.perf_counter()
     values: dict[str, float] = {}
 
-    with _backend(workers, scheduler, dask_local, runner) as execute, store.opened(
+    with backend(workers, scheduler, dask_local, runner) as execute, store.opened(
             fingerprint, definition.name, resume):  # fmt: skip
         def evaluate(_, population) -> list[float]:
             cases = []
