@@ -404,7 +404,41 @@ CAMPAIGNS = [
     Bad("campaign of an unknown law", ["campaign", "sensitivity", "--controller", "lqr", "--out", "{tmp}/s"], "--controller: unknown control law 'lqr'"),
 ]  # fmt: skip
 
-TABLE = CONFIGS + SCENARIOS + PATHS + SPECIAL_FILES + ROBUSTNESS + CAMPAIGNS
+
+def _budget_result() -> bytes:
+    """A 1 s slew result (11 records at the target attitude), as NetCDF bytes."""
+    import xarray as xr
+
+    t = np.arange(11) * 0.1
+    identity = np.tile([1.0, 0.0, 0.0, 0.0], (t.size, 1))
+    ds = xr.Dataset(
+        {"quaternion": (("time", "component"), identity)},
+        coords={"time": t},
+        attrs={"target_quaternion": [1.0, 0.0, 0.0, 0.0]},
+    )
+    return bytes(ds.to_netcdf())
+
+
+def _budget(id: str, pointing: str, fragment: str) -> Bad:
+    argv = ["budget", "{tmp}/result.nc", "--requirements", "{tmp}/req.toml", "--out", "{tmp}/b"]
+    files = {"result.nc": _budget_result(), "req.toml": f"[pointing]\n{pointing}\n"}
+    return Bad(id, argv, fragment, files)
+
+
+_RPE = "[pointing.indices.RPE]\nbound_deg = 0.01\n"
+BUDGET = [
+    _budget("budget window longer than the run", _RPE + "window_s = 50.0", "pointing.indices.RPE.window_s: 50 s is longer than the record: at most 1.1 s"),
+    _budget("budget drift separation beyond the run", "[pointing.indices.PDE]\nbound_deg = 0.01\nwindow_s = 0.5\nstability_s = 0.8", "pointing.indices.PDE.stability_s: 0.8 s is longer than the record"),
+    _budget("budget confidence 1.5", "confidence = 1.5\n" + _RPE + "window_s = 0.5", "pointing.confidence: Input should be less than 1 (got 1.5)"),
+    _budget("budget confidence 0", "[pointing.indices.APE]\nbound_deg = 0.01\nconfidence = 0.0", "pointing.indices.APE.confidence: Input should be greater than 0"),
+    _budget("budget unknown index", "[pointing.indices.XPE]\nbound_deg = 0.01", "pointing: indices.XPE: unknown index; choose one of APE, MPE, RPE"),
+    _budget("budget RPE without a window", _RPE, "indices.RPE.window_s: RPE needs a window length"),
+    _budget("budget unknown interpretation", 'interpretation = "spatial"', "pointing.interpretation: Input should be 'temporal', 'ensemble' or 'mixed'"),
+    _budget("budget ensemble of one run", 'interpretation = "ensemble"\n[pointing.indices.APE]\nbound_deg = 0.01', "pointing.interpretation: 'ensemble' needs a campaign"),
+    Bad("budget of a missing result", ["budget", "{tmp}/none.nc", "--requirements", "{tmp}/req.toml"], "RESULT_OR_CAMPAIGN {tmp}/none.nc: no such file or folder", {"req.toml": "[pointing]\n"}),
+]  # fmt: skip
+
+TABLE = CONFIGS + SCENARIOS + PATHS + SPECIAL_FILES + ROBUSTNESS + CAMPAIGNS + BUDGET
 
 
 def test_the_table_is_at_least_sixty_rows():
