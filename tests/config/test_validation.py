@@ -178,3 +178,26 @@ def test_huge_hub_radius_is_refused_with_its_range():
     data["hub"]["radius_m"] = 1.34e154
     with pytest.raises(ConfigError, match=r"hub\.radius_m: .*less than or equal to 1000"):
         validate_config(data)
+
+
+@pytest.mark.parametrize(
+    ("mount", "yaw", "span", "refused"),
+    [
+        ([0.0, 0.6, 0.0], 0.0, "+y", False),  # root on the surface (r = 0.6 m), outward
+        ([0.0, 0.6, 0.0], 0.0, "-y", True),  # the same root, spanning back through the hub
+        # Yawed 90 deg at 0.8 m: the 1.5 m chord lies along Y_B, its inner edge at
+        # y = 0.8 - 0.75 = 0.05 m, inside the 0.6 m radius.
+        ([0.0, 0.8, 0.0], 90.0, "+y", True),
+        # The chord's inner edge at y = 1.35 - 0.75 = 0.6 m: on the surface, accepted.
+        ([0.0, 1.35, 0.0], 90.0, "+y", False),
+    ],
+)  # fmt: skip
+def test_a_plate_may_touch_the_hub_but_not_enter_it(mount, yaw, span, refused):
+    # docs/model.md, 'Geometric interference': the nominal hub, radius 0.6 m, height 1.5 m.
+    data = nominal_dict()
+    data["appendages"][0].update(mount_point_m=mount, mount_yaw_deg=yaw, span_direction=span)
+    if refused:
+        with pytest.raises(ConfigError, match=r"appendages\[0\] \(panel_1\) passes through the hub"):
+            validate_config(data)
+    else:
+        validate_config(data)
