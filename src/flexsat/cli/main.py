@@ -114,8 +114,9 @@ def modal(
     from flexsat.dynamics.plant import Plant
     from flexsat.study.outputs import write_modal
 
+    cfg = load_config(config)  # a config's mistakes are told before any notice
     _announce_compilation()
-    plant = Plant.from_config(load_config(config))
+    plant = Plant.from_config(cfg)
     n_modes = len(plant.dof_names())
     bad = [k for k in animate or [] if not 1 <= k <= n_modes]
     if bad:
@@ -176,8 +177,9 @@ def linearize(
     spin = parse_about(about)
     reduction = parse_reduction(reduce)
     groups = None if outputs is None else [g.strip() for g in outputs.split(",")]
+    cfg = load_config(config)  # a config's mistakes are told before any notice
     _announce_compilation()
-    plant = Plant.from_config(load_config(config))
+    plant = Plant.from_config(cfg)
     _, summary = write_linearize(plant, spin, groups, reduction, out, actuated)
     if json_output:
         typer.echo(dumps(summary))
@@ -221,8 +223,9 @@ def margins(
     from flexsat.study.linear import family_margins, write_margins
 
     slew_scenario = None if scenario is None else load_slew(scenario)
+    cfg = load_config(config)  # a config's mistakes are told before any notice
     _announce_compilation()
-    plant = Plant.from_config(load_config(config))
+    plant = Plant.from_config(cfg)
     summary = write_margins(plant, slew_scenario, out)
     if campaign is not None:
         family = family_margins(plant, campaign, slew_scenario, out)
@@ -285,8 +288,9 @@ def openloop(
     from flexsat.simulate import OpenLoopScenario, load_scenario
     from flexsat.study.outputs import fly_openloop
 
+    cfg = load_config(config)  # a config's mistakes are told before any notice
     _announce_compilation()
-    plant = Plant.from_config(load_config(config))
+    plant = Plant.from_config(cfg)
     chosen = load_scenario(scenario)
     given = {"--duration": duration, "--dt": dt, "--solver": solver}
     fields = {"--duration": "duration_s", "--dt": "dt_s", "--solver": "solver"}
@@ -344,8 +348,9 @@ def slew(
     from flexsat.simulate import SlewScenario, load_slew
     from flexsat.simulate.scenario import check_observation_window
 
+    cfg = load_config(config)  # a config's mistakes are told before any notice
     _announce_compilation()
-    plant = Plant.from_config(load_config(config))
+    plant = Plant.from_config(cfg)
     chosen = load_slew(scenario, check_window=duration is None)
     overrides: dict = {}
     if duration is not None:
@@ -663,8 +668,8 @@ def study(
     from flexsat.control.laws import get_law
     from flexsat.study import run_study
 
-    _announce_compilation()
     cfg = load_config(config)
+    _announce_compilation()
     chosen = () if controller == "all" else tuple(c.strip() for c in controller.split(","))
     for name in chosen:
         try:
