@@ -158,7 +158,7 @@ def _cases(ctx) -> dict[str, tuple[int, float]]:
     from flexsat.campaigns import load_campaign
     from flexsat.campaigns.definition import CaseStream
     from flexsat.simulate import SlewScenario
-    from flexsat.study.pipeline import CAMPAIGNS
+    from flexsat.study.thesis import CAMPAIGNS
 
     out = {}
     for name in CAMPAIGNS:

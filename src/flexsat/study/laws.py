@@ -1,7 +1,7 @@
 """The law comparison over the thesis's campaigns: every law, and the ASMC with hybrid
 active damping, flown through the same cases.
 
-For each campaign of :data:`~flexsat.study.pipeline.CAMPAIGNS` and each variant
+For each campaign of :data:`~flexsat.study.thesis.CAMPAIGNS` and each variant
 (the study's laws with their default gains, then :data:`DAMPED` = the ASMC with the
 root actuators of :data:`HYBRID_DAMPING`), the cases' stored metrics are reduced to
 one column of figures (:func:`law_statistics`): R1/R2/R3 pass rates, the
@@ -174,7 +174,7 @@ def law_comparison(
     """
     from flexsat.campaigns import load_campaign
     from flexsat.study.outputs import write_json
-    from flexsat.study.pipeline import CAMPAIGNS
+    from flexsat.study.thesis import CAMPAIGNS
 
     variants = _variants(laws, default_law)
     payload: dict = {"quick": quick, "variants": list(variants), "campaigns": {}}

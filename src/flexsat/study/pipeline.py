@@ -54,11 +54,9 @@ from flexsat.study.outputs import (
     write_json,
     write_modal,
 )
+from flexsat.study.thesis import CAMPAIGNS
 
 __all__ = ["CAMPAIGNS", "LANES", "PARTS", "Part", "StudyContext", "run_study"]
-
-CAMPAIGNS = ("sensitivity", "montecarlo-critical", "deployment-shock")
-"""The thesis's three campaigns (chapter 5), in the order of the report."""
 
 QUICK_ANIMATED_MODES = 2
 """Mode GIFs of the quick study: the lowest flexible modes that drive a hub DOF (the

@@ -12,6 +12,7 @@ from __future__ import annotations
 import numpy as np
 
 __all__ = [
+    "CAMPAIGNS",
     "CLOSED_LOOP",
     "J_TOT_NOMINAL",
     "M0_HUB",
@@ -25,6 +26,10 @@ __all__ = [
     "TRANSLATION_MODES_MIN_HZ",
     "appendix_b_mass_matrix",
 ]
+
+CAMPAIGNS = ("sensitivity", "montecarlo-critical", "deployment-shock")
+"""The thesis's three campaigns (chapter 5), in the order of the report: the names of
+their presets (:func:`flexsat.campaigns.load_campaign`)."""
 
 # Appendix B, eqs. B.2-B.6: M(0) of the nominal case, printed to 2 decimals.
 M0_HUB = np.diag([163.50, 163.50, 163.50, 189.99, 44.16, 177.90])  # eq. B.2
