@@ -489,10 +489,17 @@ def load_slew(path: str | Path | None = None, *, check_window: bool = True) -> S
     ConfigError
         Naming the file, the field and the allowed range.
     """
+    scenario = _read_scenario(path, SlewScenario)
+    if path is None or not check_window:
+        return scenario
+    return check_observation_window(scenario, str(path))
+
+
+def _read_scenario(path: str | Path | None, model: type[_Frozen]) -> _Frozen:
+    """``model`` validated from the TOML file ``path``; its defaults when ``path`` is None."""
     if path is None:
-        return SlewScenario()
-    scenario = validate_config(read_toml(path, "scenario"), source=str(path), model=SlewScenario)
-    return check_observation_window(scenario, str(path)) if check_window else scenario
+        return model()
+    return validate_config(read_toml(path, "scenario"), source=str(path), model=model)
 
 
 def thesis_openloop() -> OpenLoopScenario:
@@ -517,6 +524,4 @@ def load_scenario(path: str | Path | None = None) -> OpenLoopScenario:
     ConfigError
         Naming the file, the field and the allowed range.
     """
-    if path is None:
-        return thesis_openloop()
-    return validate_config(read_toml(path, "scenario"), source=str(path), model=OpenLoopScenario)
+    return _read_scenario(path, OpenLoopScenario)
