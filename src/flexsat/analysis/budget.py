@@ -78,19 +78,29 @@ _DISTRIBUTIONS = {
 
 
 class Contributor(_Frozen):
-    """One error source of the budget, per hub axis, in degrees."""
+    """One error source of the budget, per hub axis, in degrees (docs/pointing.md)."""
 
-    name: str = Field(min_length=1, max_length=64)
-    kind: Literal["bias", "random", "periodic"] = Field(alias="class")
+    name: str = Field(min_length=1, max_length=64, description="what it is, for the tables")
+    kind: Literal["bias", "random", "periodic"] = Field(
+        alias="class", description="the standard's class: bias, random or periodic"
+    )
     distribution: str | None = Field(
-        None, description="gaussian, uniform or fixed (bias); gaussian or uniform (random)"
+        None,
+        description="gaussian, uniform or fixed (bias); gaussian or uniform (random); "
+        "sinusoidal (periodic); default the first",
     )
     knowledge: bool = Field(False, description="an estimation error: feeds AKE ... KRE")
-    mean_deg: Triple = (0.0, 0.0, 0.0)
-    sigma_deg: NonNegativeTriple = (0.0, 0.0, 0.0)
-    bound_deg: NonNegativeTriple = Field((0.0, 0.0, 0.0), description="uniform: half-range")
-    amplitude_deg: NonNegativeTriple = (0.0, 0.0, 0.0)
-    period_s: Duration | None = None
+    mean_deg: Triple = Field((0.0, 0.0, 0.0), description="mean μ per hub axis [deg]")
+    sigma_deg: NonNegativeTriple = Field(
+        (0.0, 0.0, 0.0), description="standard deviation σ per hub axis (gaussian) [deg]"
+    )
+    bound_deg: NonNegativeTriple = Field(
+        (0.0, 0.0, 0.0), description="half-range B per hub axis (uniform: ±B) [deg]"
+    )
+    amplitude_deg: NonNegativeTriple = Field(
+        (0.0, 0.0, 0.0), description="amplitude A per hub axis (periodic) [deg]"
+    )
+    period_s: Duration | None = Field(None, description="period T (periodic) [s]")
 
     @model_validator(mode="after")
     def _consistent(self) -> Contributor:
@@ -110,27 +120,45 @@ class Contributor(_Frozen):
 class IndexRequirement(_Frozen):
     """One index's bound, window and confidence."""
 
-    bound_deg: Positive
-    window_s: Duration | None = None
-    stability_s: Duration | None = Field(None, description="PDE/KDE: Δt_s between windows")
-    observation_s: Duration | None = Field(None, description="PRE/KRE: Δt_o between windows")
-    confidence: Confidence | None = None
-    axes: tuple[Literal["x", "y", "z", "total", "los"], ...] | None = None
+    bound_deg: Positive = Field(description="the bound the index must stay within [deg]")
+    window_s: Duration | None = Field(None, description="Δt, the window length [s]")
+    stability_s: Duration | None = Field(
+        None, description="PDE/KDE: Δt_s, the time between the two windows [s]"
+    )
+    observation_s: Duration | None = Field(
+        None, description="PRE/KRE: Δt_o, the time between two observations' windows [s]"
+    )
+    confidence: Confidence | None = Field(
+        None, description="P of this index, in (0, 1); default the table's [-]"
+    )
+    axes: tuple[Literal["x", "y", "z", "total", "los"], ...] | None = Field(
+        None, description="axes measured; default every one the data hold"
+    )
 
 
 class PointingRequirements(_Frozen):
     """The ``[pointing]`` table of a requirement file (docs/pointing.md)."""
 
-    confidence: Confidence = 0.9973
-    interval: Confidence = Field(0.95, description="confidence of the estimate's interval")
-    interpretation: Literal["temporal", "ensemble", "mixed"] = "temporal"
-    summation: Literal["statistical", "worst_case"] = "statistical"
-    boresight: Triple | None = None
+    confidence: Confidence = Field(0.9973, description="P, the confidence level [-]")
+    interval: Confidence = Field(
+        0.95, description="γ, the confidence of the estimate's interval [-]"
+    )
+    interpretation: Literal["temporal", "ensemble", "mixed"] = Field(
+        "temporal", description="the statistical interpretation"
+    )
+    summation: Literal["statistical", "worst_case"] = Field(
+        "statistical", description="the budget total the verdict uses"
+    )
+    boresight: Triple | None = Field(
+        None, description="a payload boresight, hub frame: adds the line of sight [-]"
+    )
     start_s: Annotated[float, Field(ge=0.0, le=1e7, allow_inf_nan=False, strict=True)] = Field(
         0.0, description="records before it (the slew itself) are left out [s]"
     )
-    indices: dict[str, IndexRequirement] = Field(default_factory=dict)
-    contributors: tuple[Contributor, ...] = ()
+    indices: dict[str, IndexRequirement] = Field(
+        default_factory=dict, description="each index's requirement, by name (APE ...)"
+    )
+    contributors: tuple[Contributor, ...] = Field((), description="the budget's error sources")
 
     @model_validator(mode="after")
     def _known(self) -> PointingRequirements:
@@ -153,6 +181,16 @@ class PointingRequirements(_Frozen):
 
 def load_requirements(path: str | Path) -> PointingRequirements:
     """Read the ``[pointing]`` table of a TOML requirement file.
+
+    Parameters
+    ----------
+    path : str or Path
+        The TOML file.
+
+    Returns
+    -------
+    PointingRequirements
+        The validated table.
 
     Raises
     ------
@@ -182,7 +220,7 @@ def load_runs(path: str | Path) -> tuple[str, list]:
     path : str or Path
         A result written by ``flexsat slew --out`` (``result.nc``), or the folder of
         a campaign store (``flexsat campaign --out``), whose decimated case
-        histories are read (:meth:`flexsat.campaigns.store.CampaignStore.histories`).
+        histories ``histories/<case id>.nc`` are read, by case id.
 
     Returns
     -------
@@ -197,28 +235,27 @@ def load_runs(path: str | Path) -> tuple[str, list]:
         A missing path, a file that is not a slew's result, or a folder that is not
         a campaign store with histories.
     """
+    import xarray as xr
+
     from flexsat.files import check_user_file
 
     path = Path(path)
     if not path.exists():
         raise ConfigError(f"RESULT_OR_CAMPAIGN {path}: no such file or folder")
     if path.is_dir():
-        from flexsat.campaigns.store import CampaignStore
-
         if not (path / "campaign.json").exists():
             raise ConfigError(f"RESULT_OR_CAMPAIGN {path}: not a campaign store (no campaign.json)")
-        try:
-            histories = CampaignStore(path).histories()
-        except (OSError, ValueError) as exc:
-            raise ConfigError(
-                f"RESULT_OR_CAMPAIGN {path}: unreadable case history ({exc})"
-            ) from None
+        histories = []
+        for history in sorted((path / "histories").glob("*.nc")):  # the store's layout
+            try:
+                with xr.open_dataset(history) as ds:
+                    histories.append(ds.load())
+            except (OSError, ValueError) as exc:
+                raise ConfigError(f"RESULT_OR_CAMPAIGN {history}: unreadable ({exc})") from None
         if not histories:
             raise ConfigError(f"RESULT_OR_CAMPAIGN {path}: the campaign stores no case history")
-        return "campaign", list(histories.values())
+        return "campaign", histories
     check_user_file(path, "RESULT_OR_CAMPAIGN", limited=False)
-    import xarray as xr
-
     try:
         with xr.open_dataset(path) as ds:
             dataset = ds.load()
@@ -230,7 +267,18 @@ def load_runs(path: str | Path) -> tuple[str, list]:
 
 
 def gaussian_factor(confidence: float) -> float:
-    """n_P = Φ⁻¹((1 + P)/2): P of a zero-mean Gaussian lies within ±n_P σ [-]."""
+    """n_P = Φ⁻¹((1 + P)/2): P of a zero-mean Gaussian lies within ±n_P σ.
+
+    Parameters
+    ----------
+    confidence : float
+        P, in (0, 1) [-].
+
+    Returns
+    -------
+    float
+        n_P [-].
+    """
     return float(norm.ppf(0.5 * (1.0 + confidence)))
 
 
@@ -322,7 +370,7 @@ def summed(parts: list[dict], confidence: float) -> dict:
     parts : list of dict
         :func:`contribution` outputs.
     confidence : float
-        P in (0, 1).
+        P in (0, 1) [-].
 
     Returns
     -------
@@ -343,6 +391,11 @@ def summed(parts: list[dict], confidence: float) -> dict:
 
 def budget_rows(requirements: PointingRequirements) -> list[dict]:
     """The budget of every required index on each hub axis (no contributors: none).
+
+    Parameters
+    ----------
+    requirements : PointingRequirements
+        The indices and the contributors.
 
     Returns
     -------
@@ -481,7 +534,18 @@ def evaluate(datasets: list, requirements: PointingRequirements) -> dict:
 
 
 def to_csv(rows: list[dict]) -> str:
-    """Rows of :func:`evaluate` as CSV text (one header, the union of their keys)."""
+    """Rows of :func:`evaluate` as CSV text (one header, the union of their keys).
+
+    Parameters
+    ----------
+    rows : list of dict
+        The rows.
+
+    Returns
+    -------
+    str
+        The CSV text.
+    """
     keys = list(dict.fromkeys(k for row in rows for k in row))
     buffer = io.StringIO()
     writer = csv.DictWriter(buffer, fieldnames=keys, lineterminator="\n")

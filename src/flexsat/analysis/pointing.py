@@ -202,15 +202,35 @@ def error_rotation(ds: xr.Dataset) -> np.ndarray:
 
 
 def performance_error(ds: xr.Dataset) -> np.ndarray:
-    """The performance error of a slew: its attitude error's rotation vector [rad], (n, 3)."""
+    """The performance error of a slew: its attitude error's rotation vector.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A slew's dataset (:func:`error_rotation`).
+
+    Returns
+    -------
+    ndarray, shape (n, 3)
+        θ of q_d^-1 (x) q, hub frame [rad].
+    """
     return error_rotation(ds)
 
 
 def knowledge_error(ds: xr.Dataset) -> np.ndarray | None:
-    """The knowledge error: the estimator's ``estimation_error`` record [rad], (n, 3).
+    """The knowledge error: the estimator's ``estimation_error`` record.
 
-    2 vec(q_hat^-1 (x) q_true) in the hub frame, recorded by the MEKF stage
-    (``flexsat.control.stages.mekf``); None for a run flown without an estimator.
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A slew's dataset.
+
+    Returns
+    -------
+    ndarray, shape (n, 3), or None
+        2 vec(q_hat^-1 (x) q_true) in the hub frame, recorded by the MEKF stage
+        (``flexsat.control.stages.mekf``) [rad]; None for a run flown without an
+        estimator.
     """
     if "estimation_error" not in ds:
         return None
@@ -292,8 +312,8 @@ class Statistic:
     samples : int
         How many samples the order statistic was taken among.
     where : float
-        The time of the worst window for the ensemble interpretation, the index of
-        the worst run for the temporal one on several runs (NaN otherwise).
+        The time of the worst sample for the ensemble interpretation [s], the
+        number of the worst run (from 0) for the temporal one [-]; NaN otherwise.
     """
 
     value: float
@@ -324,9 +344,9 @@ def order_statistic(samples: np.ndarray, confidence: float, interval: float = 0.
     samples : ndarray, shape (n,)
         The samples, any unit ``u`` [u]; NaN samples are left out.
     confidence : float
-        P in (0, 1].
+        P in (0, 1] [-].
     interval : float
-        γ, the confidence of the interval, in (0, 1).
+        γ, the confidence of the interval, in (0, 1) [-].
 
     Returns
     -------
@@ -371,9 +391,9 @@ def interpret(
     interpretation : str
         One of :data:`INTERPRETATIONS`.
     confidence : float
-        P, in (0, 1] (1: the worst case).
+        P, in (0, 1] (1: the worst case) [-].
     interval : float
-        γ of the confidence interval (:func:`order_statistic`).
+        γ of the confidence interval (:func:`order_statistic`) [-].
 
     Returns
     -------
