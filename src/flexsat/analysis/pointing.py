@@ -164,8 +164,12 @@ def index_samples(
     if window_s is None:
         raise ConfigError(f"{index}.window_s: {index} needs a window length")
     n = _records(window_s, dt, f"{index}.window_s", t.size, span_s)
-    summed = np.cumsum(np.concatenate([np.zeros((1, *error.shape[1:])), error]), axis=0)
-    means = (summed[n:] - summed[:-n]) / n  # means[i]: records i .. i + n - 1
+    # sums of the departures from the record's mean: their round-off scales with the
+    # signal's variation, not with its level (a 30 deg offset summed over 1e6 records)
+    offset = error.mean(axis=0)
+    zero = np.zeros((1, *error.shape[1:]))
+    summed = np.cumsum(np.concatenate([zero, error - offset]), axis=0)
+    means = (summed[n:] - summed[:-n]) / n + offset  # means[i]: records i .. i + n - 1
     if kind == "M":
         return t[: means.shape[0]], _magnitude(means)
     if kind == "R":
