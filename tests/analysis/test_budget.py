@@ -44,17 +44,17 @@ def _requirements(contributors, **indices) -> PointingRequirements:
 
 
 MIXED = [
-    {"name": "alignment", "class": "bias", "sigma_deg": [1e-3, 1e-3, 2e-3]},
-    {"name": "sensor noise", "class": "random", "sigma_deg": [2e-3, 2e-3, 1e-3]},
+    {"name": "alignment", "kind": "bias", "sigma_deg": [1e-3, 1e-3, 2e-3]},
+    {"name": "sensor noise", "kind": "random", "sigma_deg": [2e-3, 2e-3, 1e-3]},
     {
         "name": "panel mode",
-        "class": "periodic",
+        "kind": "periodic",
         "amplitude_deg": [5e-4, 5e-4, 0.0],
         "period_s": 3.0,
     },
     {
         "name": "thermal",
-        "class": "bias",
+        "kind": "bias",
         "distribution": "uniform",
         "bound_deg": [5e-4, 5e-4, 1e-3],
     },
@@ -114,7 +114,7 @@ def test_a_periodic_contribution_is_the_index_of_its_sinusoid(index):
         [
             {
                 "name": "mode",
-                "class": "periodic",
+                "kind": "periodic",
                 "amplitude_deg": [amplitude, 0.0, 0.0],
                 "period_s": period,
             }
@@ -137,13 +137,13 @@ def test_closed_forms_of_the_distributions():
     p = 0.9973
     req = IndexRequirement(bound_deg=1.0, window_s=1.0)
     # a Gaussian bias: n_P sigma, n_P = Phi^-1((1 + P) / 2) = 2.99998 (to 1e-5)
-    bias = _requirements([{"name": "b", "class": "bias", "sigma_deg": [1e-3, 0, 0]}], APE={})
+    bias = _requirements([{"name": "b", "kind": "bias", "sigma_deg": [1e-3, 0, 0]}], APE={})
     total = summed([contribution(bias.contributors[0], "APE", req)], p)
     assert gaussian_factor(p) == pytest.approx(norm.ppf(0.99865), rel=1e-15)
     assert total["statistical"][0] == pytest.approx(2.99998e-3, abs=1e-8)
     # fixed biases add as numbers, with their signs, in both sums' means
     fixed = [
-        {"name": f"f{k}", "class": "bias", "distribution": "fixed", "mean_deg": [v, 0, 0]}
+        {"name": f"f{k}", "kind": "bias", "distribution": "fixed", "mean_deg": [v, 0, 0]}
         for k, v in enumerate((2e-3, -0.5e-3))
     ]
     rows = budget_rows(_requirements(fixed, APE={}, RPE={"window_s": 1.0}))
@@ -152,7 +152,7 @@ def test_closed_forms_of_the_distributions():
     assert rows[3]["statistical_deg"] == 0.0  # a bias has no relative error
     # a uniform error +-B: sigma B / sqrt(3), own P-quantile P B
     uniform = _requirements(
-        [{"name": "u", "class": "random", "distribution": "uniform", "bound_deg": [3e-3, 0, 0]}],
+        [{"name": "u", "kind": "random", "distribution": "uniform", "bound_deg": [3e-3, 0, 0]}],
         APE={},
         MPE={"window_s": 1.0},
     )
@@ -165,7 +165,7 @@ def test_closed_forms_of_the_distributions():
 def test_knowledge_contributors_feed_only_the_knowledge_indices():
     star = {
         "name": "star tracker",
-        "class": "random",
+        "kind": "random",
         "knowledge": True,
         "sigma_deg": [1e-3, 1e-3, 5e-3],
     }
@@ -193,7 +193,7 @@ def test_evaluate_a_campaign_gives_measured_and_budget_verdicts():
             "confidence": 0.5,
             "interpretation": "ensemble",
             "indices": {"APE": {"bound_deg": 0.025, "confidence": 0.5}},
-            "contributors": [{"name": "b", "class": "bias", "sigma_deg": [0.01, 0.01, 0.01]}],
+            "contributors": [{"name": "b", "kind": "bias", "sigma_deg": [0.01, 0.01, 0.01]}],
         }
     )
     report = evaluate(cases, req)
@@ -214,9 +214,9 @@ def test_evaluate_a_campaign_gives_measured_and_budget_verdicts():
         ("confidence = 1.0", "pointing.confidence: Input should be less than 1"),
         ("[pointing.indices.XPE]\nbound_deg = 1.0", "pointing: indices.XPE: unknown index"),
         ("[pointing.indices.RPE]\nbound_deg = 1.0", "indices.RPE.window_s: RPE needs a window"),
-        ('[[pointing.contributors]]\nname = "m"\nclass = "periodic"', "period_s: a periodic"),
+        ('[[pointing.contributors]]\nname = "m"\nkind = "periodic"', "period_s: a periodic"),
         (
-            '[[pointing.contributors]]\nname = "m"\nclass = "random"\ndistribution = "fixed"',
+            '[[pointing.contributors]]\nname = "m"\nkind = "random"\ndistribution = "fixed"',
             "distribution: a random contributor is gaussian or uniform",
         ),
     ],

@@ -38,7 +38,7 @@ window_s = 0.5
 
 [[pointing.contributors]]
 name = "star tracker"
-class = "random"
+kind = "random"
 knowledge = true
 sigma_deg = [0.0014, 0.0014, 0.0083]
 """

@@ -82,7 +82,7 @@ class Contributor(_Frozen):
 
     name: str = Field(min_length=1, max_length=64, description="what it is, for the tables")
     kind: Literal["bias", "random", "periodic"] = Field(
-        alias="class", description="the standard's class: bias, random or periodic"
+        description="the standard's class: bias, random or periodic"
     )
     distribution: str | None = Field(
         None,
