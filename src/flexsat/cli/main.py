@@ -849,17 +849,17 @@ def equations(
 
 @app.command()
 def budget(
-    source: Annotated[
+    result_or_campaign: Annotated[
         Path,
-        typer.Argument(
-            metavar="RESULT_OR_CAMPAIGN",
-            help="A slew's result.nc (flexsat slew --out) or a campaign store folder.",
-        ),
+        typer.Argument(help="A slew's result.nc (flexsat slew --out) or a campaign store folder."),
     ],
     requirements: Annotated[
         Path, typer.Option("--requirements", help="TOML file with a [pointing] table.")
     ],
-    json_output: JsonOption = False,
+    json_output: Annotated[
+        bool,
+        typer.Option("--json", help="Print one JSON object instead of tables (keys name units)."),
+    ] = False,
     out: Annotated[
         Path | None, typer.Option(help="Write budget.json and budget.csv to this folder.")
     ] = None,
@@ -872,8 +872,8 @@ def budget(
     from flexsat.analysis.budget import evaluate, load_requirements, load_runs, to_csv
 
     chosen = load_requirements(requirements)
-    kind, datasets = load_runs(source)
-    report = {"source": str(source), "kind": kind, **evaluate(datasets, chosen)}
+    kind, datasets = load_runs(result_or_campaign)
+    report = {"source": str(result_or_campaign), "kind": kind, **evaluate(datasets, chosen)}
     if out is not None:
         from flexsat.files import write_text
         from flexsat.study.outputs import prepare_output_dir, write_json
