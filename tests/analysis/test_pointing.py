@@ -249,6 +249,8 @@ def test_bad_windows_and_names_are_refused_naming_the_field():
         index_samples(t, e, "RPE", 0.5)
     with pytest.raises(ConfigError, match=r"PDE.stability_s: 0.08 s is longer"):
         index_samples(t, e, "PDE", 0.05, 0.08)
+    with pytest.raises(ConfigError, match=r"MPE.window_s: 0.0004 s is shorter than the record's"):
+        index_samples(t, e, "MPE", 0.0004)  # 0.4 records of 1 ms
     with pytest.raises(ConfigError, match="index: unknown index 'XPE'"):
         index_samples(t, e, "XPE", 0.05)
     with pytest.raises(ConfigError, match=r"confidence: must be in \(0, 1\]"):

@@ -108,7 +108,12 @@ def _records(seconds: float, dt: float, field: str, available: int, span_s: floa
     """A duration as a whole number of records, refused when the record is too short."""
     if not (np.isfinite(seconds) and seconds > 0.0):
         raise ConfigError(f"{field}: must be a finite duration > 0 s, got {seconds}")
-    count = max(1, round(seconds / dt))
+    count = round(seconds / dt)
+    if count < 1:
+        raise ConfigError(
+            f"{field}: {seconds:g} s is shorter than the record's spacing ({dt:g} s); "
+            f"choose at least {dt:g} s"
+        )
     if count > available:
         raise ConfigError(
             f"{field}: {seconds:g} s is longer than the record: at most {span_s:g} s "
