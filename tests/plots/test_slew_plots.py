@@ -13,6 +13,7 @@ from matplotlib.figure import Figure
 import flexsat.config
 from flexsat.control.laws.pd import PDConfig
 from flexsat.dynamics.plant import Plant
+from flexsat.plots.openloop import plot_energy, plot_root_deformation, plot_tip_displacement
 from flexsat.plots.slew import (
     SLEW_FIGURES,
     attitude_error_vector,
@@ -22,10 +23,7 @@ from flexsat.plots.slew import (
     plot_phase_plane,
     plot_pointing,
     plot_slew_attitude,
-    plot_slew_energy,
     plot_slew_quaternion,
-    plot_slew_root_deformation,
-    plot_slew_tip_displacement,
     plot_sliding_variables,
     plot_torque_breakdown,
     plot_torque_limits,
@@ -44,10 +42,10 @@ TIME_FIGURES = [
     plot_disturbances,
     plot_torque_limits,
     plot_torque_breakdown,
-    plot_slew_root_deformation,
-    plot_slew_tip_displacement,
+    plot_root_deformation,
+    plot_tip_displacement,
     plot_flex_torque,
-    plot_slew_energy,
+    plot_energy,
 ]
 
 
@@ -170,7 +168,7 @@ def test_adaptation_floor_and_ceiling(slew_ds) -> None:
 
 
 def test_reused_figures_lose_the_torque_shading(slew_ds) -> None:
-    for plot in (plot_slew_root_deformation, plot_slew_tip_displacement, plot_slew_energy):
+    for plot in (plot_root_deformation, plot_tip_displacement, plot_energy):
         fig = plot(slew_ds)
         legends = [*fig.legends, *(ax.get_legend() for ax in fig.axes if ax.get_legend())]
         assert legends

@@ -18,10 +18,9 @@ run (``ds.attrs["scenario"]``), so they match whatever scenario flew the slew.
 - :func:`plot_torque_limits`: commanded and applied torque against RF*T_max, T_max.
 - :func:`plot_torque_breakdown`: gyroscopic, equivalent and robust parts of the law.
 - :func:`plot_flex_torque`: joint torque of the appendages against the net torque.
-- :func:`plot_slew_root_deformation`, :func:`plot_slew_tip_displacement`,
-  :func:`plot_slew_energy`: the open-loop figures of :mod:`flexsat.plots.openloop`
-  drawn for the slew (without their torque-on shading, torque being commanded
-  throughout a slew).
+- the open-loop figures of :mod:`flexsat.plots.openloop` (root deformation, tip
+  displacement, energy) drawn from the slew's dataset; a dataset with a controller
+  gets no torque-on shading (torque being commanded throughout a slew).
 - :func:`attitude_error_vector`: q_v,e at every record, for the phase plane.
 - the loop stages' figures (:mod:`flexsat.plots.stages`): one per stage that
   records something (wheels, gyro, star tracker, MEKF, drive...), named after it.
@@ -64,10 +63,7 @@ __all__ = [
     "plot_pointing",
     "plot_slew",
     "plot_slew_attitude",
-    "plot_slew_energy",
     "plot_slew_quaternion",
-    "plot_slew_root_deformation",
-    "plot_slew_tip_displacement",
     "plot_sliding_variables",
     "plot_torque_breakdown",
     "plot_torque_limits",
@@ -155,61 +151,6 @@ def _recorded(values: np.ndarray) -> bool:
 def _settled(what: str, t: float) -> str:
     """When ``what`` holds for good, from a settling time (NaN: not by the end)."""
     return "not settled by the end of the run" if math.isnan(t) else f"{what} from t = {t:.4g} s"
-
-
-def plot_slew_root_deformation(ds: xr.Dataset) -> Figure:
-    """Appendage root rotations rho [deg] and translations eta [m] during the slew.
-
-    :func:`flexsat.plots.openloop.plot_root_deformation` without the torque shading
-    (torque is commanded throughout a slew).
-
-    Parameters
-    ----------
-    ds : xarray.Dataset
-        A slew's dataset.
-
-    Returns
-    -------
-    Figure
-        The figure.
-    """
-    return plot_root_deformation(ds)
-
-
-def plot_slew_tip_displacement(ds: xr.Dataset) -> Figure:
-    """Panel tip displacement of each appendage [mm] during the slew.
-
-    :func:`flexsat.plots.openloop.plot_tip_displacement` without the torque shading.
-
-    Parameters
-    ----------
-    ds : xarray.Dataset
-        A slew's dataset.
-
-    Returns
-    -------
-    Figure
-        The figure.
-    """
-    return plot_tip_displacement(ds)
-
-
-def plot_slew_energy(ds: xr.Dataset) -> Figure:
-    """Energy balance of the slew [J], linear and logarithmic.
-
-    :func:`flexsat.plots.openloop.plot_energy` without the torque shading.
-
-    Parameters
-    ----------
-    ds : xarray.Dataset
-        A slew's dataset.
-
-    Returns
-    -------
-    Figure
-        The figure.
-    """
-    return plot_energy(ds)
 
 
 # -- attitude error --------------------------------------------------------------------
@@ -713,7 +654,7 @@ def plot_disturbances(ds: xr.Dataset) -> Figure:
     realised = np.asarray(ds.attrs["realised_disturbances"], dtype=float)
 
     def packed(name, size=3):
-        return realised[PACKED[name]:PACKED[name] + size]
+        return realised[PACKED[name] : PACKED[name] + size]
 
     ratio, hz = packed("sloshing_ratio", 1)[0], packed("sloshing_hz", 1)[0]
     gain = packed("gain")
@@ -919,10 +860,10 @@ _MAKERS = {
     "disturbances": plot_disturbances,
     "torque_limits": plot_torque_limits,
     "torque_breakdown": plot_torque_breakdown,
-    "root_deformation": plot_slew_root_deformation,
-    "tip_displacement": plot_slew_tip_displacement,
+    "root_deformation": plot_root_deformation,
+    "tip_displacement": plot_tip_displacement,
     "flex_torque": plot_flex_torque,
-    "energy": plot_slew_energy,
+    "energy": plot_energy,
 }
 
 SLEW_FIGURES = tuple(_MAKERS)
