@@ -160,6 +160,15 @@ def test_closed_forms_of_the_distributions():
     assert rows[0]["sigma_deg"] == pytest.approx(3e-3 / math.sqrt(3.0), rel=1e-15)
     assert rows[0]["worst_case_deg"] == pytest.approx(p * 3e-3, rel=1e-15)
     assert rows[3]["statistical_deg"] == 0.0  # a random error averages out of the mean
+    # a random error's own mean is a constant: in the APE and the MPE, not in the RPE
+    offset = {"name": "o", "kind": "random", "mean_deg": [1e-3, 0, 0], "sigma_deg": [2e-3, 0, 0]}
+    rows = budget_rows(
+        _requirements([offset], APE={}, MPE={"window_s": 1.0}, RPE={"window_s": 1.0})
+    )
+    n_p = gaussian_factor(0.9973)
+    assert rows[0]["statistical_deg"] == pytest.approx(1e-3 + n_p * 2e-3, rel=1e-15)
+    assert rows[3]["statistical_deg"] == pytest.approx(1e-3, rel=1e-15)
+    assert rows[6]["statistical_deg"] == pytest.approx(n_p * 2e-3, rel=1e-15)
 
 
 def test_knowledge_contributors_feed_only_the_knowledge_indices():

@@ -291,10 +291,11 @@ def contribution(contributor: Contributor, index: str, req: IndexRequirement) ->
 
     Bias: all of it to the absolute and mean indices, nothing to the relative,
     drift and reproducibility ones (constant over an observation). Random: all to
-    the absolute and relative ones, nothing to the window means (its correlation
-    time taken much shorter than Δt). Periodic, amplitude A and period T: a sinusoid
-    of amplitude A for APE, A |sinc(Δt/T)| for MPE (its window mean), A |1 - sinc(Δt/T)|
-    for RPE (a record against the mean of the window centred on it), and
+    the absolute one, its spread to the relative one, its mean to the mean one (its
+    spread averages out of a window, its correlation time taken much shorter than
+    Δt). Periodic, amplitude A and period T: a sinusoid of amplitude A for APE,
+    A |sinc(Δt/T)| for MPE (its window mean), A |1 - sinc(Δt/T)| for RPE (a record
+    against the mean of the window centred on it), and
     2 A |sinc(Δt/T) sin(π Δ/T)| for PDE and PRE (Δ = Δt_s or Δt_o), with
     sinc(x) = sin(πx)/(πx): exact for the indices of :mod:`flexsat.analysis.pointing`.
 
@@ -323,8 +324,11 @@ def contribution(contributor: Contributor, index: str, req: IndexRequirement) ->
         factor = 0.0
     elif contributor.kind == "bias":
         factor = 1.0 if kind in "AM" else 0.0
-    elif contributor.kind == "random":
-        factor = 1.0 if kind in "AR" else 0.0
+    elif contributor.kind == "random":  # its mean is a constant: in APE and MPE only
+        factor = 1.0 if kind in "AMR" else 0.0
+        mean = mean if kind in "AM" else zero
+        if kind == "M":  # the spread averages out of the window mean
+            sigma, scale = zero, zero
     else:
         period = float(contributor.period_s)
         scale = np.asarray(contributor.amplitude_deg)
