@@ -83,7 +83,19 @@ def case_history(ds, dt: float = HISTORY_DT_S) -> dict:
 
 
 def case_row(case: ResolvedCase) -> dict:
-    """The head of a case's row: its id, inputs and seeds (what it was run from)."""
+    """The head of a case's row: its id, inputs and seeds (what it was run from).
+
+    Parameters
+    ----------
+    case : ResolvedCase
+        The case as the campaign resolved it (configs as plain dicts, seeds).
+
+    Returns
+    -------
+    dict
+        ``case_id``, ``inputs_digest``, ``root_seed``, ``stream_index``,
+        ``parameters`` and ``inputs`` (the plant and scenario, for replay).
+    """
     return {
         "case_id": case.case_id,
         "inputs_digest": case.digest,
@@ -95,7 +107,18 @@ def case_row(case: ResolvedCase) -> dict:
 
 
 def case_inputs(case: ResolvedCase):
-    """The validated ``(Plant, SlewScenario)`` of a resolved case."""
+    """The validated ``(Plant, SlewScenario)`` of a resolved case.
+
+    Parameters
+    ----------
+    case : ResolvedCase
+        The case as the campaign resolved it.
+
+    Returns
+    -------
+    tuple of (Plant, SlewScenario)
+        The truth plant and the slew scenario the case flies.
+    """
     from flexsat.config.models import SatelliteConfig
     from flexsat.dynamics.plant import Plant
     from flexsat.simulate import SlewScenario
@@ -106,7 +129,15 @@ def case_inputs(case: ResolvedCase):
 
 def finish_row(row: dict, result) -> None:
     """Fill a row from its slew's :class:`~flexsat.simulate.result.Result`: history,
-    status and metrics (the stored scenario's requirements, control effort)."""
+    status and metrics (the stored scenario's requirements, control effort).
+
+    Parameters
+    ----------
+    row : dict
+        The case's row (from :func:`case_row`), filled in place.
+    result : Result
+        The finished slew.
+    """
     from flexsat.analysis.effort import effort_metrics
     from flexsat.analysis.requirements import slew_metrics
 
@@ -119,6 +150,14 @@ def finish_row(row: dict, result) -> None:
 
 
 def fail_row(row: dict, exc: Exception) -> None:
-    """Mark a row failed by ``exc``: its type, message and the function that raised."""
+    """Mark a row failed by ``exc``: its type, message and the function that raised.
+
+    Parameters
+    ----------
+    row : dict
+        The case's row (from :func:`case_row`), marked in place.
+    exc : Exception
+        What stopped the case.
+    """
     last = traceback.extract_tb(exc.__traceback__)[-1]
     row.update(status="failed", error=f"{type(exc).__name__}: {exc} ({last.name})", metrics={})
