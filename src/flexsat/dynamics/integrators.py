@@ -31,8 +31,10 @@ __all__ = [
     "STATUS_NOT_FINITE",
     "applied_torque",
     "augmented_derivative",
+    "rk4_combine",
     "rk4_hold",
     "rk4_open_loop",
+    "rk4_stage",
     "rk4_step",
 ]
 
@@ -114,6 +116,53 @@ def augmented_derivative(x, torque_B, n, Q, dx, packed, cs):
     return status
 
 
+@njit(cache=True, inline="always")
+def rk4_stage(x, h, k, stage):
+    """An RK4 stage's state, ``stage = x + h k``, element by element.
+
+    Parameters
+    ----------
+    x : ndarray, shape (m,)
+        State at the start of the step [SI, per element].
+    h : float
+        The stage's step, ``dt / 2`` or ``dt`` [s].
+    k : ndarray, shape (m,)
+        The derivative the stage follows [SI per s].
+    stage : ndarray, shape (m,)
+        Overwritten with the stage's state [SI, per element].
+    """
+    for j in range(x.shape[0]):
+        stage[j] = x[j] + h * k[j]
+
+
+@njit(cache=True, inline="always")
+def rk4_combine(x, dt, k1, k2, k3, k4, out):
+    """The RK4 step's end, ``out = x + dt/6 (k1 + 2 k2 + 2 k3 + k4)``, checked finite.
+
+    Parameters
+    ----------
+    x : ndarray, shape (m,)
+        State at the start of the step [SI, per element].
+    dt : float
+        Step [s].
+    k1, k2, k3, k4 : ndarray, shape (m,)
+        The four stages' derivatives [SI per s].
+    out : ndarray, shape (m,)
+        Overwritten with the state at the end of the step, up to the first element
+        that is not finite [SI, per element].
+
+    Returns
+    -------
+    bool
+        Every element of ``out`` is finite.
+    """
+    for j in range(x.shape[0]):
+        out[j] = x[j] + dt / 6.0 * (k1[j] + 2.0 * k2[j] + 2.0 * k3[j] + k4[j])
+        if not np.isfinite(out[j]):
+            return False
+    return True
+
+
 @njit(cache=True)
 def rk4_step(x, dt, torque_B, n, Q, scratch, packed, first=False):
     """One RK4 step of the augmented state x, in place, under a held body torque.
@@ -146,26 +195,20 @@ def rk4_step(x, dt, torque_B, n, Q, scratch, packed, first=False):
         ``STATUS_OK``, a kernel status or ``STATUS_NOT_FINITE``.
     """
     x, Q, scratch, packed = borrowed(x), borrowed(Q), borrowed(scratch), borrowed(packed)
-    size = x.shape[0]
     k1, k2, k3, k4, stage = scratch[0], scratch[1], scratch[2], scratch[3], scratch[4]
     status = STATUS_OK
     if not first:
         status = augmented_derivative(x, torque_B, n, Q, k1, packed, hub_cs(x))
-    for j in range(size):
-        stage[j] = x[j] + 0.5 * dt * k1[j]
+    rk4_stage(x, 0.5 * dt, k1, stage)
     status |= augmented_derivative(stage, torque_B, n, Q, k2, packed, hub_cs(stage))
-    for j in range(size):
-        stage[j] = x[j] + 0.5 * dt * k2[j]
+    rk4_stage(x, 0.5 * dt, k2, stage)
     status |= augmented_derivative(stage, torque_B, n, Q, k3, packed, hub_cs(stage))
-    for j in range(size):
-        stage[j] = x[j] + dt * k3[j]
+    rk4_stage(x, dt, k3, stage)
     status |= augmented_derivative(stage, torque_B, n, Q, k4, packed, hub_cs(stage))
     if status != STATUS_OK:
         return status
-    for j in range(size):
-        stage[j] = x[j] + dt / 6.0 * (k1[j] + 2.0 * k2[j] + 2.0 * k3[j] + k4[j])
-        if not np.isfinite(stage[j]):
-            return STATUS_NOT_FINITE
+    if not rk4_combine(x, dt, k1, k2, k3, k4, stage):
+        return STATUS_NOT_FINITE
     copy_into(x, stage)
     return STATUS_OK
 

@@ -19,7 +19,7 @@ import numpy as np
 from numba import njit
 
 from flexsat.dynamics.borrowed import borrowed
-from flexsat.dynamics.integrators import augmented_derivative
+from flexsat.dynamics.integrators import augmented_derivative, rk4_combine, rk4_stage
 from flexsat.dynamics.kernels import hub_cs
 from flexsat.dynamics.linalg3 import euler_rate_matrix_cs, load_seg, mv
 from flexsat.dynamics.status import STATUS_NOT_FINITE, STATUS_OK
@@ -198,32 +198,27 @@ def rk4_coupled_step(x, t, dt, n, Q, scratch, derivatives, params, flow, packed,
     for j in range(m):
         ce[j] = c[j]
     status = _rates(x, n, t, derivatives, params, flow, Q, k1, packed, not fresh)
-    for j in range(size):
-        stage[j] = x[j] + 0.5 * dt * k1[j]
+    rk4_stage(x, 0.5 * dt, k1, stage)
     # The chain's rate at each RK4 stage is flow.dot; it is folded into the next stage's
     # state and the weighted sum at once (no copy per stage), in the order the plant's sum is taken.
     for j in range(m):
         acc[j] = dot[j]
         ce[j] = c[j] + 0.5 * dt * dot[j]
     status |= _rates(stage, n, t + 0.5 * dt, derivatives, params, flow, Q, k2, packed)
-    for j in range(size):
-        stage[j] = x[j] + 0.5 * dt * k2[j]
+    rk4_stage(x, 0.5 * dt, k2, stage)
     for j in range(m):
         acc[j] += 2.0 * dot[j]
         ce[j] = c[j] + 0.5 * dt * dot[j]
     status |= _rates(stage, n, t + 0.5 * dt, derivatives, params, flow, Q, k3, packed)
-    for j in range(size):
-        stage[j] = x[j] + dt * k3[j]
+    rk4_stage(x, dt, k3, stage)
     for j in range(m):
         acc[j] += 2.0 * dot[j]
         ce[j] = c[j] + dt * dot[j]
     status |= _rates(stage, n, t + dt, derivatives, params, flow, Q, k4, packed)
     if status != STATUS_OK:
         return status
-    for j in range(size):
-        stage[j] = x[j] + dt / 6.0 * (k1[j] + 2.0 * k2[j] + 2.0 * k3[j] + k4[j])
-        if not np.isfinite(stage[j]):
-            return STATUS_NOT_FINITE
+    if not rk4_combine(x, dt, k1, k2, k3, k4, stage):
+        return STATUS_NOT_FINITE
     for j in range(m):
         ce[j] = c[j] + dt / 6.0 * (acc[j] + dot[j])
         if not np.isfinite(ce[j]):
