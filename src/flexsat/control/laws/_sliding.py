@@ -10,16 +10,21 @@ from numba import njit
 
 from flexsat.control.quaternion import quaternion_error
 from flexsat.control.registry import Channel
-from flexsat.dynamics.linalg3 import cross
+from flexsat.dynamics.linalg3 import cross, mv
 
 __all__ = [
     "SLIDING_DIAGNOSTICS",
     "clip_and_store",
     "errors",
     "inertia3",
+    "integral_diagnostics",
+    "law_terms",
     "linear_sliding_feedback",
     "sat",
+    "store_integral_breakdown",
+    "surface",
     "surface_attributes",
+    "surface_guide",
 ]
 
 
@@ -116,6 +121,79 @@ def clip_and_store(limit, tau_gyro, tau_guide, tau_rob, tau_cmd):
     """tau_cmd = clip(tau_gyro + tau_guide + tau_rob, +-limit) per axis [N m]."""
     for a in range(3):
         tau_cmd[a] = min(limit, max(-limit, tau_gyro[a] + tau_guide[a] + tau_rob[a]))
+
+
+@njit(cache=True)
+def law_terms(q_d, omega_d, omega_dot_d, q, omega_B, J):
+    """The terms every built-in law starts from (law contract's arguments, SI).
+
+    Returns q_v,e, its rate, omega_e and the pointing error [rad] (:func:`errors`),
+    the design inertia as nested tuples (:func:`inertia3`), the tracking feed-forward
+    J omega_dot_d in B (eq. 4.12) [N m] and the gyroscopic torque omega x (J omega)
+    [N m].
+    """
+    qv, qv_dot, omega_e, theta_err, w_dot_d = errors(q_d, omega_d, omega_dot_d, q, omega_B)
+    J3 = inertia3(J)
+    return qv, qv_dot, omega_e, theta_err, J3, mv(J3, w_dot_d), cross(omega_B, mv(J3, omega_B))
+
+
+@njit(cache=True)
+def surface(omega_e, lam, qv):
+    """The sliding variable s = omega_e + lambda q_v,e per axis (eq. 4.6) [rad/s]."""
+    return (omega_e[0] + lam * qv[0], omega_e[1] + lam * qv[1], omega_e[2] + lam * qv[2])
+
+
+@njit(cache=True)
+def surface_guide(J_w_dot_d, lam, J_qv_dot):
+    """J (omega_dot_d - lambda q_v,e_dot) per axis, the guiding torque of a surface of
+    slope ``lam`` [rad/s] (eqs. 4.12-4.14) [N m]."""
+    return (
+        J_w_dot_d[0] - lam * J_qv_dot[0],
+        J_w_dot_d[1] - lam * J_qv_dot[1],
+        J_w_dot_d[2] - lam * J_qv_dot[2],
+    )
+
+
+def integral_diagnostics(
+    surface_note: str, integral: Channel, guide_note: str, rob_note: str
+) -> tuple[Channel, ...]:
+    """The first five diagnostics of a law whose surface carries an integral state, in
+    the order :func:`store_integral_breakdown` writes them.
+
+    Parameters
+    ----------
+    surface_note, guide_note, rob_note : str
+        Descriptions of s [rad/s], tau_guide and tau_rob [N m].
+    integral : Channel
+        The integral state's channel (per axis).
+
+    Returns
+    -------
+    tuple of Channel
+        s, the integral, tau_gyro, tau_guide, tau_rob, each per axis.
+    """
+    return (
+        Channel("sliding_variable", "rad/s", surface_note, per_axis=True),
+        integral,
+        Channel("tau_gyro", "N m", "w x J w", per_axis=True),
+        Channel("tau_guide", "N m", guide_note, per_axis=True),
+        Channel("tau_rob", "N m", rob_note, per_axis=True),
+    )
+
+
+@njit(cache=True)
+def store_integral_breakdown(limit, s, integral, tau_gyro, tau_guide, tau_rob, tau_cmd, diag):
+    """The command of a law whose surface carries an integral state, and its first 15
+    diagnostics: s, the integral, tau_gyro, tau_guide, tau_rob (3 each, in that order).
+
+    ``tau_cmd`` as :func:`clip_and_store` [N m]; ``diag[0:15]`` overwritten [SI].
+    """
+    clip_and_store(limit, tau_gyro, tau_guide, tau_rob, tau_cmd)
+    diag[0], diag[1], diag[2] = s
+    diag[3], diag[4], diag[5] = integral
+    diag[6], diag[7], diag[8] = tau_gyro
+    diag[9], diag[10], diag[11] = tau_guide
+    diag[12], diag[13], diag[14] = tau_rob
 
 
 SLIDING_DIAGNOSTICS = (

@@ -25,14 +25,15 @@ from flexsat.config.models import Positive
 from flexsat.control.laws._sliding import (
     SLIDING_DIAGNOSTICS,
     clip_and_store,
-    errors,
-    inertia3,
+    law_terms,
     linear_sliding_feedback,
     sat,
+    surface,
     surface_attributes,
+    surface_guide,
 )
 from flexsat.control.laws.registry import LawConfig, LawSpec
-from flexsat.dynamics.linalg3 import cross, mv
+from flexsat.dynamics.linalg3 import mv
 
 __all__ = ["ASMC", "ASMCConfig", "ASMCGains"]
 
@@ -135,10 +136,9 @@ def asmc_step(q_d, omega_d, omega_dot_d, q, omega_B, J, gains, state, t, dt, tau
     ``state``: Lambda of the previous call, and 1.0 once a call has been made.
     """
     limit = gains[G.reduction_factor] * gains[G.t_max]
-    qv, qv_dot, omega_e, theta_err, w_dot_d = errors(q_d, omega_d, omega_dot_d, q, omega_B)
-    J3 = inertia3(J)
-    J_w_dot_d = mv(J3, w_dot_d)  # tracking feed-forward J omega_dot_d (eq. 4.12)
-    tau_gyro = cross(omega_B, mv(J3, omega_B))  # omega x (J omega)
+    qv, qv_dot, omega_e, theta_err, J3, J_w_dot_d, tau_gyro = law_terms(
+        q_d, omega_d, omega_dot_d, q, omega_B, J
+    )
     J_qv_dot = mv(J3, qv_dot)
     jk_min, lam_min, lam_max = gains[G.jk_min], gains[G.lambda_min], gains[G.lambda_max]
     phi = gains[G.phi]
@@ -159,9 +159,8 @@ def asmc_step(q_d, omega_d, omega_dot_d, q, omega_B, J, gains, state, t, dt, tau
         if abs(J_qv_dot[a]) > 0.0:
             lam_feasible = min(lam_feasible, max(0.0, budget) / abs(J_qv_dot[a]))
     lam = max(lam_min, min(lam_target, lam_feasible))  # eq. 4.29
-    s = (omega_e[0] + lam * qv[0], omega_e[1] + lam * qv[1], omega_e[2] + lam * qv[2])
-    tau_guide = (J_w_dot_d[0] - lam * J_qv_dot[0], J_w_dot_d[1] - lam * J_qv_dot[1],
-                 J_w_dot_d[2] - lam * J_qv_dot[2])  # J (omega_dot_d - Lambda q_v,e_dot)
+    s = surface(omega_e, lam, qv)
+    tau_guide = surface_guide(J_w_dot_d, lam, J_qv_dot)  # J (omega_dot_d - Lambda q_v,e_dot)
     # eq. 4.30, per axis: all the residual budget outside the boundary layer, scaled
     # down towards JK_min inside it.
     jk = (

@@ -24,10 +24,16 @@ from numba import njit
 from pydantic import Field
 
 from flexsat.config.models import Positive
-from flexsat.control.laws._sliding import clip_and_store, errors, inertia3, sat, surface_attributes
+from flexsat.control.laws._sliding import (
+    integral_diagnostics,
+    law_terms,
+    sat,
+    store_integral_breakdown,
+    surface_attributes,
+)
 from flexsat.control.laws.registry import LawConfig, LawSpec
 from flexsat.control.registry import Channel
-from flexsat.dynamics.linalg3 import cross, mv
+from flexsat.dynamics.linalg3 import mv
 
 __all__ = ["ISMC", "ISMCConfig", "ISMCGains"]
 
@@ -89,9 +95,9 @@ def ismc_step(q_d, omega_d, omega_dot_d, q, omega_B, J, gains, state, t, dt, tau
     has been made (the first call sets z so that s = 0).
     """
     limit = gains[G.reduction_factor] * gains[G.t_max]
-    qv, qv_dot, omega_e, _, w_dot_d = errors(q_d, omega_d, omega_dot_d, q, omega_B)
-    J3 = inertia3(J)
-    tau_gyro = cross(omega_B, mv(J3, omega_B))  # omega x (J omega)
+    qv, qv_dot, omega_e, _, J3, J_w_dot_d, tau_gyro = law_terms(
+        q_d, omega_d, omega_dot_d, q, omega_B, J
+    )
     lam, k_i, jk, phi = gains[G.lambda_], gains[G.k_i], gains[G.jk], gains[G.phi]
     if state[3] == 0.0:  # s(0) = 0: no reaching phase
         for a in range(3):
@@ -102,15 +108,10 @@ def ismc_step(q_d, omega_d, omega_dot_d, q, omega_B, J, gains, state, t, dt, tau
     # the equivalent control: s_dot = 0 on the rigid design model without disturbance
     Jw = mv(J3, (lam * qv_dot[0] + k_i * qv[0], lam * qv_dot[1] + k_i * qv[1],
                  lam * qv_dot[2] + k_i * qv[2]))  # fmt: skip
-    J_w_dot_d = mv(J3, w_dot_d)  # tracking feed-forward J omega_dot_d (eq. 4.12)
     tau_guide = (J_w_dot_d[0] - Jw[0], J_w_dot_d[1] - Jw[1], J_w_dot_d[2] - Jw[2])
     tau_rob = (-jk * sat(s[0] / phi), -jk * sat(s[1] / phi), -jk * sat(s[2] / phi))
-    clip_and_store(limit, tau_gyro, tau_guide, tau_rob, tau_cmd)
-    diag[0], diag[1], diag[2] = s
-    diag[3], diag[4], diag[5] = state[0], state[1], state[2]
-    diag[6], diag[7], diag[8] = tau_gyro
-    diag[9], diag[10], diag[11] = tau_guide
-    diag[12], diag[13], diag[14] = tau_rob
+    z = (state[0], state[1], state[2])
+    store_integral_breakdown(limit, s, z, tau_gyro, tau_guide, tau_rob, tau_cmd, diag)
     for a in range(3):  # z_dot = k_i q_v,e, explicit Euler over the control period
         state[a] += k_i * qv[a] * dt
     return 0
@@ -118,12 +119,10 @@ def ismc_step(q_d, omega_d, omega_dot_d, q, omega_B, J, gains, state, t, dt, tau
 
 ISMC = LawSpec(
     name="ismc", label="ISMC", config=ISMCConfig, step=ismc_step, state_size=4,
-    diagnostics=(
-        Channel("sliding_variable", "rad/s", "s = w_e + L q_v,e + z", per_axis=True),
+    diagnostics=integral_diagnostics(
+        "s = w_e + L q_v,e + z",
         Channel("surface_integral", "rad/s", "z = k_i int q_v,e dt - s0", per_axis=True),
-        Channel("tau_gyro", "N m", "w x J w", per_axis=True),
-        Channel("tau_guide", "N m", "-J (L q_v,e_dot + k_i q_v,e)", per_axis=True),
-        Channel("tau_rob", "N m", "-JK sat(s/Phi)", per_axis=True),
+        "-J (L q_v,e_dot + k_i q_v,e)", "-JK sat(s/Phi)",
     ),
     description="integral sliding-mode control (no reaching phase)",
 )  # fmt: skip

@@ -12,10 +12,10 @@ from numba import njit
 from pydantic import Field
 
 from flexsat.config.models import Positive
-from flexsat.control.laws._sliding import clip_and_store, errors, inertia3
+from flexsat.control.laws._sliding import clip_and_store, law_terms
 from flexsat.control.laws.registry import LawConfig, LawSpec
 from flexsat.control.registry import Channel
-from flexsat.dynamics.linalg3 import cross, mv
+from flexsat.dynamics.linalg3 import mv
 
 __all__ = ["PD", "PDConfig", "PDGains"]
 
@@ -70,14 +70,11 @@ class PDConfig(LawConfig):
 def pd_step(q_d, omega_d, omega_dot_d, q, omega_B, J, gains, state, t, dt, tau_cmd, diag):
     """The PD command (law contract in :mod:`flexsat.control.laws.registry`); no state."""
     limit = gains[G.reduction_factor] * gains[G.t_max]
-    qv, _, omega_e, _, w_dot_d = errors(q_d, omega_d, omega_dot_d, q, omega_B)
-    J3 = inertia3(J)
-    tau_gyro = cross(omega_B, mv(J3, omega_B))  # omega x (J omega)
+    qv, _, omega_e, _, J3, J_w_dot_d, tau_gyro = law_terms(q_d, omega_d, omega_dot_d, q, omega_B, J)
     kp, kd = gains[G.kp], gains[G.kd]
     u = (kp * qv[0] + kd * omega_e[0], kp * qv[1] + kd * omega_e[1],
          kp * qv[2] + kd * omega_e[2])  # fmt: skip
     Ju = mv(J3, u)
-    J_w_dot_d = mv(J3, w_dot_d)  # tracking feed-forward J omega_dot_d
     tau_guide = (J_w_dot_d[0] - Ju[0], J_w_dot_d[1] - Ju[1], J_w_dot_d[2] - Ju[2])
     clip_and_store(limit, tau_gyro, tau_guide, (0.0, 0.0, 0.0), tau_cmd)
     diag[0], diag[1], diag[2] = tau_gyro

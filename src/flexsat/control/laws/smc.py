@@ -17,14 +17,15 @@ from flexsat.config.models import Positive
 from flexsat.control.laws._sliding import (
     SLIDING_DIAGNOSTICS,
     clip_and_store,
-    errors,
-    inertia3,
+    law_terms,
     linear_sliding_feedback,
     sat,
+    surface,
     surface_attributes,
+    surface_guide,
 )
 from flexsat.control.laws.registry import LawConfig, LawSpec
-from flexsat.dynamics.linalg3 import cross, mv
+from flexsat.dynamics.linalg3 import mv
 
 __all__ = ["SMC", "SMCConfig", "SMCGains"]
 
@@ -81,15 +82,13 @@ class SMCConfig(LawConfig):
 def smc_step(q_d, omega_d, omega_dot_d, q, omega_B, J, gains, state, t, dt, tau_cmd, diag):
     """The SMC command (law contract in :mod:`flexsat.control.laws.registry`); no state."""
     limit = gains[G.reduction_factor] * gains[G.t_max]
-    qv, qv_dot, omega_e, _, w_dot_d = errors(q_d, omega_d, omega_dot_d, q, omega_B)
-    J3 = inertia3(J)
-    J_w_dot_d = mv(J3, w_dot_d)  # tracking feed-forward J omega_dot_d (eq. 4.12)
-    tau_gyro = cross(omega_B, mv(J3, omega_B))  # omega x (J omega)
+    qv, qv_dot, omega_e, _, J3, J_w_dot_d, tau_gyro = law_terms(
+        q_d, omega_d, omega_dot_d, q, omega_B, J
+    )
     J_qv_dot = mv(J3, qv_dot)
     lam, jk, phi = gains[G.lambda_], gains[G.jk], gains[G.phi]
-    s = (omega_e[0] + lam * qv[0], omega_e[1] + lam * qv[1], omega_e[2] + lam * qv[2])
-    tau_guide = (J_w_dot_d[0] - lam * J_qv_dot[0], J_w_dot_d[1] - lam * J_qv_dot[1],
-                 J_w_dot_d[2] - lam * J_qv_dot[2])  # J (omega_dot_d - lambda q_v,e_dot)
+    s = surface(omega_e, lam, qv)
+    tau_guide = surface_guide(J_w_dot_d, lam, J_qv_dot)  # J (omega_dot_d - lambda q_v,e_dot)
     tau_rob = (-jk * sat(s[0] / phi), -jk * sat(s[1] / phi), -jk * sat(s[2] / phi))
     clip_and_store(limit, tau_gyro, tau_guide, tau_rob, tau_cmd)
     diag[0], diag[1], diag[2] = s

@@ -35,10 +35,17 @@ from numba import njit
 from pydantic import Field, model_validator
 
 from flexsat.config.models import Positive
-from flexsat.control.laws._sliding import clip_and_store, errors, inertia3, surface_attributes
+from flexsat.control.laws._sliding import (
+    integral_diagnostics,
+    law_terms,
+    store_integral_breakdown,
+    surface,
+    surface_attributes,
+    surface_guide,
+)
 from flexsat.control.laws.registry import LawConfig, LawSpec
 from flexsat.control.registry import Channel
-from flexsat.dynamics.linalg3 import cross, mv
+from flexsat.dynamics.linalg3 import mv
 
 __all__ = [
     "STSMC",
@@ -211,15 +218,13 @@ def stsmc_step(q_d, omega_d, omega_dot_d, q, omega_B, J, gains, state, t, dt, ta
     ``state``: the twisting integral v per axis [rad/s^2].
     """
     limit = gains[G.reduction_factor] * gains[G.t_max]
-    qv, qv_dot, omega_e, _, w_dot_d = errors(q_d, omega_d, omega_dot_d, q, omega_B)
-    J3 = inertia3(J)
-    J_w_dot_d = mv(J3, w_dot_d)  # tracking feed-forward J omega_dot_d (eq. 4.12)
-    tau_gyro = cross(omega_B, mv(J3, omega_B))  # omega x (J omega)
+    qv, qv_dot, omega_e, _, J3, J_w_dot_d, tau_gyro = law_terms(
+        q_d, omega_d, omega_dot_d, q, omega_B, J
+    )
     J_qv_dot = mv(J3, qv_dot)
     lam = gains[G.lambda_]
-    s = (omega_e[0] + lam * qv[0], omega_e[1] + lam * qv[1], omega_e[2] + lam * qv[2])
-    tau_guide = (J_w_dot_d[0] - lam * J_qv_dot[0], J_w_dot_d[1] - lam * J_qv_dot[1],
-                 J_w_dot_d[2] - lam * J_qv_dot[2])  # J (omega_dot_d - lambda q_v,e_dot)
+    s = surface(omega_e, lam, qv)
+    tau_guide = surface_guide(J_w_dot_d, lam, J_qv_dot)  # J (omega_dot_d - lambda q_v,e_dot)
     rows = _inverse_row_sums(J)
     c1_root_L = gains[G.c1] * sqrt(gains[G.d_rate])  # k1_i = c1 sqrt(L) sqrt(rows_i)
     v = (state[0], state[1], state[2])
@@ -228,28 +233,23 @@ def stsmc_step(q_d, omega_d, omega_dot_d, q, omega_B, J, gains, state, t, dt, ta
          _twist(c1_root_L * sqrt(rows[2]), s[2]) + v[2])  # fmt: skip
     tau_rob = mv(J3, u)
     tau_int = mv(J3, v)
-    clip_and_store(limit, tau_gyro, tau_guide, tau_rob, tau_cmd)
+    store_integral_breakdown(limit, s, v, tau_gyro, tau_guide, tau_rob, tau_cmd, diag)
+    diag[15], diag[16], diag[17] = tau_int
     for a in range(3):  # v_dot = -k2 sgn(s), explicit Euler over the control period
         v_max = gains[G.d_max] * rows[a]
         v_next = v[a] - gains[G.c2] * gains[G.d_rate] * rows[a] * _sgn(s[a]) * dt
         state[a] = min(v_max, max(-v_max, v_next))
-    diag[0], diag[1], diag[2] = s
-    diag[3], diag[4], diag[5] = v
-    diag[6], diag[7], diag[8] = tau_gyro
-    diag[9], diag[10], diag[11] = tau_guide
-    diag[12], diag[13], diag[14] = tau_rob
-    diag[15], diag[16], diag[17] = tau_int
     return 0
 
 
 STSMC = LawSpec(
     name="stsmc", label="STSMC", config=STSMCConfig, step=stsmc_step, state_size=3,
     diagnostics=(
-        Channel("sliding_variable", "rad/s", "s = w_e + L q_v,e", per_axis=True),
-        Channel("twisting_integral", "rad/s^2", "v, v_dot = -k2 sgn(s)", per_axis=True),
-        Channel("tau_gyro", "N m", "w x J w", per_axis=True),
-        Channel("tau_guide", "N m", "-J L q_v,e_dot", per_axis=True),
-        Channel("tau_rob", "N m", "J (-k1 |s|^1/2 sgn(s) + v)", per_axis=True),
+        *integral_diagnostics(
+            "s = w_e + L q_v,e",
+            Channel("twisting_integral", "rad/s^2", "v, v_dot = -k2 sgn(s)", per_axis=True),
+            "-J L q_v,e_dot", "J (-k1 |s|^1/2 sgn(s) + v)",
+        ),
         Channel("tau_integral", "N m", "J v, the integral part of tau_rob", per_axis=True),
     ),
     description="super-twisting sliding-mode control (Nadafi et al. 2019)",
