@@ -13,7 +13,7 @@ steps of 0.1 ms take spinningBodyNDOF about 40 min on a loaded two-core machine)
         omega_<engine> (m, 3)  hub rate omega_BN_B [rad/s]
         theta (m, 2, N)        hinge angles [rad] (spinningBodyNDOF; array +x, then -x)
 
-``tests/dynamics/test_basilisk_flexpanels.py`` holds flexsat against them without
+``tests/dynamics/appendages/test_chain_basilisk.py`` holds flexsat against them without
 Basilisk. Run ``python bench/basilisk_flexpanels.py [N ...]`` (``pip install -e
 '.[bench]'``); it prints the cross-engine agreement.
 """
