@@ -142,7 +142,7 @@ def test_dask_tasks_batch_cases_but_every_worker_thread_gets_several():
     # never so many that a worker thread has fewer than four tasks of the campaign: a
     # worker lost mid-run then loses a task another re-runs, not its whole share (the
     # real cluster's kill test flies 12 cases on two workers: one case per task).
-    from flexsat.campaigns.runner import DASK_BATCH, _dask_batch
+    from flexsat.campaigns.backends import DASK_BATCH, _dask_batch
 
     assert _dask_batch(1000, 2) == DASK_BATCH == 32
     assert _dask_batch(12, 2) == 1 and _dask_batch(69, 2) == 8 and _dask_batch(0, 4) == 1

@@ -4,7 +4,7 @@ import subprocess
 import sys
 import textwrap
 
-from flexsat.campaigns.runner import _dask_client
+from flexsat.campaigns.backends import _dask_client
 
 
 def _worker_state():

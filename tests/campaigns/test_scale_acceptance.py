@@ -159,7 +159,7 @@ def test_a_local_dask_cluster_runs_without_the_dashboard_feeds():
     # sampling every thread every 10 ms would be most of an idle cluster's CPU).
     import dask
 
-    from flexsat.campaigns.runner import QUIET_DASK, _dask_client
+    from flexsat.campaigns.backends import QUIET_DASK, _dask_client
 
     def settings() -> dict:
         return {key: dask.config.get(key) for key in QUIET_DASK}

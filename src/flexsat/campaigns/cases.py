@@ -1,12 +1,14 @@
 """One campaign case's row: what it was run from, its metrics and history, or its failure.
 
-What every runner writes a case's row with (:func:`~flexsat.campaigns.runner.run_case`,
-:func:`~flexsat.campaigns.ensemble.run_ensemble`), so that their rows are the same bit
-for bit; below both, so that neither imports the other for it.
+What every runner writes a case's row with (:func:`run_case`, one case in this process,
+and :func:`~flexsat.campaigns.ensemble.run_ensemble`), so that their rows are the same
+bit for bit; below both backends (:mod:`flexsat.campaigns.backends`) and the runner, so
+that none imports another for it.
 """
 
 from __future__ import annotations
 
+import time
 import traceback
 
 from flexsat.campaigns.definition import ResolvedCase
@@ -19,11 +21,12 @@ __all__ = [
     "case_row",
     "fail_row",
     "finish_row",
+    "run_case",
 ]
 
 
 HISTORY_KEY = "history"
-"""Key of the decimated time history in a :func:`~flexsat.campaigns.runner.run_case` row
+"""Key of the decimated time history in a :func:`run_case` row
 (not stored in the table)."""
 
 HISTORY_DT_S = 0.1
@@ -161,3 +164,42 @@ def fail_row(row: dict, exc: Exception) -> None:
     """
     last = traceback.extract_tb(exc.__traceback__)[-1]
     row.update(status="failed", error=f"{type(exc).__name__}: {exc} ({last.name})", metrics={})
+
+
+def run_case(case: ResolvedCase) -> dict:
+    """Run one resolved case; never raises: failures come back as a failed row.
+
+    The row also holds, under :data:`HISTORY_KEY`, the decimated time history of
+    the case (:func:`case_history`); :func:`~flexsat.campaigns.runner.run_campaign`
+    stores it apart from the table. A case that fails before simulating has no history.
+
+    Parameters
+    ----------
+    case : ResolvedCase
+        The case to fly.
+
+    Returns
+    -------
+    dict
+        The case's row: ``case_id``, ``status``, ``message``, ``parameters``,
+        ``inputs``, ``metrics`` (:func:`flexsat.analysis.slew_metrics`, SI or the
+        key's unit), ``case_wall_time_s`` and ``case_cpu_time_s`` (the case's own
+        wall and CPU time [s]).
+    """
+    from flexsat.simulate import run_slew
+
+    row = case_row(case)
+    start, cpu = time.perf_counter(), time.process_time()
+    if case.error:  # refused while streaming: a failed row, nothing to run
+        row.update(status="failed", error=case.error, metrics={}, case_wall_time_s=0.0,
+                   case_cpu_time_s=0.0)  # fmt: skip
+        return row
+    try:
+        plant, scenario = case_inputs(case)
+        finish_row(row, run_slew(plant, scenario, progress=False))
+    except Exception as exc:  # a failed case is data, not a crash of the campaign
+        fail_row(row, exc)
+    row["case_wall_time_s"] = time.perf_counter() - start
+    # the process's CPU: a worker (or this process) runs one case at a time
+    row["case_cpu_time_s"] = time.process_time() - cpu
+    return row

@@ -1,7 +1,7 @@
 """Set-up of the worker processes of the Dask LocalCluster a campaign starts.
 
 Dask imports this module in each worker process before the worker registers (its
-``preload``, given by :func:`flexsat.campaigns.runner._dask_client`). Workers of a
+``preload``, given by :func:`flexsat.campaigns.backends._dask_client`). Workers of a
 cluster the user runs (``--scheduler``) are theirs and are left alone.
 """
 

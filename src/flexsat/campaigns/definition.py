@@ -6,7 +6,14 @@ Cases come from any combination of:
 - ``[grid]``: the cartesian product of ``[[grid.axes]]``, each axis a list of
   levels (a label and modifiers); ``grid.common`` applies to every grid case;
 - ``[random]``: ``n`` cases whose modifiers draw from distributions, one stream
-  per case spawned from ``root_seed`` (``numpy.random.SeedSequence(root).spawn``).
+  per case spawned from ``root_seed`` (``numpy.random.SeedSequence(root).spawn``);
+- ``[sobol]``: Saltelli's sample of a box of parameters (:mod:`flexsat.campaigns.sobol`);
+
+or from a search that runs alone (``[worst_case]``, :mod:`flexsat.campaigns.worstcase`).
+Each is a campaign kind (:mod:`flexsat.campaigns.kinds`): the cases come from the
+registered kinds whose table the campaign has, looked up, never named here but where
+the built-ins register. The shipped presets are the TOML files of the ``presets``
+folder (:func:`campaign_presets`).
 
 ``plant`` modifiers act on the satellite config, ``scenario`` modifiers on the slew
 scenario. Cases are resolved in the parent process, one at a time as the runner
@@ -26,11 +33,12 @@ from collections.abc import Iterator
 from dataclasses import dataclass
 from importlib import resources
 from pathlib import Path
-from typing import Annotated, Literal
+from typing import Annotated, Any, Literal
 
 import numpy as np
 from pydantic import Field, field_validator, model_validator
 
+from flexsat.campaigns.kinds import KINDS, CampaignKind, CaseSource, register_kind
 from flexsat.campaigns.modifiers import Modifier, ModifierError, apply_modifiers
 from flexsat.config.load import read_toml, validate_config
 from flexsat.config.models import SatelliteConfig, _Frozen
@@ -51,6 +59,7 @@ __all__ = [
     "SobolCases",
     "WorstCaseSearch",
     "campaign_fingerprint",
+    "campaign_presets",
     "describe_counts",
     "dispersed_modifiers",
     "load_campaign",
@@ -59,7 +68,23 @@ __all__ = [
     "sobol_samples",
 ]
 
-CAMPAIGN_PRESETS = ("sensitivity", "montecarlo-critical", "deployment-shock", "montecarlo-random")
+PRESETS_DIR = Path(str(resources.files("flexsat.campaigns") / "presets"))
+"""The folder of the shipped campaign presets: each ``<name>.toml`` is the preset ``name``."""
+
+
+def campaign_presets() -> tuple[str, ...]:
+    """Names of the shipped campaign presets: the TOML files of :data:`PRESETS_DIR`.
+
+    Returns
+    -------
+    tuple of str
+        The file names without ``.toml``, sorted.
+    """
+    return tuple(sorted(path.stem for path in PRESETS_DIR.glob("*.toml")))
+
+
+CAMPAIGN_PRESETS = campaign_presets()
+"""The presets shipped with flexsat, as :func:`campaign_presets` found them on import."""
 
 
 class CaseSpec(_Frozen):
@@ -235,8 +260,9 @@ class Reduced(_Frozen):
         0.02, description="control period [s] (a whole multiple of dt_s)"
     )
     record_dt_s: Annotated[float, Field(gt=0.0, le=10.0, allow_inf_nan=False)] | None = Field(
-        None, description="record period [s] (a whole multiple of dt_s; default two "
-        "steps; a longer base record period is kept)"
+        None,
+        description="record period [s] (a whole multiple of dt_s; default two "
+        "steps; a longer base record period is kept)",
     )
 
     @model_validator(mode="after")
@@ -270,19 +296,66 @@ class CampaignDefinition(_Frozen):
         None, description="search the parameters' box for the worst case (runs alone)"
     )
     reduced: Reduced | None = Field(None, description="fly every case on a reduced model")
+    other_kinds: dict[str, Any] = Field(
+        default_factory=dict, exclude=True,
+        description="the tables of registered kinds that are not built in, by kind name",
+    )  # fmt: skip
+
+    @model_validator(mode="before")
+    @classmethod
+    def _other_kinds(cls, data: Any) -> Any:
+        """Move the table of a registered kind that is not a declared field into
+        ``other_kinds``, validated by the kind's model."""
+        if not isinstance(data, dict):
+            return data
+        names = [n for n in KINDS.names() if n not in cls.model_fields and n in data]
+        if not names:
+            return data
+        data = dict(data)
+        other = dict(data.get("other_kinds") or {})
+        for name in names:
+            table = data.pop(name)
+            other[name] = KINDS.get(name).config.model_validate(table)
+        data["other_kinds"] = other
+        return data
 
     @model_validator(mode="after")
     def _has_cases(self) -> CampaignDefinition:
-        if self.worst_case is not None and (self.cases or self.grid or self.random or self.sobol):
-            raise ValueError("a worst_case search runs alone: no cases, grid, random or sobol")
-        if not (self.cases or self.grid or self.random or self.sobol or self.include_nominal):
+        tables = self.tables()
+        searches = [KINDS.get(n) for n in tables if KINDS.get(n).search is not None]
+        if searches and len(tables) > 1:
+            others = [n for n in KINDS.names() if n != searches[0].name]
+            listed = ", ".join(others[:-1]) + f" or {others[-1]}" if len(others) > 1 else others[0]
+            raise ValueError(f"a {searches[0].name} search runs alone: no {listed}")
+        if not (tables or self.include_nominal):
             raise ValueError("a campaign needs cases, a grid, random or Sobol cases or the nominal")
         validate_config(self.base, source="base", model=SlewScenario)
         return self
 
+    def tables(self) -> dict[str, Any]:
+        """The campaign's kinds: each registered kind's table it has, in registration order.
+
+        Returns
+        -------
+        dict
+            Kind name (:mod:`flexsat.campaigns.kinds`) to its validated table (for
+            ``cases``, the non-empty list of explicit cases).
+        """
+        out = {}
+        for name in KINDS.names():
+            table = getattr(self, name) if name in type(self).model_fields else (
+                self.other_kinds.get(name))  # fmt: skip
+            if table is not None and not (isinstance(table, list) and not table):
+                out[name] = table
+        return out
+
     def fingerprint(self) -> str:
         """Hash of the definition, to refuse resuming a store made by another one."""
-        text = json.dumps(self.model_dump(mode="json"), sort_keys=True)
+        data = self.model_dump(mode="json")
+        if self.other_kinds:  # absent otherwise: a built-in campaign's hash is unchanged
+            data["other_kinds"] = {k: v.model_dump(mode="json")
+                                   for k, v in self.other_kinds.items()}  # fmt: skip
+        text = json.dumps(data, sort_keys=True)
         return hashlib.sha256(text.encode()).hexdigest()[:16]
 
 
@@ -338,8 +411,7 @@ def describe_counts(counts: dict[str, int]) -> str:
     str
         The total and its parts.
     """
-    words = {"listed": "listed", "grid": "from the grid", "random": "drawn",
-             "sobol": "from Saltelli's sample"}  # fmt: skip
+    words = {kind.count_key: kind.words or f"from {kind.name}" for kind in KINDS}
     parts = [f"{counts[key]} {word}" for key, word in words.items() if counts.get(key)]
     if counts.get("nominal"):
         parts.append("the nominal")
@@ -353,8 +425,6 @@ def _digest(data) -> str:
 
 HEAD_CASES = 100
 """Cases resolved before a campaign starts: their digest is the store's ``case_inputs``."""
-
-_STREAMED_ID = re.compile(r"(random|sobol)-(\d{5,})")
 
 
 class CaseStream:
@@ -378,7 +448,8 @@ class CaseStream:
     satellite : SatelliteConfig
         Its base satellite.
     n_random : int, optional
-        Random cases to draw; default the definition's ``[random] n``.
+        Random cases to draw (``--cases``, handed to every kind); default the
+        definition's ``[random] n``.
     strict : bool
         Raise on a refused case instead of yielding it with its ``error``.
 
@@ -410,27 +481,26 @@ class CaseStream:
         self._scenario_base = scenario_base
         self._n_dof = Plant.from_config(satellite).n_dof  # modifiers change values only
         self._sized: set[tuple] = set()
+        # each kind of the campaign that generates cases, its source, in registration order
+        self._kinds: list[tuple[CampaignKind, CaseSource]] = [
+            (kind, kind.cases(table, n_random))
+            for kind, table in ((KINDS.get(n), t) for n, t in definition.tables().items())
+            if kind.cases is not None
+        ]  # fmt: skip
         self._fixed = self._fixed_specs()
-        self.n_random = 0
-        if definition.random is not None:
-            self.n_random = definition.random.n if n_random is None else n_random
-            if self.n_random < 1:
-                raise ConfigError(f"--cases must be >= 1, got {self.n_random}")
-        self._sobol = None if definition.sobol is None else sobol_samples(definition.sobol)
         # the streamed sources: (case count, spec of its k-th case)
-        self._sources = [(self.n_random, self._random_spec)]
-        if self._sobol is not None:
-            self._sources.append((len(self._sobol), self._sobol_spec))
+        self._sources = [(src.count, src.spec) for kind, src in self._kinds if kind.streamed]
+        streamed = {kind.id_prefix: src.count for kind, src in self._kinds if kind.streamed}
         ids = [spec[0] for spec in self._fixed]
-        counts = {"random": self.n_random, "sobol": 0 if self._sobol is None else len(self._sobol)}
-        clash = [i for i in ids if (m := _STREAMED_ID.fullmatch(i)) and int(m[2]) < counts[m[1]]]
+        drawn_id = re.compile(rf"({'|'.join(map(re.escape, streamed)) or '(?!)'})-(\d{{5,}})")
+        clash = [i for i in ids if (m := drawn_id.fullmatch(i)) and int(m[2]) < streamed[m[1]]]
         counted = collections.Counter(ids)
         repeated = sorted({i for i, n in counted.items() if n > 1} | set(clash))
         if repeated:
             shown = ", ".join(map(repr, repeated[:5])) + (" ..." if len(repeated) > 5 else "")
+            own = " and ".join(f"{kind.id_prefix}-NNNNN" for kind in KINDS if kind.streamed)
             raise ConfigError(f"campaign {definition.name}: duplicate case ids: {shown} (each "
-                              "case id once; random-NNNNN and sobol-NNNNN are the drawn "
-                              "cases' own)")  # fmt: skip
+                              f"case id once; {own} are the drawn cases' own)")  # fmt: skip
         self.head = [self.resolve(spec) for spec in self._fixed]
         n_head = min(self._n_streamed, max(1, HEAD_CASES - len(self.head)))
         self.head += [self.resolve(self._streamed_spec(i)) for i in range(n_head)]
@@ -441,13 +511,15 @@ class CaseStream:
         Returns
         -------
         dict
-            ``nominal`` (0 or 1), ``listed`` (``[[cases]]``), ``grid``, ``random``
-            (drawn, ``--cases``) and ``sobol`` (Saltelli's sample).
+            ``nominal`` (0 or 1), then each registered kind that generates cases by its
+            :attr:`~flexsat.campaigns.kinds.CampaignKind.count_key`: ``listed``
+            (``[[cases]]``), ``grid``, ``random`` (drawn, ``--cases``), ``sobol``
+            (Saltelli's sample)..., 0 for a kind the campaign does not have.
         """
-        nominal, listed = int(self.definition.include_nominal), len(self.definition.cases)
-        return {"nominal": nominal, "listed": listed,
-                "grid": len(self._fixed) - nominal - listed, "random": self.n_random,
-                "sobol": 0 if self._sobol is None else len(self._sobol)}  # fmt: skip
+        sources = {kind.name: src.count for kind, src in self._kinds}
+        counts = {"nominal": int(self.definition.include_nominal)}
+        counts |= {kind.count_key: sources.get(kind.name, 0) for kind in KINDS if kind.cases}
+        return counts
 
     @property
     def _n_streamed(self) -> int:
@@ -476,31 +548,15 @@ class CaseStream:
         raise IndexError(i)
 
     def _fixed_specs(self) -> list[tuple[str, tuple[int, int], list, list]]:
-        """(id, (root seed, index) of its random stream, plant and scenario modifiers)."""
-        definition = self.definition
+        """(id, (root seed, index) of its random stream, plant and scenario modifiers)
+        of the nominal and of every case of the kinds that are not streamed."""
         specs: list[tuple[str, tuple[int, int], list[Modifier], list[Modifier]]] = []
-        if definition.include_nominal:
+        if self.definition.include_nominal:
             specs.append(("nominal", (0, 0), [], []))
-        specs += [(c.id, (0, k), c.plant, c.scenario) for k, c in enumerate(definition.cases)]
-        if definition.grid is not None:
-            grid = definition.grid
-            for k, levels in enumerate(itertools.product(*(axis.levels for axis in grid.axes))):
-                case_id = "+".join(level.label for level in levels)
-                plant = [*grid.common.plant, *(m for lv in levels for m in lv.plant)]
-                scenario = [*grid.common.scenario, *(m for lv in levels for m in lv.scenario)]
-                specs.append((case_id, (grid.seed, k), plant, scenario))
+        for kind, source in self._kinds:
+            if not kind.streamed:
+                specs += [source.spec(k) for k in range(source.count)]
         return specs
-
-    def _random_spec(self, i: int) -> tuple[str, tuple[int, int], list, list]:
-        rnd = self.definition.random
-        return (f"random-{i:05d}", (rnd.root_seed, i), rnd.plant, rnd.scenario)
-
-    def _sobol_spec(self, i: int) -> tuple[str, tuple[int, int], list, list]:
-        """The i-th row of Saltelli's sample, each parameter a modifier of the plant
-        (paths under ``hub`` and ``appendages``) or of the scenario (the others)."""
-        sobol = self.definition.sobol
-        return (f"sobol-{i:05d}", (sobol.seed, i), *dispersed_modifiers(sobol.parameters,
-                                                                       self._sobol[i]))
 
     def resolve(self, spec) -> ResolvedCase:
         """Resolve one case from ``(id, (root seed, index), plant mods, scenario mods)``."""
@@ -658,8 +714,7 @@ def load_campaign(name_or_path: str | Path) -> CampaignDefinition:
     Parameters
     ----------
     name_or_path : str or Path
-        A preset name (``sensitivity``, ``montecarlo-critical``, ``deployment-shock``,
-        ``montecarlo-random``) or the path of a campaign TOML file.
+        A preset name (:func:`campaign_presets`) or the path of a campaign TOML file.
 
     Returns
     -------
@@ -670,14 +725,15 @@ def load_campaign(name_or_path: str | Path) -> CampaignDefinition:
     ConfigError
         If no preset has that name and no such file exists, or the file is invalid.
     """
-    if str(name_or_path) in CAMPAIGN_PRESETS:
-        path = Path(str(resources.files("flexsat.campaigns") / "presets" / f"{name_or_path}.toml"))
+    presets = campaign_presets()
+    if str(name_or_path) in presets:
+        path = PRESETS_DIR / f"{name_or_path}.toml"
     else:
         path = Path(name_or_path)
         if not path.exists():
             raise ConfigError(
                 f"campaign {str(name_or_path)!r} is neither a preset "
-                f"({', '.join(CAMPAIGN_PRESETS)}) nor a file"
+                f"({', '.join(presets)}) nor a file"
             )
     return validate_config(read_toml(path, "campaign"), source=str(path), model=CampaignDefinition)
 
@@ -711,3 +767,53 @@ def resolve_cases(
         Naming the case and the problem (unknown path, invalid resulting value).
     """
     return list(CaseStream(definition, satellite, n_random, strict=True))
+
+
+# The built-in kinds that generate cases, each its cases and one registration line
+# (Sobol's and the worst-case search register in flexsat.campaigns.sobol and
+# flexsat.campaigns.worstcase).
+
+
+def _listed_cases(cases: list[CaseSpec], n_cases: int | None) -> CaseSource:
+    """``[[cases]]``: each explicit case, stream (0, k)."""
+    return CaseSource(len(cases), lambda k: (cases[k].id, (0, k), cases[k].plant,
+                                             cases[k].scenario))  # fmt: skip
+
+
+def _grid_cases(grid: Grid, n_cases: int | None) -> CaseSource:
+    """``[grid]``: the cartesian product of the axes' levels, stream (seed, k)."""
+    crossed = list(itertools.product(*(axis.levels for axis in grid.axes)))
+
+    def spec(k: int) -> tuple[str, tuple[int, int], list, list]:
+        levels = crossed[k]
+        plant = [*grid.common.plant, *(m for lv in levels for m in lv.plant)]
+        scenario = [*grid.common.scenario, *(m for lv in levels for m in lv.scenario)]
+        return ("+".join(level.label for level in levels), (grid.seed, k), plant, scenario)
+
+    return CaseSource(len(crossed), spec)
+
+
+def _random_cases(rnd: RandomCases, n_cases: int | None) -> CaseSource:
+    """``[random]``: ``n`` (or ``--cases``) draws, stream (root_seed, k)."""
+    n = rnd.n if n_cases is None else n_cases
+    if n < 1:
+        raise ConfigError(f"--cases must be >= 1, got {n}")
+    return CaseSource(n, lambda k: (f"random-{k:05d}", (rnd.root_seed, k), rnd.plant,
+                                    rnd.scenario))  # fmt: skip
+
+
+register_kind(CampaignKind("cases", CaseSpec, "explicit cases, one by one", _listed_cases,
+                           counted_as="listed", words="listed"))  # fmt: skip
+register_kind(CampaignKind("grid", Grid, "the levels of several axes, crossed", _grid_cases,
+                           words="from the grid"))  # fmt: skip
+register_kind(
+    CampaignKind(
+        "random",
+        RandomCases,
+        "Monte Carlo draws from distributions",
+        _random_cases,
+        streamed=True,
+        id_prefix="random",
+        words="drawn",
+    )
+)

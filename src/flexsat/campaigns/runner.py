@@ -1,4 +1,4 @@
-"""Running campaign cases: a local process pool (default) or a Dask cluster.
+"""Running a campaign into its store: the cases, their rows and histories, the signals.
 
 Cases are resolved in the parent, streamed as the backend consumes them
 (:class:`~flexsat.campaigns.definition.CaseStream`), so every backend and worker
@@ -6,31 +6,26 @@ count runs the same inputs and the stored rows are identical bit for bit.
 A case that raises or diverges is stored as failed with its message; the campaign
 goes on. Ctrl-C or SIGTERM stops the run at once (pending cases cancelled, workers
 stopped) and says how many cases are stored and how to resume.
+
+The backends that fly the cases (local pool, ensemble, Dask) are in
+:mod:`flexsat.campaigns.backends`, a case's row in :mod:`flexsat.campaigns.cases`, the
+summary in :mod:`flexsat.campaigns.summary` and the replay of one case in
+:mod:`flexsat.campaigns.replay`; their public names are importable from here too.
+A campaign whose kind searches (:mod:`flexsat.campaigns.kinds`) is handed to the kind.
 """
 
 from __future__ import annotations
 
 import contextlib
-import itertools
-import math
-import os
-import re
 import signal
 import time
-from collections.abc import Iterable, Iterator
+from collections.abc import Iterator
 from pathlib import Path
 
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
 
-from flexsat.campaigns.cases import (
-    HISTORY_DT_S,
-    HISTORY_KEY,
-    case_history,
-    case_inputs,
-    case_row,
-    fail_row,
-    finish_row,
-)
+from flexsat.campaigns.backends import RUNNERS, backend, run_batch
+from flexsat.campaigns.cases import HISTORY_DT_S, HISTORY_KEY, case_history, run_case
 from flexsat.campaigns.definition import (
     CampaignDefinition,
     CaseDigest,
@@ -38,10 +33,12 @@ from flexsat.campaigns.definition import (
     ResolvedCase,
     campaign_fingerprint,
 )
+from flexsat.campaigns.kinds import KINDS
+from flexsat.campaigns.replay import replay_case
 from flexsat.campaigns.store import HISTORY_UNITS, CampaignStore
+from flexsat.campaigns.summary import SUMMARY_ROWS, WORST_BY, WORST_CASES, summarize
 from flexsat.config.models import SatelliteConfig
-from flexsat.errors import ConfigError, FlexsatError, shorten
-from flexsat.pool import LocalPool
+from flexsat.errors import ConfigError, FlexsatError
 
 __all__ = [
     "HISTORY_DT_S",
@@ -61,222 +58,7 @@ __all__ = [
 ]
 
 
-RUNNERS = ("pool", "ensemble")
-"""Local runners of :func:`run_campaign`."""
-
 _DRAW_S = 0.1  # s between redraws of the progress bar (rich's own rate, 10 per s)
-_CASE_ID = re.compile(r"^[A-Za-z0-9_+\-][A-Za-z0-9_.+\-]*$")
-
-
-def replay_case(store: str | Path, case_id: str):
-    """Re-run one stored case alone from its stored inputs.
-
-    Parameters
-    ----------
-    store : str or Path
-        The campaign's store folder.
-    case_id : str
-        The id of the case (a row of ``results.parquet``).
-
-    Returns
-    -------
-    Result
-        The case's slew, as :func:`flexsat.simulate.run_slew` returns it.
-
-    Raises
-    ------
-    ConfigError
-        ``store`` holds no campaign, ``case_id`` is not a case id (no path
-        separators) or not in the store, or its stored inputs are refused.
-    """
-    from flexsat.config.load import validate_config
-    from flexsat.dynamics.plant import Plant
-    from flexsat.simulate import SlewScenario, run_slew
-
-    store = CampaignStore(store)
-    if not (store.root / "campaign.json").is_file():
-        raise ConfigError(f"{store.root} is not a campaign store (no campaign.json)")
-    if not _CASE_ID.match(case_id):
-        raise ConfigError(
-            f"{shorten(repr(case_id))} is not a case id (letters, digits and _ . + -)"
-        )
-    path = store.cases_dir / f"{case_id}.json"
-    if not path.exists():
-        raise ConfigError(f"no case {case_id!r} in {store.root}")
-    row = store.row(case_id)
-    inputs = row.get("inputs") or {}
-    source = f"case {case_id!r}"
-    plant = Plant.from_config(validate_config(inputs.get("plant"), source=f"{source} (plant)"))
-    scenario = validate_config(
-        inputs.get("scenario"), source=f"{source} (scenario)", model=SlewScenario
-    )
-    return run_slew(plant, scenario)
-
-
-WORST_CASES = 5
-"""Worst cases listed per requirement and for the pointing error."""
-
-WORST_BY = (
-    ("R1", "r1_pass", "ape_deg", "deg"),
-    ("R2", "r2_pass", "max_rate_error_deg_s", "deg/s"),
-    ("R3", "r3_pass", "max_commanded_torque_nm", "N m"),
-    ("pointing", None, "final_pointing_error_deg", "deg"),
-)
-"""What the worst cases are ranked by: (name, verdict key or None, metric, unit). R1 by
-the absolute pointing error over the window, R2 by the largest residual rate over it,
-R3 by the peak commanded torque (the largest axis), the pointing error at the end."""
-
-
-SUMMARY_ROWS = (
-    ("cases", "cases stored"),
-    ("computed_this_run", "computed by this run"),
-    ("resumed_this_run", "resumed from the store by this run"),
-    ("failed", "failed cases (stopped or refused)"),
-    ("r1_pass_rate", "R1 pass rate (absolute pointing)"),
-    ("r2_pass_rate", "R2 pass rate (residual rate)"),
-    ("r3_pass_rate", "R3 pass rate (torque limit)"),
-    ("worst_final_pointing_error_deg", "worst final pointing error [deg]"),
-    ("cpu_time_s", "CPU time of the stored cases [s]"),
-    ("case_wall_time_s", "wall time of the stored cases, summed [s]"),
-    ("campaign_wall_time_s", "wall time of every run into the store [s]"),
-    ("runs", "runs recorded in the store"),
-    ("run_wall_time_s", "wall time of this run [s]"),
-)
-"""The rows of a campaign's summary table (CLI and report): key in the summary, and
-the label that says what it counts."""
-
-
-def summarize(store: str | Path) -> dict:
-    """Pass rates, the worst cases and the cost of a stored campaign.
-
-    Parameters
-    ----------
-    store : str or Path
-        The campaign's store folder.
-
-    Returns
-    -------
-    dict
-        ``cases`` (stored), ``failed``, the pass rate of each requirement
-        (``r1_pass_rate``..., fractions in [0, 1]), ``worst_by_requirement`` (for R1,
-        R2, R3 and the final pointing error, :data:`WORST_BY`: the metric, its unit,
-        the failing count and the :data:`WORST_CASES` worst cases, failing ones first,
-        then by the metric, largest first: ``case_id``, ``value``, ``passes``) and
-        ``worst_cases``, those by final pointing error alone [deg]. ``cpu_time_s``: the
-        stored cases' own CPU time, summed [s] (a case stored without it counts its
-        wall time); ``case_wall_time_s``: their own wall times, summed [s] (what a
-        run stopped before recording itself spent is in both);
-        ``campaign_wall_time_s``: the wall times of the runs recorded in the store,
-        summed [s] (``runs`` of them). Also ``requirements`` (per
-        requirement: passes, the exact 95 % interval of the pass rate and the failing
-        case ids), ``metrics`` (per metric: min, 5/50/95 %, max) and
-        ``cases_for_3sigma_at_95`` (the cases needed, with no failure, to claim
-        99.73 % at 95 % confidence); see :mod:`flexsat.campaigns.statistics`.
-    """
-    from flexsat.campaigns.statistics import (
-        cases_needed,
-        metric_statistics,
-        requirement_statistics,
-    )
-
-    opened = CampaignStore(store)
-    table = opened.table()
-    rows = opened.rows()
-    n = len(rows)
-
-    def rate(key: str) -> float:
-        return sum(bool(r["metrics"].get(key)) for r in rows) / n if n else float("nan")
-
-    def seconds(row: dict, key: str) -> float:
-        value = row.get(key, row.get("case_wall_time_s"))
-        return value if isinstance(value, int | float) and math.isfinite(value) else 0.0
-
-    worst_by = [_worst(rows, *spec) for spec in WORST_BY]
-    pointing = [c for c in worst_by[-1]["cases"] if c["value"] is not None]
-    worst_cases = [
-        {"case_id": c["case_id"], "final_pointing_error_deg": c["value"]} for c in pointing
-    ]
-    runs = opened.runs()
-    return {
-        "cases": n,
-        "failed": sum(r["status"] != "ok" for r in rows),
-        "r1_pass_rate": rate("r1_pass"),
-        "r2_pass_rate": rate("r2_pass"),
-        "r3_pass_rate": rate("r3_pass"),
-        "worst_final_pointing_error_deg": pointing[0]["value"] if pointing else float("nan"),
-        "worst_cases": worst_cases,
-        "worst_by_requirement": worst_by,
-        "cpu_time_s": sum(seconds(r, "case_cpu_time_s") for r in rows),
-        "case_wall_time_s": sum(seconds(r, "case_wall_time_s") for r in rows),
-        "campaign_wall_time_s": sum(float(r.get("wall_time_s", 0.0)) for r in runs),
-        "runs": len(runs),
-        "requirements": requirement_statistics(table).to_dict("records") if n else [],
-        "metrics": metric_statistics(table).to_dict("records") if n else [],
-        "cases_for_3sigma_at_95": cases_needed(0.9973, 0.95),
-    }
-
-
-def _worst(rows: list[dict], name: str, verdict: str | None, metric: str, unit: str) -> dict:
-    """The worst cases by one requirement (see :data:`WORST_BY`)."""
-    ranked = []
-    for row in rows:
-        ok = row["status"] == "ok"
-        value = row["metrics"].get(metric) if ok else None
-        if isinstance(value, list):  # per axis: the largest
-            value = max(value) if value else None
-        if not isinstance(value, int | float) or not math.isfinite(value):
-            value = None
-        passes = None if verdict is None else bool(ok and row["metrics"].get(verdict))
-        if verdict is None and value is None:
-            continue  # no value to rank by
-        # failing first, then the largest value; a case without a value after those with one
-        ranked.append(((passes is True, value is None, -(value or 0.0), row["case_id"]),
-                       {"case_id": row["case_id"], "value": value, "passes": passes}))  # fmt: skip
-    ranked.sort(key=lambda item: item[0])
-    return {
-        "requirement": name, "verdict": verdict, "metric": metric, "unit": unit,
-        "failing": sum(entry["passes"] is False for _, entry in ranked),
-        "cases": [entry for _, entry in ranked[:WORST_CASES]],
-    }  # fmt: skip
-
-
-def run_case(case: ResolvedCase) -> dict:
-    """Run one resolved case; never raises: failures come back as a failed row.
-
-    The row also holds, under :data:`HISTORY_KEY`, the decimated time history of
-    the case (:func:`case_history`); :func:`run_campaign` stores it apart from the
-    table. A case that fails before simulating has no history.
-
-    Parameters
-    ----------
-    case : ResolvedCase
-        The case to fly.
-
-    Returns
-    -------
-    dict
-        The case's row: ``case_id``, ``status``, ``message``, ``parameters``,
-        ``inputs``, ``metrics`` (:func:`flexsat.analysis.slew_metrics`, SI or the
-        key's unit), ``case_wall_time_s`` and ``case_cpu_time_s`` (the case's own
-        wall and CPU time [s]).
-    """
-    from flexsat.simulate import run_slew
-
-    row = case_row(case)
-    start, cpu = time.perf_counter(), time.process_time()
-    if case.error:  # refused while streaming: a failed row, nothing to run
-        row.update(status="failed", error=case.error, metrics={}, case_wall_time_s=0.0,
-                   case_cpu_time_s=0.0)  # fmt: skip
-        return row
-    try:
-        plant, scenario = case_inputs(case)
-        finish_row(row, run_slew(plant, scenario, progress=False))
-    except Exception as exc:  # a failed case is data, not a crash of the campaign
-        fail_row(row, exc)
-    row["case_wall_time_s"] = time.perf_counter() - start
-    # the process's CPU: a worker (or this process) runs one case at a time
-    row["case_cpu_time_s"] = time.process_time() - cpu
-    return row
 
 
 class CampaignInterrupted(FlexsatError):
@@ -331,9 +113,9 @@ def run_campaign(
         ``cases``, ``case_counts`` (:meth:`CaseStream.counts`), ``ran`` (computed by
         this call), ``resumed`` (found stored by this call), ``failed``,
         ``wall_time_s`` (this call's; each run's is also recorded in the store,
-        :meth:`CampaignStore.record_run`), the store paths; for a
-        ``[worst_case]`` search, what :func:`~flexsat.campaigns.worstcase.run_worst_case`
-        returns (the worst case found).
+        :meth:`CampaignStore.record_run`), the store paths; for a kind that searches
+        (``[worst_case]``), what its search returns
+        (:func:`~flexsat.campaigns.worstcase.run_worst_case`: the worst case found).
 
     Raises
     ------
@@ -348,13 +130,12 @@ def run_campaign(
     """
     if runner not in RUNNERS:
         raise ConfigError(f"runner: {runner!r} is not one of {', '.join(RUNNERS)}")
-    if definition.worst_case is not None:  # a search, not a fixed set of cases
-        from flexsat.campaigns.worstcase import run_worst_case
-
-        return run_worst_case(definition, definition.worst_case, satellite, out,
-                              workers=workers, resume=resume, scheduler=scheduler,
-                              dask_local=dask_local, runner=runner,
-                              backend=_backend)  # fmt: skip
+    for name, table in definition.tables().items():
+        kind = KINDS.get(name)
+        if kind.search is not None:  # a search, not a fixed set of cases: it runs alone
+            return kind.search(definition, table, satellite, out, workers=workers,
+                               resume=resume, scheduler=scheduler, dask_local=dask_local,
+                               runner=runner, backend=backend)  # fmt: skip
     store = CampaignStore(out)
     if store.root.exists() and not store.root.is_dir():
         raise ConfigError(f"--out {store.root}: exists and is not a folder")
@@ -367,8 +148,11 @@ def run_campaign(
     with _Interrupts() as interrupts:
         try:
             cases = CaseStream(definition, satellite, n_random)  # checks what it can up front
-            with _backend(workers, scheduler, dask_local, runner) as execute, store.opened(
-                campaign_fingerprint(definition, satellite, cases), definition.name, resume
+            with (
+                backend(workers, scheduler, dask_local, runner) as execute,
+                store.opened(
+                    campaign_fingerprint(definition, satellite, cases), definition.name, resume
+                ),
             ):
                 todo = _Todo(cases, store)
                 columns = (TextColumn(f"campaign {definition.name}"), BarColumn(),
@@ -417,8 +201,12 @@ def run_campaign(
     }
 
 
-def _interrupted(definition: CampaignDefinition, store: CampaignStore,
-                 cases: CaseStream | None, stop: _Interrupted) -> CampaignInterrupted:
+def _interrupted(
+    definition: CampaignDefinition,
+    store: CampaignStore,
+    cases: CaseStream | None,
+    stop: _Interrupted,
+) -> CampaignInterrupted:
     """The error of a campaign stopped by a signal: what is stored and how to resume."""
     if cases is None:
         where = "while preparing its cases, before any ran; run the same command to start it"
@@ -523,151 +311,3 @@ class _Interrupts:
             self.deferring = False
             if self.pending is not None:
                 raise _Interrupted(self.pending)
-
-
-def _lost_case(case: ResolvedCase, exitcode: int | None) -> dict:
-    """The failed row of a case whose worker process died running it (twice)."""
-    return {
-        **case_row(case),
-        "status": "failed",
-        "error": f"its worker process died running it (exit code {exitcode}), twice",
-        "metrics": {},
-        "case_wall_time_s": float("nan"),
-        "case_cpu_time_s": float("nan"),
-    }
-
-
-@contextlib.contextmanager
-def _backend(workers, scheduler, dask_local, runner="pool"):
-    """Connect to (or start) the backend, then yield ``execute(cases, size) -> rows``
-    (``size``: at most how many cases will come, to size the pool)."""
-    if scheduler or dask_local:
-        with _dask_client(scheduler, dask_local) as client:
-            yield lambda todo, size: _dask(client, todo, size)
-        return
-    workers = workers or os.cpu_count() or 1
-    if runner == "ensemble":
-        from flexsat.campaigns.ensemble import run_ensemble
-
-        yield lambda todo, size: run_ensemble(todo, threads=workers)
-        return
-
-    def execute(todo: Iterable[ResolvedCase], size: int) -> Iterator[dict]:
-        source = iter(todo)
-        first = list(itertools.islice(source, 2))  # no workers for one case or none
-        if workers == 1 or len(first) <= 1:
-            for case in itertools.chain(first, source):
-                yield run_case(case)
-            return
-        n = min(workers, size)
-        with LocalPool(run_case, n, _lost_case) as pool:
-            yield from pool.map_unordered(itertools.chain(first, source))
-
-    yield execute
-
-
-QUIET_DASK = {
-    "distributed.worker.profile.enabled": False,  # the dashboard's sampler, every 10 ms
-    "distributed.admin.tick.interval": "1s",  # the event loops' block detector, 20 ms
-    "distributed.admin.system-monitor.interval": "5s",  # dashboard metrics, 500 ms
-    "distributed.scheduler.work-stealing": False,  # a window of tasks per thread: balanced
-}
-"""Dask settings of a campaign's cluster and client. Dask's defaults feed its
-dashboard, which a campaign does not start: an idle LocalCluster of 2 workers took
-3.5 CPU-s per 30 s on its own (12 % of a core), 1.0 CPU-s with these
-(CHANGELOG.md, 'Dask: a quiet cluster')."""
-
-
-@contextlib.contextmanager
-def _dask_client(scheduler, dask_local):
-    import dask
-    from dask.distributed import Client, LocalCluster
-
-    with dask.config.set(QUIET_DASK):  # the workers of a LocalCluster inherit them
-        cluster = None
-        if scheduler is None:
-            cluster = LocalCluster(
-                n_workers=dask_local, threads_per_worker=1, processes=True,
-                host="127.0.0.1", dashboard_address=None,
-                preload=["flexsat.campaigns.dask_worker"],
-            )  # fmt: skip
-        try:
-            client = Client(cluster if cluster is not None else scheduler, timeout="10s")
-        except (OSError, TimeoutError, ValueError) as exc:
-            if cluster is not None:
-                cluster.close()
-            raise ConfigError(
-                f"cannot connect to the Dask scheduler {scheduler}: {exc}"
-            ) from None
-        try:
-            yield client
-        finally:
-            client.close()
-            if cluster is not None:
-                cluster.close()
-
-
-DASK_BATCH = 32
-"""Cases per Dask task, at most: a task's overhead (its scheduling, its transfer, the
-worker's event loop) is paid once per batch. Batches shrink as fewer than
-``4 * DASK_BATCH`` cases per worker thread remain to submit (:func:`_dask_batch`).
-1000 reduced cases on a LocalCluster of two workers took 34.2–37.6 s with 8 per task,
-30.8 s with 32 (CHANGELOG.md, 'Workers that start sooner')."""
-
-
-def _dask_batch(remaining: int, threads: int) -> int:
-    """Cases in the next Dask task when at most ``remaining`` cases are left to submit
-    to ``threads`` worker threads: at most :data:`DASK_BATCH`, and few enough that each
-    thread still gets four tasks. So a worker lost mid-run loses a task that another
-    re-runs, not the campaign's share, and the last tasks are short: the workers finish
-    together instead of one waiting for the other's last full batch."""
-    return max(1, min(DASK_BATCH, remaining // (4 * max(1, threads))))
-
-
-def run_batch(cases: list[ResolvedCase]) -> list[dict]:
-    """Rows of :func:`run_case` for each case, in one task (never raises): the batch
-    flown as one ensemble (:func:`flexsat.campaigns.ensemble.run_ensemble`, one thread).
-
-    Parameters
-    ----------
-    cases : list of ResolvedCase
-        The batch.
-
-    Returns
-    -------
-    list of dict
-        One row per case, in order.
-    """
-    from flexsat.campaigns.ensemble import run_ensemble
-
-    return list(run_ensemble(cases, threads=1, batch=len(cases)))
-
-
-def _dask(client, todo, size: int) -> Iterator[dict]:
-    """Batches of cases submitted as they are streamed, a few per worker in flight
-    (``size``: at most how many cases will come)."""
-    from dask.distributed import as_completed as dask_completed
-
-    source = iter(todo)
-    threads = max(1, sum(client.nthreads().values()))
-    window, submitted = 2 * threads, 0
-
-    def submit(completed) -> bool:
-        nonlocal submitted
-        batch = list(itertools.islice(source, _dask_batch(size - submitted, threads)))
-        submitted += len(batch)
-        if batch:
-            completed.add(client.submit(run_batch, batch, pure=False))
-        return bool(batch)
-
-    completed = dask_completed([])
-    try:
-        for _ in range(window):
-            if not submit(completed):
-                break
-        for future in completed:
-            yield from future.result()
-            future.release()
-            submit(completed)
-    finally:
-        client.cancel(list(completed.futures))

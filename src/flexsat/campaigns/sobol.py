@@ -14,11 +14,17 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from flexsat.campaigns.definition import SobolCases, sobol_problem
+from flexsat.campaigns.definition import (
+    SobolCases,
+    dispersed_modifiers,
+    sobol_problem,
+    sobol_samples,
+)
+from flexsat.campaigns.kinds import CampaignKind, CaseSource, register_kind
 from flexsat.campaigns.statistics import metric_columns
 from flexsat.campaigns.store import CampaignStore
 
-__all__ = ["analyze_sobol", "sobol_indices"]
+__all__ = ["SOBOL", "analyze_sobol", "sobol_indices"]
 
 
 def analyze_sobol(sobol: SobolCases, outputs: np.ndarray, seed: int = 0) -> pd.DataFrame:
@@ -78,3 +84,38 @@ def sobol_indices(store: str | Path, sobol: SobolCases) -> pd.DataFrame:
     out = pd.concat(frames, ignore_index=True) if frames else pd.DataFrame()
     out.attrs["skipped"] = skipped
     return out
+
+
+def _sobol_cases(sobol: SobolCases, n_cases: int | None) -> CaseSource:
+    """``[sobol]``: the k-th row of Saltelli's sample, each parameter a modifier of the
+    plant (paths under ``hub`` and ``appendages``) or of the scenario (the others)."""
+    samples = sobol_samples(sobol)
+    return CaseSource(
+        len(samples),
+        lambda k: (
+            f"sobol-{k:05d}",
+            (sobol.seed, k),
+            *dispersed_modifiers(sobol.parameters, samples[k]),
+        ),
+    )
+
+
+def _sobol_summary(store: Path, sobol: SobolCases) -> dict:
+    """The Sobol indices of every metric (:func:`sobol_indices`)."""
+    indices = sobol_indices(store, sobol)
+    return {"indices": indices.to_dict("records"), "skipped": indices.attrs["skipped"]}
+
+
+SOBOL = register_kind(
+    CampaignKind(
+        "sobol",
+        SobolCases,
+        "Saltelli's sample for Sobol indices",
+        _sobol_cases,
+        streamed=True,
+        id_prefix="sobol",
+        words="from Saltelli's sample",
+        summarize=_sobol_summary,
+    )
+)
+"""The ``[sobol]`` campaign kind (:mod:`flexsat.campaigns.kinds`)."""

@@ -28,11 +28,12 @@ from flexsat.campaigns.definition import (
     WorstCaseSearch,
     dispersed_modifiers,
 )
+from flexsat.campaigns.kinds import CampaignKind, register_kind
 from flexsat.campaigns.store import CampaignStore, _write_atomic
 from flexsat.config.models import SatelliteConfig
 from flexsat.errors import ConfigError
 
-__all__ = ["check_search", "run_worst_case"]
+__all__ = ["WORST_CASE", "check_search", "run_worst_case"]
 
 
 def run_worst_case(
@@ -73,8 +74,8 @@ def run_worst_case(
     backend : callable
         ``backend(workers, scheduler, dask_local, runner)``: a context manager that
         yields ``execute(cases, size) -> rows``, the one the campaign runner flies its
-        cases with (:func:`~flexsat.campaigns.runner.run_campaign` hands it in: it
-        calls this search, which so needs no import of the runner).
+        cases with (:func:`flexsat.campaigns.backends.backend`, which
+        :func:`~flexsat.campaigns.runner.run_campaign` hands in).
 
     Returns
     -------
@@ -97,13 +98,21 @@ def run_worst_case(
 
     with backend(workers, scheduler, dask_local, runner) as execute, store.opened(
             fingerprint, definition.name, resume):  # fmt: skip
+
         def evaluate(_, population) -> list[float]:
             cases = []
             for x in population:
                 k = state["evaluations"]
                 state["evaluations"] += 1
-                cases.append(stream.resolve((f"de-{k:05d}", (search.seed, k),
-                                             *dispersed_modifiers(search.parameters, x))))
+                cases.append(
+                    stream.resolve(
+                        (
+                            f"de-{k:05d}",
+                            (search.seed, k),
+                            *dispersed_modifiers(search.parameters, x),
+                        )
+                    )
+                )
             todo = [c for c in cases if store.stored_digest(c.case_id) != c.digest]
             for row in execute(todo, len(todo)):
                 history = row.pop(HISTORY_KEY, None)
@@ -195,3 +204,16 @@ def _search_digest(definition: CampaignDefinition, search: WorstCaseSearch) -> s
     text = json.dumps([definition.model_dump(mode="json"), search.model_dump(mode="json")],
                       sort_keys=True)  # fmt: skip
     return hashlib.sha256(text.encode()).hexdigest()[:16]
+
+
+def _worst_case_summary(store: Path, search: WorstCaseSearch) -> dict:
+    """What the search found, as ``worst_case.json`` records it (empty before it ends)."""
+    path = CampaignStore(store).root / "worst_case.json"
+    return json.loads(path.read_text()) if path.is_file() else {}
+
+
+WORST_CASE = register_kind(CampaignKind(
+    "worst_case", WorstCaseSearch, "differential evolution over a box, for the worst case",
+    search=run_worst_case, summarize=_worst_case_summary,
+))  # fmt: skip
+"""The ``[worst_case]`` campaign kind (:mod:`flexsat.campaigns.kinds`): a search."""
