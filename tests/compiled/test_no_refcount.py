@@ -10,7 +10,7 @@ from numba.core import cgutils
 from numba.core.runtime import _nrt_python, rtsys
 from numba.extending import intrinsic
 
-from flexsat.dynamics.borrowed import borrowed
+from flexsat.compiled.no_refcount import borrowed
 
 
 class _Inner(NamedTuple):

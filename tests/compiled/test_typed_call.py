@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from flexsat.simulate.typed_call import TypedOnce
+from flexsat.compiled.typed_call import TypedOnce
 
 
 @njit

@@ -515,8 +515,8 @@ def campaign(
     name: Annotated[
         str,
         typer.Argument(
-            help="Preset (sensitivity, montecarlo-critical, deployment-shock, "
-            "montecarlo-random), a campaign TOML file, or 'replay STORE CASE_ID'."
+            help="A preset (flexsat config preset --list names them), a campaign TOML "
+            "file, or 'replay STORE CASE_ID'."
         ),
     ],
     replay_args: Annotated[
@@ -803,15 +803,15 @@ def config_preset(
     Every template is commented line by line: units, allowed ranges, and which
     command reads it. --list names them all.
     """
-    from flexsat.campaigns.definition import CAMPAIGN_PRESETS
+    from flexsat.campaigns.definition import campaign_presets
     from flexsat.config import TEMPLATES, preset_path
 
     if list_templates:
         print_table(_console, "Templates (flexsat config preset NAME -o FILE)",
                     ("name", "what it is"), list(TEMPLATES.items()),
                     right=(False, False))  # fmt: skip
-        _console.print("The thesis's campaigns run by name: flexsat campaign "
-                       + " | ".join(CAMPAIGN_PRESETS))  # fmt: skip
+        _console.print("The campaign presets run by name: flexsat campaign "
+                       + " | ".join(campaign_presets()))  # fmt: skip
         return
     source = preset_path(name)
     if output is None:
