@@ -804,11 +804,11 @@ def config_preset(
     command reads it. --list names them all.
     """
     from flexsat.campaigns.definition import campaign_presets
-    from flexsat.config import TEMPLATES, preset_path
+    from flexsat.config import preset_path, templates
 
     if list_templates:
         print_table(_console, "Templates (flexsat config preset NAME -o FILE)",
-                    ("name", "what it is"), list(TEMPLATES.items()),
+                    ("name", "what it is"), list(templates().items()),
                     right=(False, False))  # fmt: skip
         _console.print("The campaign presets run by name: flexsat campaign "
                        + " | ".join(campaign_presets()))  # fmt: skip

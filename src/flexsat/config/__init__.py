@@ -6,6 +6,7 @@ from flexsat.config.load import (
     load_config,
     nominal,
     preset_path,
+    templates,
     validate_config,
 )
 from flexsat.config.models import AppendageConfig, HubConfig, SatelliteConfig, TargetFrequencies
@@ -20,5 +21,6 @@ __all__ = [
     "load_config",
     "nominal",
     "preset_path",
+    "templates",
     "validate_config",
 ]

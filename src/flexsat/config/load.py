@@ -21,6 +21,7 @@ __all__ = [
     "nominal",
     "preset_path",
     "read_toml",
+    "templates",
     "validate_config",
 ]
 
@@ -35,15 +36,35 @@ TEMPLATES = {
     "campaign-grid": "campaign crossing the levels of several axes (campaign FILE)",
     "campaign-random": "Monte Carlo campaign, values drawn per case (campaign FILE)",
 }
-"""Every shipped TOML template, commented line by line: name -> what it is (and the
-option that reads it)."""
+"""What each shipped TOML template is (and the option that reads it), by name: the
+curated lines :func:`templates` lists first."""
+TEMPLATES_DIR = Path(str(resources.files("flexsat.config") / "presets"))
+"""The folder of the shipped templates: each ``<name>.toml`` is the template ``name``."""
 PRESETS = ("nominal", "chain")
 """The satellite presets among :data:`TEMPLATES`."""
 _MAX_REPORTED = 3  # problems listed in one error message
 
 
+def templates() -> dict[str, str]:
+    """Every shipped template, found in :data:`TEMPLATES_DIR`: name -> what it is.
+
+    Returns
+    -------
+    dict of str to str
+        Those of :data:`TEMPLATES`, in its order, with its lines; then any other TOML
+        file of the folder, sorted, described by the first line of its header comment.
+    """
+    found = {path.stem: path for path in TEMPLATES_DIR.glob("*.toml")}
+    listed = {name: line for name, line in TEMPLATES.items() if name in found}
+    for name in sorted(set(found) - set(listed)):
+        header = [line.lstrip("#").strip() for line in found[name].read_text().splitlines()
+                  if line.startswith("#")]  # fmt: skip
+        listed[name] = header[0] if header else ""
+    return listed
+
+
 def preset_path(name: str) -> Path:
-    """Path of a shipped template TOML file (a name of :data:`TEMPLATES`; copy it to edit).
+    """Path of a shipped template TOML file (a name of :func:`templates`; copy it to edit).
 
     Parameters
     ----------
@@ -59,9 +80,10 @@ def preset_path(name: str) -> Path:
     ConfigError
         If ``name`` is not a template; the message lists them.
     """
-    if name not in TEMPLATES:
-        raise ConfigError(f"unknown preset {name!r}; available: {', '.join(TEMPLATES)}")
-    return Path(str(resources.files("flexsat.config") / "presets" / f"{name}.toml"))
+    available = templates()
+    if name not in available:
+        raise ConfigError(f"unknown preset {name!r}; available: {', '.join(available)}")
+    return TEMPLATES_DIR / f"{name}.toml"
 
 
 def nominal() -> SatelliteConfig:
