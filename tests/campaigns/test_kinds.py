@@ -85,3 +85,10 @@ def test_a_kind_must_generate_or_search():
     with pytest.raises(ValueError, match="needs an id_prefix"):
         register_kind(CampaignKind("drawn", RandomCases, cases=lambda t, n: None, streamed=True))
     assert "nothing" not in kind_names() and "drawn" not in kind_names()
+
+
+def test_a_bad_table_of_a_registered_kind_names_the_kind_and_its_field(tmp_path, corners_kind):
+    path = tmp_path / "corners.toml"
+    path.write_text(TOY.replace("parameters =", "parmeters ="))
+    with pytest.raises(ConfigError, match=r"\[corners\]: .*unknown key 'parmeters'"):
+        load_campaign(path)

@@ -314,8 +314,11 @@ class CampaignDefinition(_Frozen):
         data = dict(data)
         other = dict(data.get("other_kinds") or {})
         for name in names:
-            table = data.pop(name)
-            other[name] = KINDS.get(name).config.model_validate(table)
+            try:  # its problems named in its table, then given as the definition's
+                other[name] = validate_config(data.pop(name), source=f"[{name}]",
+                                              model=KINDS.get(name).config)  # fmt: skip
+            except ConfigError as exc:
+                raise ValueError(str(exc)) from None
         data["other_kinds"] = other
         return data
 

@@ -1,9 +1,10 @@
 """The campaign-kind contract: how a kind of campaign generates its cases and is summarized.
 
 A kind is one module that builds a :class:`CampaignKind` and one
-:func:`register_kind` line (the built-ins: ``cases``, ``grid``, ``random`` and
-``sobol`` in :mod:`flexsat.campaigns.definition`, ``worst_case`` in
-:mod:`flexsat.campaigns.worstcase`, imported by :mod:`flexsat.campaigns`; a user's
+:func:`register_kind` line (the built-ins: ``cases``, ``grid`` and ``random`` in
+:mod:`flexsat.campaigns.definition`, ``sobol`` in :mod:`flexsat.campaigns.sobol`,
+``worst_case`` in :mod:`flexsat.campaigns.worstcase`, imported by
+:mod:`flexsat.campaigns`, whose import line is a built-in's registration; a user's
 kind in their own file, or an installed package's through the entry-point group
 ``flexsat.campaign_kinds``). A campaign TOML names a kind by its table,
 ``[<name>]``; the definition (:class:`~flexsat.campaigns.definition.CaseStream`), the
