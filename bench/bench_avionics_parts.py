@@ -28,10 +28,10 @@ from numba import njit
 
 import harness
 from flexsat import Plant, nominal
+from flexsat.compiled.first_class import first_class
+from flexsat.compiled.no_refcount import borrowed
 from flexsat.control.stages.registry import DERIVATIVE_SIGNATURE, no_derivative
-from flexsat.dynamics.borrowed import borrowed
 from flexsat.dynamics.integrators import rk4_step
-from flexsat.dynamics.packed import first_class
 from flexsat.simulate import SlewScenario
 from flexsat.simulate.closedloop import prepare_slew
 from flexsat.simulate.coupled import rk4_coupled_step

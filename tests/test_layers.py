@@ -38,6 +38,7 @@ LAYERS: tuple[tuple[str, tuple[str, ...]], ...] = (
     ("package", ("flexsat", "flexsat._compiled_cache")),
     ("physics", ("flexsat.dynamics",)),
     ("configuration", ("flexsat.config",)),
+    ("compiled toolkit", ("flexsat.compiled",)),
     ("shared", ("flexsat.errors", "flexsat.files", "flexsat.jsonable", "flexsat.parallel",
                 "flexsat.pool", "flexsat.processes", "flexsat._version")),
 )  # fmt: skip

@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from flexsat.compiled.linalg3 import euler_rate_matrix, rot_zyx
 from flexsat.dynamics.appendages.contract import OBS_KINETIC, OBS_MOMENTUM, OBS_SIZE
 from flexsat.dynamics.attitude import (
     SWITCH_PITCH,
@@ -15,7 +16,6 @@ from flexsat.dynamics.attitude import (
     rebase,
 )
 from flexsat.dynamics.kernels import accelerations, observe
-from flexsat.dynamics.linalg3 import euler_rate_matrix, rot_zyx
 
 # Round-off: each quantity is formed by a few dozen floating-point operations on
 # values of order one, in two frames; 1e-12 relative leaves a factor ~100 over eps.

@@ -8,9 +8,9 @@ import inspect
 import numpy as np
 import pytest
 
+from flexsat.compiled.linalg3 import copy_into
 from flexsat.control.stages import delay
 from flexsat.dynamics import attitude, integrators, kernels, records
-from flexsat.dynamics.linalg3 import copy_into
 from flexsat.simulate import coupled, loops
 
 LOOP_MODULES = (kernels, attitude, integrators, records, loops, coupled, delay)

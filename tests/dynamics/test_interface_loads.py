@@ -23,10 +23,10 @@ import functools
 import numpy as np
 import pytest
 
+from flexsat.compiled.linalg3 import euler_rate_bias, euler_rate_matrix, rot_zyx
 from flexsat.config import load_config, nominal
 from flexsat.config.load import preset_path
 from flexsat.dynamics.appendages import modal as modal_kernels
-from flexsat.dynamics.linalg3 import euler_rate_bias, euler_rate_matrix, rot_zyx
 from flexsat.dynamics.plant import Plant
 from flexsat.linear.export import modal_satellite
 from flexsat.simulate.closedloop import run_slew

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from flexsat.dynamics import status
+from flexsat.compiled import status
 from flexsat.dynamics.appendages import PlateModel, appendage_model, appendage_model_names
 from flexsat.dynamics.plant import Plant
 from flexsat.simulate.common import run_attributes
@@ -40,7 +40,8 @@ def test_plate_is_registered():
 
 def test_every_failure_status_has_one_message(nominal_plant):
     codes = (status.STATUS_HUB_GIMBAL_LOCK, status.STATUS_JOINT_GIMBAL_LOCK,
-             status.STATUS_NOT_FINITE, status.STATUS_CONTROL_FAILED)  # fmt: skip
+             status.STATUS_NOT_FINITE, status.STATUS_STEP_TOO_SMALL,
+             status.STATUS_STEP_BUDGET, status.STATUS_CONTROL_FAILED)  # fmt: skip
     assert set(status.STATUS_MESSAGES) == set(codes)
     assert status.STATUS_OK not in status.STATUS_MESSAGES
 

@@ -5,12 +5,12 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from flexsat.compiled.first_class import first_class
 from flexsat.config import nominal
 from flexsat.config.models import SatelliteConfig
 from flexsat.dynamics import kernels
 from flexsat.dynamics.appendages import plate
 from flexsat.dynamics.appendages.contract import SIGNATURES
-from flexsat.dynamics.packed import first_class
 from flexsat.dynamics.plant import Plant
 from flexsat.dynamics.rigid import rigid_inertia
 from flexsat.errors import ConfigError

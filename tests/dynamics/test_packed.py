@@ -9,8 +9,8 @@ import sys
 import pytest
 from numba import njit, types
 
+from flexsat.compiled.first_class import first_class
 from flexsat.dynamics.appendages.contract import TIPS_SIGNATURE
-from flexsat.dynamics.packed import first_class
 
 
 @njit(cache=True)

@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 
 import flexsat.config
+from flexsat.compiled import linalg3
 from flexsat.config import validate_config
-from flexsat.dynamics import linalg3
 from flexsat.dynamics.plant import Plant
 from flexsat.plots import hub_outline, rot_zyx, satellite_geometry
 

@@ -18,12 +18,12 @@ import numpy as np
 import pytest
 
 from flexsat.campaigns.definition import load_campaign, resolve_cases
+from flexsat.compiled.linalg3 import euler_rate_bias, euler_rate_matrix
 from flexsat.config import nominal
 from flexsat.config.models import SatelliteConfig
 from flexsat.control.quaternion import target_quaternion
 from flexsat.control.stages import JOINT_ACTUATORS
 from flexsat.dynamics.appendages.sadm import DRIVE_COORDINATE, with_sadm
-from flexsat.dynamics.linalg3 import euler_rate_bias, euler_rate_matrix
 from flexsat.dynamics.plant import Plant
 from flexsat.simulate import run_slew
 from flexsat.simulate.scenario import SlewScenario

@@ -147,10 +147,10 @@ def test_the_solvers_derivative_is_the_plants(nominal_plant):
     # (one pointer to unbox instead of every array and kernel): the same rates as
     # augmented_derivative, bit for bit (tolerance 0: the same compiled arithmetic on
     # the same arrays), at a deformed, spinning state under torque.
+    from flexsat.compiled.typed_call import typed_list
     from flexsat.dynamics.integrators import augmented_derivative
     from flexsat.dynamics.kernels import hub_cs
     from flexsat.simulate.openloop import initial_state, listed_derivative
-    from flexsat.simulate.typed_call import typed_list
 
     scenario = OpenLoopScenario.model_validate({"initial": _DEFORMED_SPINNING})
     q0, qd0 = initial_state(nominal_plant, scenario)

@@ -140,7 +140,23 @@ def register_kind(kind: CampaignKind) -> CampaignKind:
 
 
 def get_kind(name: str) -> CampaignKind:
-    """The registered campaign kind ``name``; ValueError listing the kinds if none."""
+    """The registered campaign kind ``name``.
+
+    Parameters
+    ----------
+    name : str
+        The kind's name, the TOML table that selects it (``"random"``, ``"sobol"``...).
+
+    Returns
+    -------
+    CampaignKind
+        Its registered declaration.
+
+    Raises
+    ------
+    ValueError
+        If no kind of that name is registered (the message lists the kinds).
+    """
     return KINDS.get(name)
 
 

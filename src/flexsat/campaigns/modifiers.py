@@ -143,7 +143,8 @@ def truncnormal_ppf(u: float, mean: float, std: float, low: float, high: float) 
 
     x = mean + std Phi^-1(Phi(a) + u (Phi(b) - Phi(a))), with a, b the standardized
     bounds, from scipy's ``ndtr`` and ``ndtri``, without the distribution machinery
-    ``scipy.stats.truncnorm.ppf`` puts around the same quantile, which was a quarter of a campaign process's work per random case. An
+    ``scipy.stats.truncnorm.ppf`` puts around the same quantile, which was a quarter of
+    a campaign process's work per random case. An
     interval above the mean is mirrored below it, where Phi keeps its digits; a narrow
     one far in a tail, where Phi(b) - Phi(a) cancels, goes to ``truncnorm.ppf``.
     Agrees with ``truncnorm.ppf`` to 1e-12 std (``tests/campaigns/test_modifiers.py``).

@@ -33,7 +33,7 @@ import numpy as np
 from numba import njit
 from scipy.spatial.transform import Rotation
 
-from flexsat.dynamics.linalg3 import (
+from flexsat.compiled.linalg3 import (
     copy_into,
     euler_rate_matrix,
     euler_rate_matrix_inv,
@@ -90,7 +90,7 @@ def is_identity(frame):
 def euler_zyx(R):
     """ZYX Euler angles of a rotation matrix.
 
-    The inverse of :func:`flexsat.dynamics.linalg3.rot_zyx`, with theta in
+    The inverse of :func:`flexsat.compiled.linalg3.rot_zyx`, with theta in
     [-pi/2, pi/2]; at theta = +-pi/2 only phi - psi (or phi + psi) is defined.
 
     Parameters

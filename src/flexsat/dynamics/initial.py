@@ -6,7 +6,7 @@ from typing import Any
 
 import numpy as np
 
-from flexsat.dynamics.linalg3 import euler_rate_matrix_inv
+from flexsat.compiled.linalg3 import euler_rate_matrix_inv
 from flexsat.dynamics.plant import Plant
 from flexsat.errors import ConfigError
 

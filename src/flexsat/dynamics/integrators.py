@@ -20,12 +20,12 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from flexsat.compiled.linalg3 import copy_into, euler_rate_matrix_cs, mtv
+from flexsat.compiled.no_refcount import borrowed
+from flexsat.compiled.status import STATUS_NOT_FINITE, STATUS_OK
 from flexsat.dynamics.appendages.contract import HUB_DISSIPATION
 from flexsat.dynamics.attitude import rebase
-from flexsat.dynamics.borrowed import borrowed
 from flexsat.dynamics.kernels import accelerations_cs, hub_cs
-from flexsat.dynamics.linalg3 import copy_into, euler_rate_matrix_cs, mtv
-from flexsat.dynamics.status import STATUS_NOT_FINITE, STATUS_OK
 
 __all__ = [
     "STATUS_NOT_FINITE",

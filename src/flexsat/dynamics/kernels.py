@@ -19,7 +19,7 @@ thesis plate) transmit no inertia, so the Schur complement is the bare hub's mas
 matrix and no factorization is needed; the 6 x 6 solve runs only when an appendage
 transmits inertia. Cost is linear in N.
 
-Every kernel here, in the appendage models and in :mod:`flexsat.dynamics.linalg3` is
+Every kernel here, in the appendage models and in :mod:`flexsat.compiled.linalg3` is
 compiled with ``error_model="numpy"``: a float division by zero would give inf/nan
 (which the RK4 loops report as a non-finite state) instead of raising, so no zero
 test guards each division. No divisor can be zero: masses are validated positive and
@@ -34,22 +34,7 @@ from math import cos, sin
 
 from numba import njit
 
-from flexsat.dynamics.appendages.contract import (
-    HUB_ACC,
-    HUB_ALPHA,
-    HUB_DISSIPATION,
-    HUB_FORCE,
-    HUB_INERTIA,
-    HUB_OMEGA,
-    HUB_SBIAS,
-    HUB_TORQUE,
-    OBS_DISSIPATION,
-    OBS_ELASTIC,
-    OBS_KINETIC,
-    OBS_LOCKED_INERTIA,
-    OBS_MOMENTUM,
-)
-from flexsat.dynamics.linalg3 import (
+from flexsat.compiled.linalg3 import (
     add,
     add_block,
     copy_into,
@@ -72,10 +57,25 @@ from flexsat.dynamics.linalg3 import (
     scale,
     sub,
 )
-from flexsat.dynamics.status import (
+from flexsat.compiled.status import (
     STATUS_HUB_GIMBAL_LOCK,
     STATUS_JOINT_GIMBAL_LOCK,
     STATUS_OK,
+)
+from flexsat.dynamics.appendages.contract import (
+    HUB_ACC,
+    HUB_ALPHA,
+    HUB_DISSIPATION,
+    HUB_FORCE,
+    HUB_INERTIA,
+    HUB_OMEGA,
+    HUB_SBIAS,
+    HUB_TORQUE,
+    OBS_DISSIPATION,
+    OBS_ELASTIC,
+    OBS_KINETIC,
+    OBS_LOCKED_INERTIA,
+    OBS_MOMENTUM,
 )
 
 __all__ = [
@@ -111,7 +111,7 @@ def _solve_hub(packed, force_B, torque_B):
     elimination on 3 x 3 blocks: X = P^-1 B, y = P^-1 F, then the Schur complement
     (D - C X) omega_dot = T - C y and a = y - X omega_dot. The matrix is symmetric
     positive definite, so P and the Schur complement are too and both 3 x 3 inverses
-    (:func:`~flexsat.dynamics.linalg3.inverse3`) exist. Straight-line code on
+    (:func:`~flexsat.compiled.linalg3.inverse3`) exist. Straight-line code on
     3 x 3 blocks instead of a 6 x 6 Gaussian elimination's loops.
     """
     hub = packed.hub

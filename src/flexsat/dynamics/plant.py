@@ -15,6 +15,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from flexsat.compiled.first_class import first_class
+from flexsat.compiled.linalg3 import euler_rate_matrix
+from flexsat.compiled.status import STATUS_OK, status_message
 from flexsat.config.models import SatelliteConfig
 from flexsat.dynamics import kernels
 from flexsat.dynamics.appendages import AppendageModel, appendage_model
@@ -31,9 +34,7 @@ from flexsat.dynamics.appendages.contract import (
 )
 from flexsat.dynamics.appendages.plate import JOINT_DOFS
 from flexsat.dynamics.layout import HUB_DOFS, StateLayout
-from flexsat.dynamics.linalg3 import euler_rate_matrix
-from flexsat.dynamics.packed import PackedPlant, first_class, only
-from flexsat.dynamics.status import STATUS_OK, status_message
+from flexsat.dynamics.packed import PackedPlant, only
 from flexsat.errors import ConfigError, SimulationError
 
 __all__ = ["HUB_DOFS", "JOINT_DOFS", "Plant"]

@@ -9,22 +9,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from flexsat.dynamics.appendages.contract import (
-    OBS_ELASTIC,
-    OBS_KINETIC,
-    OBS_LOCKED_INERTIA,
-    OBS_MOMENTUM,
-    OBS_SIZE,
-)
-from flexsat.dynamics.borrowed import borrowed
-from flexsat.dynamics.kernels import (
-    accelerations,
-    hub_joint_wrench,
-    keep_solution,
-    observe,
-    tip_displacement,
-)
-from flexsat.dynamics.linalg3 import (
+from flexsat.compiled.linalg3 import (
     copy_into,
     euler_rate_bias,
     euler_rate_matrix,
@@ -33,7 +18,22 @@ from flexsat.dynamics.linalg3 import (
     mv,
     rot_zyx,
 )
-from flexsat.dynamics.status import STATUS_OK
+from flexsat.compiled.no_refcount import borrowed
+from flexsat.compiled.status import STATUS_OK
+from flexsat.dynamics.appendages.contract import (
+    OBS_ELASTIC,
+    OBS_KINETIC,
+    OBS_LOCKED_INERTIA,
+    OBS_MOMENTUM,
+    OBS_SIZE,
+)
+from flexsat.dynamics.kernels import (
+    accelerations,
+    hub_joint_wrench,
+    keep_solution,
+    observe,
+    tip_displacement,
+)
 
 __all__ = ["derive_records"]
 
@@ -95,7 +95,7 @@ def _derive_rows(
 ):  # fmt: skip
     """:func:`derive_records` on work arrays its caller owns: Q and the joint forces
     (n_dof,), the hub wrench (6,), the observation row (``OBS_SIZE``); all borrowed
-    (:mod:`flexsat.dynamics.borrowed`)."""
+    (:mod:`flexsat.compiled.no_refcount`)."""
     q, qd, tau_B, joint_force, solved = borrowed((q, qd, tau_B, joint_force, solved))
     packed = borrowed(packed)
     omega, omega_dot, tau_flex, H = borrowed((omega, omega_dot, tau_flex, H))

@@ -51,7 +51,7 @@ def rot_zyx(angles: np.ndarray) -> np.ndarray:
     -------
     ndarray, shape (..., 3, 3)
         Child (body) components -> parent components [-]; the same matrix as
-        :func:`flexsat.dynamics.linalg3.rot_zyx`.
+        :func:`flexsat.compiled.linalg3.rot_zyx`.
     """
     a = np.asarray(angles, dtype=float)
     flat = Rotation.from_euler("ZYX", a.reshape(-1, 3)[:, ::-1]).as_matrix()

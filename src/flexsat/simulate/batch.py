@@ -16,9 +16,9 @@ from typing import NamedTuple
 import numpy as np
 from numba import config, njit, prange, set_num_threads, typeof
 
+from flexsat.compiled.typed_call import typed_append, typed_list
 from flexsat.simulate.common import chunk_steps
 from flexsat.simulate.loops import LoopClock, LoopRecords, rk4_closed_loop
-from flexsat.simulate.typed_call import typed_append, typed_list
 
 __all__ = [
     "BatchItem",

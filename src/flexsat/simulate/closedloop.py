@@ -9,6 +9,9 @@ from typing import NamedTuple, Protocol
 import numpy as np
 from numba import njit
 
+from flexsat.compiled.first_class import first_class
+from flexsat.compiled.status import STATUS_CONTROL_FAILED
+from flexsat.compiled.typed_call import TypedOnce, typed_list
 from flexsat.config import nominal
 from flexsat.config.models import SatelliteConfig
 from flexsat.control.laws import LAW_SIGNATURE, get_law
@@ -24,10 +27,8 @@ from flexsat.control.stages.registry import (
 )
 from flexsat.dynamics.attitude import identity_frame, inertial_view, is_identity, rebase
 from flexsat.dynamics.integrators import rk4_hold
-from flexsat.dynamics.packed import first_class
 from flexsat.dynamics.plant import Plant
 from flexsat.dynamics.rigid import design_coordinates, rigid_inertia
-from flexsat.dynamics.status import STATUS_CONTROL_FAILED
 from flexsat.errors import ConfigError, SimulationError
 from flexsat.simulate.batch import fly, slew_timing
 from flexsat.simulate.common import PROGRESS_MIN_STEPS, progress_bar, run_attributes
@@ -37,7 +38,6 @@ from flexsat.simulate.loops import LoopData, LoopStages, run_actuators, run_sens
 from flexsat.simulate.openloop import initial_state
 from flexsat.simulate.result import Result, build_dataset
 from flexsat.simulate.scenario import SlewScenario
-from flexsat.simulate.typed_call import TypedOnce, typed_list
 
 __all__ = [
     "Controller",
@@ -275,7 +275,7 @@ def finish_slew(run: PreparedSlew, status: int, done: int, rows: int, wall: floa
     run : PreparedSlew
         The slew, its buffers filled by the loop.
     status : int
-        The loop's status (0: finished; else :mod:`flexsat.dynamics.status`).
+        The loop's status (0: finished; else :mod:`flexsat.compiled.status`).
     done : int
         Steps taken.
     rows : int
@@ -428,7 +428,7 @@ def loop_stages(scenario: SlewScenario) -> LoopStages:
     """The compiled law and stages of a slew, as the loop takes them.
 
     Each is compiled with its role's signature on first use and cached on disk
-    (:func:`flexsat.dynamics.packed.first_class`); no plant is needed. The chains are
+    (:func:`flexsat.compiled.first_class.first_class`); no plant is needed. The chains are
     padded to a multiple of :data:`~flexsat.simulate.coupled.CHAIN_SLOTS` entries.
 
     Parameters
@@ -557,7 +557,7 @@ def _listed_sensors(x, n, t, loop):
     """:func:`~flexsat.simulate.loops.run_sensors` on the structures in ``loop``, a typed
     list of one (stages, data, packed plant) tuple: unboxed as one pointer, where
     the structures themselves would unbox every array and first-class function at
-    every call (:mod:`flexsat.simulate.typed_call`)."""
+    every call (:mod:`flexsat.compiled.typed_call`)."""
     stages, d, _ = loop[0]
     return run_sensors(x, n, t, stages, d)
 
@@ -598,7 +598,7 @@ def _python_loop(plant, scenario, x, frame, stages, d, rec_t, rec_x, rec_ctrl, r
     d.law_diag[:] = np.nan
     view = np.empty_like(x)
     # the same arguments at every instant: typed once, and the loop's structures in a
-    # typed list, unboxed as one pointer (flexsat.simulate.typed_call)
+    # typed list, unboxed as one pointer (flexsat.compiled.typed_call)
     loop = typed_list((stages, d, plant.packed))
     sensors, actuators = TypedOnce(_listed_sensors), TypedOnce(_listed_actuators)
     coupled_hold, hold = TypedOnce(_listed_coupled_hold), TypedOnce(_listed_hold)

@@ -11,7 +11,7 @@ from dataclasses import dataclass
 from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
 
 from flexsat import __version__
-from flexsat.dynamics.status import status_message
+from flexsat.compiled.status import status_message
 from flexsat.errors import ConfigError
 
 __all__ = [

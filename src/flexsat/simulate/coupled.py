@@ -18,11 +18,11 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
-from flexsat.dynamics.borrowed import borrowed
+from flexsat.compiled.linalg3 import euler_rate_matrix_cs, load_seg, mv
+from flexsat.compiled.no_refcount import borrowed
+from flexsat.compiled.status import STATUS_NOT_FINITE, STATUS_OK
 from flexsat.dynamics.integrators import augmented_derivative, rk4_combine, rk4_stage
 from flexsat.dynamics.kernels import hub_cs
-from flexsat.dynamics.linalg3 import euler_rate_matrix_cs, load_seg, mv
-from flexsat.dynamics.status import STATUS_NOT_FINITE, STATUS_OK
 
 __all__ = ["CHAIN_SLOTS", "LoopFlow", "chain_wrench", "rk4_coupled_hold", "rk4_coupled_step"]
 

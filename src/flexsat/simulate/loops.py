@@ -26,12 +26,12 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
+from flexsat.compiled.linalg3 import copy_into
+from flexsat.compiled.no_refcount import borrowed
+from flexsat.compiled.status import STATUS_CONTROL_FAILED, STATUS_OK
 from flexsat.dynamics.attitude import inertial_view, is_identity, rebase
-from flexsat.dynamics.borrowed import borrowed
 from flexsat.dynamics.integrators import augmented_derivative, rk4_step
 from flexsat.dynamics.kernels import hub_cs, keep_solution
-from flexsat.dynamics.linalg3 import copy_into
-from flexsat.dynamics.status import STATUS_CONTROL_FAILED, STATUS_OK
 from flexsat.simulate.coupled import LITERAL_STAGES, LoopFlow, chain_wrench, rk4_coupled_step
 
 __all__ = [

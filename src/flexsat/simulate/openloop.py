@@ -12,6 +12,8 @@ import numpy as np
 import xarray as xr
 from numba import njit
 
+from flexsat.compiled.status import STATUS_STEP_BUDGET, STATUS_STEP_TOO_SMALL
+from flexsat.compiled.typed_call import typed_list
 from flexsat.dynamics.attitude import SWITCH_PITCH, identity_frame, rebase
 from flexsat.dynamics.initial import initial_state
 from flexsat.dynamics.integrators import (
@@ -22,7 +24,6 @@ from flexsat.dynamics.integrators import (
 )
 from flexsat.dynamics.kernels import STATUS_OK, hub_cs
 from flexsat.dynamics.plant import Plant
-from flexsat.dynamics.status import STATUS_STEP_BUDGET, STATUS_STEP_TOO_SMALL
 from flexsat.simulate.common import (
     PROGRESS_MIN_STEPS,
     check_run_size,
@@ -33,7 +34,6 @@ from flexsat.simulate.common import (
 from flexsat.simulate.result import Result, build_dataset
 from flexsat.simulate.scenario import OpenLoopScenario, thesis_openloop
 from flexsat.simulate.stream import RecordStream, check_disk_space
-from flexsat.simulate.typed_call import typed_list
 
 __all__ = [
     "DOP853_MIN_STEP_FRACTION",
@@ -230,7 +230,7 @@ def listed_derivative(x, torque_B, n, Q, dx, plants):
 
     Passed as it is, the :class:`~flexsat.dynamics.packed.PackedPlant` would be
     unboxed at every call, each array and kernel of it: about 60 us, ten times the
-    rest of the call (:mod:`flexsat.simulate.typed_call`).
+    rest of the call (:mod:`flexsat.compiled.typed_call`).
 
     Parameters
     ----------
@@ -245,7 +245,7 @@ def listed_derivative(x, torque_B, n, Q, dx, plants):
     dx : ndarray, shape (2 n + 2,)
         Written: the state's rate [SI per s].
     plants : numba.typed.List of PackedPlant
-        :func:`~flexsat.simulate.typed_call.typed_list` of ``Plant.packed``.
+        :func:`~flexsat.compiled.typed_call.typed_list` of ``Plant.packed``.
 
     Returns
     -------

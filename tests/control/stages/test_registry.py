@@ -15,6 +15,7 @@ from numba import njit
 from pydantic import Field, ValidationError
 from scipy.integrate import trapezoid
 
+from flexsat.compiled.linalg3 import euler_rate_matrix, load_seg, mv
 from flexsat.control import Channel, StageConfig, StageSpec, register_stage
 from flexsat.control.quaternion import euler_zyx_to_quaternion, target_quaternion
 from flexsat.control.stages import (
@@ -26,7 +27,6 @@ from flexsat.control.stages import (
     ActuatorStageConfig,
     validate_stage,
 )
-from flexsat.dynamics.linalg3 import euler_rate_matrix, load_seg, mv
 from flexsat.simulate import SlewScenario, run_slew
 from flexsat.simulate.closedloop import prepare_slew
 

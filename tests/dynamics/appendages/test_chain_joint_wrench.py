@@ -22,11 +22,11 @@ import pytest
 from pydantic import Field
 from scipy.spatial.transform import Rotation
 
+from flexsat.compiled.linalg3 import euler_rate_bias, euler_rate_matrix, rot_zyx
 from flexsat.config import nominal, validate_config
 from flexsat.dynamics.appendages import ChainModel, register_appendage_model
 from flexsat.dynamics.appendages.chain_config import DOF_NAMES, ChainConfig
 from flexsat.dynamics.appendages.sadm import with_sadm
-from flexsat.dynamics.linalg3 import euler_rate_bias, euler_rate_matrix, rot_zyx
 from flexsat.dynamics.plant import Plant
 from flexsat.simulate import run_openloop
 from flexsat.simulate.scenario import OpenLoopScenario

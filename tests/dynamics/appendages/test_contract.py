@@ -17,6 +17,23 @@ from numba import njit
 from pydantic import BaseModel, ConfigDict, Field
 
 from flexsat import ConfigError, Plant, load_config
+from flexsat.compiled.linalg3 import (
+    add,
+    add_block,
+    cross,
+    dot,
+    euler_rate_bias,
+    euler_rate_matrix,
+    load_seg,
+    mm,
+    mtm,
+    mtv,
+    mv,
+    rot_zyx,
+    scale,
+    scale_m,
+    skew,
+)
 from flexsat.config import preset_path, validate_config
 from flexsat.dynamics.appendages import (
     AppendageKernels,
@@ -40,23 +57,6 @@ from flexsat.dynamics.appendages.contract import (
     PASS2_SIGNATURE,
     TIPS_SIGNATURE,
     WRENCH_SIGNATURE,
-)
-from flexsat.dynamics.linalg3 import (
-    add,
-    add_block,
-    cross,
-    dot,
-    euler_rate_bias,
-    euler_rate_matrix,
-    load_seg,
-    mm,
-    mtm,
-    mtv,
-    mv,
-    rot_zyx,
-    scale,
-    scale_m,
-    skew,
 )
 from flexsat.dynamics.rigid import rigid_inertia
 from flexsat.simulate import run_openloop

@@ -8,9 +8,9 @@ from math import asin, sqrt
 import numpy as np
 from numba import njit
 
+from flexsat.compiled.linalg3 import cross, mv
 from flexsat.control.quaternion import quaternion_error
 from flexsat.control.registry import Channel
-from flexsat.dynamics.linalg3 import cross, mv
 
 __all__ = [
     "SLIDING_DIAGNOSTICS",

@@ -21,6 +21,7 @@ import numpy as np
 from numba import njit
 from pydantic import Field, model_validator
 
+from flexsat.compiled.linalg3 import mv
 from flexsat.config.models import Positive
 from flexsat.control.laws._sliding import (
     SLIDING_DIAGNOSTICS,
@@ -33,7 +34,6 @@ from flexsat.control.laws._sliding import (
     surface_guide,
 )
 from flexsat.control.laws.registry import LawConfig, LawSpec
-from flexsat.dynamics.linalg3 import mv
 
 __all__ = ["ASMC", "ASMCConfig", "ASMCGains"]
 

@@ -23,6 +23,7 @@ import numpy as np
 from numba import njit
 from pydantic import Field
 
+from flexsat.compiled.linalg3 import mv
 from flexsat.config.models import Positive
 from flexsat.control.laws._sliding import (
     integral_diagnostics,
@@ -33,7 +34,6 @@ from flexsat.control.laws._sliding import (
 )
 from flexsat.control.laws.registry import LawConfig, LawSpec
 from flexsat.control.registry import Channel
-from flexsat.dynamics.linalg3 import mv
 
 __all__ = ["ISMC", "ISMCConfig", "ISMCGains"]
 

@@ -11,11 +11,11 @@ import numpy as np
 from numba import njit
 from pydantic import Field
 
+from flexsat.compiled.linalg3 import mv
 from flexsat.config.models import Positive
 from flexsat.control.laws._sliding import clip_and_store, law_terms
 from flexsat.control.laws.registry import LawConfig, LawSpec
 from flexsat.control.registry import Channel
-from flexsat.dynamics.linalg3 import mv
 
 __all__ = ["PD", "PDConfig", "PDGains"]
 

@@ -13,6 +13,7 @@ import numpy as np
 from numba import njit
 from pydantic import Field
 
+from flexsat.compiled.linalg3 import mv
 from flexsat.config.models import Positive
 from flexsat.control.laws._sliding import (
     SLIDING_DIAGNOSTICS,
@@ -25,7 +26,6 @@ from flexsat.control.laws._sliding import (
     surface_guide,
 )
 from flexsat.control.laws.registry import LawConfig, LawSpec
-from flexsat.dynamics.linalg3 import mv
 
 __all__ = ["SMC", "SMCConfig", "SMCGains"]
 

@@ -34,6 +34,7 @@ import numpy as np
 from numba import njit
 from pydantic import Field, model_validator
 
+from flexsat.compiled.linalg3 import mv
 from flexsat.config.models import Positive
 from flexsat.control.laws._sliding import (
     integral_diagnostics,
@@ -45,7 +46,6 @@ from flexsat.control.laws._sliding import (
 )
 from flexsat.control.laws.registry import LawConfig, LawSpec
 from flexsat.control.registry import Channel
-from flexsat.dynamics.linalg3 import mv
 
 __all__ = [
     "STSMC",

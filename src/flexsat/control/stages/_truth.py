@@ -8,8 +8,8 @@ from __future__ import annotations
 
 from numba import njit
 
+from flexsat.compiled.linalg3 import euler_rate_matrix, load_seg, mv
 from flexsat.control.quaternion import euler_zyx_to_quaternion
-from flexsat.dynamics.linalg3 import euler_rate_matrix, load_seg, mv
 
 __all__ = ["true_attitude", "true_body_rate"]
 

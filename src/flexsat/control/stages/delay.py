@@ -13,9 +13,9 @@ from typing import Annotated, Literal
 from numba import njit
 from pydantic import Field
 
+from flexsat.compiled.linalg3 import copy_into
 from flexsat.control.registry import Channel
 from flexsat.control.stages.registry import StageConfig, StageSpec
-from flexsat.dynamics.linalg3 import copy_into
 
 __all__ = ["DELAY", "MAX_DELAY_PERIODS", "DelayConfig"]
 

@@ -10,9 +10,9 @@ from typing import Literal
 
 from numba import njit
 
+from flexsat.compiled.linalg3 import euler_rate_matrix, load_seg, mv
 from flexsat.control.quaternion import euler_zyx_to_quaternion
 from flexsat.control.stages.registry import StageConfig, StageSpec
-from flexsat.dynamics.linalg3 import euler_rate_matrix, load_seg, mv
 
 __all__ = ["IDEAL_SENSOR", "IdealSensorConfig"]
 

@@ -8,7 +8,7 @@ first-class functions, so a stage defined in a user's own file runs at built-in
 speed. Both run at every control instant (every ``control_dt_s``); their outputs
 are held between instants (zero-order hold). Each step below is compiled with its
 role's signature: at import when declared with it, else when a slew first uses it
-(:func:`flexsat.dynamics.packed.first_class`; the built-ins are declared
+(:func:`flexsat.compiled.first_class.first_class`; the built-ins are declared
 ``@njit(cache=True)``).
 
 Sensor step, ``@njit(SENSOR_SIGNATURE, cache=True)``::

@@ -34,22 +34,7 @@ from math import cos, sin
 import numpy as np
 from numba import njit
 
-from flexsat.dynamics.appendages.contract import (
-    HUB_ACC,
-    HUB_ALPHA,
-    HUB_DISSIPATION,
-    HUB_FORCE,
-    HUB_INERTIA,
-    HUB_OMEGA,
-    HUB_SBIAS,
-    HUB_TORQUE,
-    OBS_DISSIPATION,
-    OBS_ELASTIC,
-    OBS_KINETIC,
-    OBS_LOCKED_INERTIA,
-    OBS_MOMENTUM,
-)
-from flexsat.dynamics.linalg3 import (
+from flexsat.compiled.linalg3 import (
     add,
     cross,
     dot,
@@ -69,7 +54,22 @@ from flexsat.dynamics.linalg3 import (
     sub,
     transpose,
 )
-from flexsat.dynamics.status import STATUS_JOINT_GIMBAL_LOCK, STATUS_OK
+from flexsat.compiled.status import STATUS_JOINT_GIMBAL_LOCK, STATUS_OK
+from flexsat.dynamics.appendages.contract import (
+    HUB_ACC,
+    HUB_ALPHA,
+    HUB_DISSIPATION,
+    HUB_FORCE,
+    HUB_INERTIA,
+    HUB_OMEGA,
+    HUB_SBIAS,
+    HUB_TORQUE,
+    OBS_DISSIPATION,
+    OBS_ELASTIC,
+    OBS_KINETIC,
+    OBS_LOCKED_INERTIA,
+    OBS_MOMENTUM,
+)
 
 __all__ = [
     "G_C",

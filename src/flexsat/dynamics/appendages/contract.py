@@ -21,7 +21,7 @@ Every kernel is a numba function compiled with its signature below: numba then t
 a tuple of them by signature, so the engine's loops compile once and run any model,
 built-in or a user's own from their own file, at full speed. Declared
 ``@njit(cache=True)``, a kernel is compiled with its signature when the first plant
-uses its model (:func:`flexsat.dynamics.packed.first_class`), so importing flexsat
+uses its model (:func:`flexsat.compiled.first_class.first_class`), so importing flexsat
 compiles no model a run does not use (the built-in models are declared so);
 declared ``@njit(<its signature>, cache=True)``, it is compiled at import.
 

@@ -48,6 +48,25 @@ from pydantic import (
 )
 from scipy.spatial.transform import Rotation
 
+from flexsat.compiled.linalg3 import (
+    add,
+    add_block,
+    cross,
+    dot,
+    euler_rate_bias,
+    euler_rate_matrix,
+    load_block33,
+    load_m33_at,
+    load_seg,
+    mm,
+    mtm,
+    mtv,
+    mv,
+    rot_zyx,
+    scale,
+    skew,
+)
+from flexsat.compiled.status import STATUS_OK
 from flexsat.config.modal_data import ModalData, load_modal_data
 from flexsat.config.models import Angle, Matrix3, Name, Point3
 from flexsat.dynamics.appendages.contract import (
@@ -70,25 +89,6 @@ from flexsat.dynamics.appendages.contract import (
     DerivedPath,
     RigidBody,
 )
-from flexsat.dynamics.linalg3 import (
-    add,
-    add_block,
-    cross,
-    dot,
-    euler_rate_bias,
-    euler_rate_matrix,
-    load_block33,
-    load_m33_at,
-    load_seg,
-    mm,
-    mtm,
-    mtv,
-    mv,
-    rot_zyx,
-    scale,
-    skew,
-)
-from flexsat.dynamics.status import STATUS_OK
 
 __all__ = ["ModalAppendageConfig", "ModalModel"]
 

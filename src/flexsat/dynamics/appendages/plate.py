@@ -35,28 +35,7 @@ import numpy as np
 from numba import njit
 from scipy.spatial.transform import Rotation
 
-from flexsat.config.models import AppendageConfig
-from flexsat.dynamics.appendages.contract import (
-    HUB_ACC,
-    HUB_ALPHA,
-    HUB_DISSIPATION,
-    HUB_FORCE,
-    HUB_INERTIA,
-    HUB_OMEGA,
-    HUB_SBIAS,
-    HUB_TORQUE,
-    OBS_DISSIPATION,
-    OBS_ELASTIC,
-    OBS_KINETIC,
-    OBS_LOCKED_INERTIA,
-    OBS_MOMENTUM,
-    AppendageKernels,
-    AppendageModel,
-    Coordinate,
-    DerivedPath,
-    RigidBody,
-)
-from flexsat.dynamics.linalg3 import (
+from flexsat.compiled.linalg3 import (
     add,
     add_block,
     cross,
@@ -79,7 +58,28 @@ from flexsat.dynamics.linalg3 import (
     sub,
     transpose,
 )
-from flexsat.dynamics.status import STATUS_JOINT_GIMBAL_LOCK, STATUS_OK
+from flexsat.compiled.status import STATUS_JOINT_GIMBAL_LOCK, STATUS_OK
+from flexsat.config.models import AppendageConfig
+from flexsat.dynamics.appendages.contract import (
+    HUB_ACC,
+    HUB_ALPHA,
+    HUB_DISSIPATION,
+    HUB_FORCE,
+    HUB_INERTIA,
+    HUB_OMEGA,
+    HUB_SBIAS,
+    HUB_TORQUE,
+    OBS_DISSIPATION,
+    OBS_ELASTIC,
+    OBS_KINETIC,
+    OBS_LOCKED_INERTIA,
+    OBS_MOMENTUM,
+    AppendageKernels,
+    AppendageModel,
+    Coordinate,
+    DerivedPath,
+    RigidBody,
+)
 from flexsat.dynamics.tuning import tune_joints
 
 __all__ = ["JOINT_DOFS", "PlateModel"]
@@ -111,7 +111,7 @@ def _rho_cs(q, o):
     """Cosines and sines of the joint angles rho = q[o+3:o+6]: (c1, s1, c2, s2, c3, s3).
 
     A pass computes them once for the pose, S(rho), S(rho)^-1 and the rate bias (the
-    ``_cs`` forms of :mod:`flexsat.dynamics.linalg3`, the same arithmetic) instead of
+    ``_cs`` forms of :mod:`flexsat.compiled.linalg3`, the same arithmetic) instead of
     once per helper: four sines and cosines fewer per plate and evaluation.
     """
     return cos(q[o + 3]), sin(q[o + 3]), cos(q[o + 4]), sin(q[o + 4]), cos(q[o + 5]), sin(q[o + 5])
