@@ -39,7 +39,7 @@ def _cantilever():
     """
     sys.path.insert(0, str(ROOT))
     from tests.dynamics.chain_satellites import beam_frequency_hz, cantilever_chain
-    from tests.dynamics.test_chain_beam import clamped_frequencies_hz
+    from tests.dynamics.appendages.test_chain_beam import clamped_frequencies_hz
 
     return beam_frequency_hz, cantilever_chain, clamped_frequencies_hz
 
