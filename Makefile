@@ -38,6 +38,7 @@ chromium:
 TEST_WORKERS ?= 2
 test: $(DEV) chromium
 	$(BIN)/ruff check src tests bench examples
+	$(BIN)/ruff format --check src tests bench examples
 	$(BIN)/python -m pytest -q -n $(TEST_WORKERS) --dist loadfile --durations=15
 	$(MAKE) docs
 
@@ -61,6 +62,7 @@ docs: $(DOCS_STAMP)
 
 lint: $(DEV)
 	$(BIN)/ruff check src tests bench examples
+	$(BIN)/ruff format --check src tests bench examples
 
 clean:
 	rm -rf $(VENV) out build *.egg-info src/*.egg-info .pytest_cache .ruff_cache .hypothesis

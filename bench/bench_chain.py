@@ -38,8 +38,8 @@ def _cantilever():
     Imported when a table needs it, so that the script registers without the tests.
     """
     sys.path.insert(0, str(ROOT))
-    from tests.dynamics.chain_satellites import beam_frequency_hz, cantilever_chain
     from tests.dynamics.appendages.test_chain_beam import clamped_frequencies_hz
+    from tests.dynamics.chain_satellites import beam_frequency_hz, cantilever_chain
 
     return beam_frequency_hz, cantilever_chain, clamped_frequencies_hz
 

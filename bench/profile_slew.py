@@ -85,8 +85,11 @@ def main(argv: list[str] | None = None) -> None:
         config = config.model_copy(update={"appendages": [
             app.model_copy(update={"locked_dofs": reduced.locked_dofs})
             for app in config.appendages]})  # fmt: skip
-        fields |= {"dt_s": reduced.dt_s, "control_dt_s": reduced.control_dt_s,
-                   "record_dt_s": reduced.record_period_s}
+        fields |= {
+            "dt_s": reduced.dt_s,
+            "control_dt_s": reduced.control_dt_s,
+            "record_dt_s": reduced.record_period_s,
+        }
     plant = Plant.from_config(config)
     scenario = SlewScenario.model_validate(fields)
     run_slew(plant, scenario.model_copy(update={"duration_s": 0.1}))  # compile

@@ -26,9 +26,7 @@ DURATION_S = float(os.environ.get("FLEXSAT_EXAMPLE_DURATION_S", 120.0))  # [s]
 plant = Plant.from_config(nominal())
 datasets, metrics = {}, {}
 for law in law_names():
-    scenario = SlewScenario.model_validate(
-        {"duration_s": DURATION_S, "controller": {"kind": law}}
-    )
+    scenario = SlewScenario.model_validate({"duration_s": DURATION_S, "controller": {"kind": law}})
     datasets[law] = run_slew(plant, scenario).dataset
     metrics[law] = slew_metrics(datasets[law])
 

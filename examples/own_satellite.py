@@ -16,7 +16,6 @@ tables a TOML file holds, then analyses its coupled modes.
 # value is refused before anything runs, with one message naming the field and
 # its allowed range.
 
-
 from flexsat import Plant, SatelliteConfig
 from flexsat.analysis import modal_analysis
 from flexsat.dynamics import rigid_inertia

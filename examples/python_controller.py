@@ -69,7 +69,14 @@ scenario = SlewScenario(duration_s=DURATION_S, control_dt_s=0.01)  # control eve
 law = QuaternionPID(scenario.target_euler_deg)
 result = run_slew(Plant.from_config(nominal()), scenario, controller=law)
 metrics = slew_metrics(result.dataset)  # the requirements of the stored scenario
-for key in ("controller", "final_pointing_error_deg", "r1_pass", "r2_pass", "r3_pass",
-            "r2_settling_time_s", "max_rate_error_deg_s"):
+for key in (
+    "controller",
+    "final_pointing_error_deg",
+    "r1_pass",
+    "r2_pass",
+    "r3_pass",
+    "r2_settling_time_s",
+    "max_rate_error_deg_s",
+):
     print(f"{key:26s} {metrics[key]}")
 plot_pointing(result.dataset)

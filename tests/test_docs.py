@@ -134,5 +134,5 @@ def test_the_module_map_lists_every_module_once():
         parts = path.with_suffix("").relative_to(source).parts
         # a subpackage's modules are listed under their top-level package
         package = ".".join(parts[:2]) if len(parts) > 2 else "flexsat"
-        modules.add(f"{package}.{'.'.join(parts[len(package.split('.')):])}")
+        modules.add(f"{package}.{'.'.join(parts[len(package.split('.')) :])}")
     assert _mapped_modules() == modules

@@ -17,9 +17,11 @@ from flexsat.jsonable import dumps, jsonable
 _scalars = st.none() | st.booleans() | st.integers() | st.text(max_size=8) | st.floats()
 _trees = st.recursive(
     _scalars,
-    lambda inner: st.lists(inner, max_size=4)
-    | st.tuples(inner, inner)
-    | st.dictionaries(st.text(max_size=6), inner, max_size=4),
+    lambda inner: (
+        st.lists(inner, max_size=4)
+        | st.tuples(inner, inner)
+        | st.dictionaries(st.text(max_size=6), inner, max_size=4)
+    ),
     max_leaves=30,
 )
 

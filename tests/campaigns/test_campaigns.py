@@ -195,9 +195,14 @@ def test_failed_case_is_recorded_and_the_campaign_finishes(tmp_path):
         '[[cases]]\nid = "stiff"\n'
         'plant = [{ path = "appendages[*].target_frequencies_hz.translation_x", value = 3000.0 }]\n'
     )
-    summary = run_campaign(load_campaign(path), nominal(), tmp_path / "s", workers=1, progress=False)
+    summary = run_campaign(
+        load_campaign(path), nominal(), tmp_path / "s", workers=1, progress=False
+    )
     assert summary["cases"] == 2 and summary["failed"] == 1
-    rows = {r["case_id"]: r for r in (json.loads(p.read_text()) for p in (tmp_path / "s" / "cases").glob("*.json"))}
+    rows = {
+        r["case_id"]: r
+        for r in (json.loads(p.read_text()) for p in (tmp_path / "s" / "cases").glob("*.json"))
+    }
     assert rows["stiff"]["status"] == "failed"
     assert "stopped at t =" in rows["stiff"]["error"]
     assert rows["nominal"]["status"] == "ok"
@@ -213,26 +218,71 @@ def test_resuming_into_another_campaign_is_refused(tmp_path):
 
 BAD_CAMPAIGNS = [
     ('[[cases]]\nid = "a"\nplant = [{ path = "hub.colour", value = 1.0 }]\n', "no 'colour'"),
-    ('[[cases]]\nid = "a"\nplant = [{ path = "hub.mass_kg", uniform = [2.0, 2.0] }]\n', "low < high"),
-    ('[[cases]]\nid = "a"\nplant = [{ path = "hub.mass_kg", truncnormal = [1.0, 0.1, 2.0, 1.0] }]\n', "low < high"),
-    ('[[cases]]\nid = "a"\nplant = [{ path = "hub.mass_kg", value = -5.0 }]\n', "hub.mass_kg: Input should be greater than or equal to 0.0001"),
-    ('[random]\nn = -3\n', "random.n"),
-    ('[base]\ndt_s = -1.0\n', "dt_s"),
+    (
+        '[[cases]]\nid = "a"\nplant = [{ path = "hub.mass_kg", uniform = [2.0, 2.0] }]\n',
+        "low < high",
+    ),
+    (
+        '[[cases]]\nid = "a"\nplant = [{ path = "hub.mass_kg", truncnormal = [1.0, 0.1, 2.0, 1.0] }]\n',
+        "low < high",
+    ),
+    (
+        '[[cases]]\nid = "a"\nplant = [{ path = "hub.mass_kg", value = -5.0 }]\n',
+        "hub.mass_kg: Input should be greater than or equal to 0.0001",
+    ),
+    ("[random]\nn = -3\n", "random.n"),
+    ("[base]\ndt_s = -1.0\n", "dt_s"),
     # initial states the satellite cannot take, refused before any case flies
-    ('[[cases]]\nid = "a"\nscenario = [{ path = "initial.appendages", value = [{ name = "boom" }] }]\n', "case 'a' (scenario): initial.appendages: "),
-    ('[[cases]]\nid = "a"\nplant = [{ path = "appendages[*].locked_dofs", value = ["eta_x"] }]\nscenario = [{ path = "initial.appendages", value = [{ name = "panel_1", eta_rate_m_s = [0.1, 0.0, 0.0] }] }]\n', "its initial rate must be 0"),
+    (
+        '[[cases]]\nid = "a"\nscenario = [{ path = "initial.appendages", value = [{ name = "boom" }] }]\n',
+        "case 'a' (scenario): initial.appendages: ",
+    ),
+    (
+        '[[cases]]\nid = "a"\nplant = [{ path = "appendages[*].locked_dofs", value = ["eta_x"] }]\nscenario = [{ path = "initial.appendages", value = [{ name = "panel_1", eta_rate_m_s = [0.1, 0.0, 0.0] }] }]\n',
+        "its initial rate must be 0",
+    ),
     # a modifier's value checked against its target before any case runs
-    ('[[cases]]\nid = "a"\nplant = [{ path = "hub.mass_kg", op = "scale", value = "x" }]\n', "hub.mass_kg: op = 'scale' takes a finite number as its factor (value), got 'x'"),
-    ('[[cases]]\nid = "a"\nplant = [{ path = "hub.inertia", op = "scale", value = "x" }]\n', "hub.inertia: op = 'scale' takes a finite number as its factor"),
-    ('[[cases]]\nid = "a"\nplant = [{ path = "hub.inertia", value = "x" }]\n', "modifier 'hub.inertia' (op = 'set'): hub.inertia takes a finite number (a scale factor"),
-    ('[[cases]]\nid = "a"\nplant = [{ path = "appendages[*].inertia", value = [1.0, 2.0] }]\n', "appendages[0].inertia takes a finite number"),
-    ('[[cases]]\nid = "a"\nplant = [{ path = "hub.mass_kg", uniform = [0.8, inf] }]\n', "uniform takes finite numbers"),
-    ('[[cases]]\nid = "a"\nplant = [{ path = "hub.mass_kg", op = "scale", uniform = [-1e308, 1e308] }]\n', "is wider than a float holds: high - low must be <= 1.798e+308"),
-    ('[[cases]]\nid = "a"\nplant = [{ path = "hub.mass_kg", normal = [1.0, 1e307] }]\n', "|mean| + 40 std must be <= 1.798e+308"),
-    ('[[cases]]\nid = "a"\nplant = [{ path = "appendages[0].name", op = "scale", value = 3 }]\n', "appendages[0].name is 'panel_1', not a number or a list of numbers"),
-    ('[worst_case]\nparameters = [{ path = "hub.mass_kg", bounds = [1.0, inf] }]\n', "bounds take finite numbers"),
+    (
+        '[[cases]]\nid = "a"\nplant = [{ path = "hub.mass_kg", op = "scale", value = "x" }]\n',
+        "hub.mass_kg: op = 'scale' takes a finite number as its factor (value), got 'x'",
+    ),
+    (
+        '[[cases]]\nid = "a"\nplant = [{ path = "hub.inertia", op = "scale", value = "x" }]\n',
+        "hub.inertia: op = 'scale' takes a finite number as its factor",
+    ),
+    (
+        '[[cases]]\nid = "a"\nplant = [{ path = "hub.inertia", value = "x" }]\n',
+        "modifier 'hub.inertia' (op = 'set'): hub.inertia takes a finite number (a scale factor",
+    ),
+    (
+        '[[cases]]\nid = "a"\nplant = [{ path = "appendages[*].inertia", value = [1.0, 2.0] }]\n',
+        "appendages[0].inertia takes a finite number",
+    ),
+    (
+        '[[cases]]\nid = "a"\nplant = [{ path = "hub.mass_kg", uniform = [0.8, inf] }]\n',
+        "uniform takes finite numbers",
+    ),
+    (
+        '[[cases]]\nid = "a"\nplant = [{ path = "hub.mass_kg", op = "scale", uniform = [-1e308, 1e308] }]\n',
+        "is wider than a float holds: high - low must be <= 1.798e+308",
+    ),
+    (
+        '[[cases]]\nid = "a"\nplant = [{ path = "hub.mass_kg", normal = [1.0, 1e307] }]\n',
+        "|mean| + 40 std must be <= 1.798e+308",
+    ),
+    (
+        '[[cases]]\nid = "a"\nplant = [{ path = "appendages[0].name", op = "scale", value = 3 }]\n',
+        "appendages[0].name is 'panel_1', not a number or a list of numbers",
+    ),
+    (
+        '[worst_case]\nparameters = [{ path = "hub.mass_kg", bounds = [1.0, inf] }]\n',
+        "bounds take finite numbers",
+    ),
     # the search's metric at load, not after its cases ran; duplicate ids by name
-    ('[worst_case]\nmetric = "happiness"\nparameters = [{ path = "hub.mass_kg", bounds = [100.0, 200.0] }]\n', "worst_case.metric: 'happiness' is not a numeric slew metric; one of final_pointing_error_deg"),
+    (
+        '[worst_case]\nmetric = "happiness"\nparameters = [{ path = "hub.mass_kg", bounds = [100.0, 200.0] }]\n',
+        "worst_case.metric: 'happiness' is not a numeric slew metric; one of final_pointing_error_deg",
+    ),
     ('[[cases]]\nid = "a"\n[[cases]]\nid = "a"\n', "duplicate case ids: 'a'"),
     ('[random]\nn = 3\n[[cases]]\nid = "random-00002"\n', "duplicate case ids: 'random-00002'"),
 ]

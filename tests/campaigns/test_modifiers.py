@@ -32,7 +32,8 @@ def test_truncated_normal_quantiles_match_scipys_truncnorm():
 def test_the_extreme_quantiles_are_the_bounds(u, bound):
     low, high = 0.8, 1.2
     assert truncnormal_ppf(u, 1.0, 0.1, low, high) == pytest.approx(
-        {"low": low, "high": high}[bound], abs=1e-15)
+        {"low": low, "high": high}[bound], abs=1e-15
+    )
 
 
 def test_the_modified_copy_is_a_deep_copy_of_the_config():
@@ -81,6 +82,12 @@ def test_a_derived_path_takes_only_its_op_and_an_unknown_path_lists_what_there_i
                         rng, {})  # fmt: skip
     message = error.value.args[0]
     assert "a 'chain' appendage" in message
-    for offered in ("beam.EI_flap_N_m2", "joint.damping_ratio", "mount_yaw_deg",
-                    "damping_ratio", "target_frequencies_hz.torsion", "sadm_angle_deg"):
+    for offered in (
+        "beam.EI_flap_N_m2",
+        "joint.damping_ratio",
+        "mount_yaw_deg",
+        "damping_ratio",
+        "target_frequencies_hz.torsion",
+        "sadm_angle_deg",
+    ):
         assert offered in message  # fmt: skip

@@ -55,8 +55,10 @@ def test_a_sobol_campaign_runs_its_sample_and_gives_indices(tmp_path):
     run = run_campaign(definition, nominal(), tmp_path, workers=1, progress=False)
     assert run["cases"] == 16 and run["failed"] == 0
     indices = sobol_indices(tmp_path, definition.sobol)
-    assert set(indices["parameter"]) == {"hub.mass_kg",
-                                         "appendages[*].target_frequencies_hz.flapping"}
+    assert set(indices["parameter"]) == {
+        "hub.mass_kg",
+        "appendages[*].target_frequencies_hz.flapping",
+    }
     assert "final_pointing_error_deg" in set(indices["metric"])
 
 

@@ -302,6 +302,7 @@ SPECIAL_FILES = [
     Bad("animate a FIFO", ["animate", "{tmp}/r.nc"], f"cannot read RESULT file {{tmp}}/r.nc: {_NOT_REGULAR}", {"r.nc": FIFO}, 10),
 ]  # fmt: skip
 
+
 def _modal_npz(**arrays) -> bytes:
     """The NPZ of :func:`~tests.cli.harness.modal_table` with ``arrays`` replaced."""
     from flexsat.config.modal_data import modal_data_from_dict
@@ -317,13 +318,15 @@ def _forged_npz() -> bytes:
 
     header = io.BytesIO()
     np.lib.format.write_array_header_1_0(
-        header, {"descr": "<f8", "fortran_order": False, "shape": (2000, 1_000_000)})
+        header, {"descr": "<f8", "fortran_order": False, "shape": (2000, 1_000_000)}
+    )
     buffer = io.BytesIO()
     with zipfile.ZipFile(io.BytesIO(_modal_npz())) as source, zipfile.ZipFile(buffer, "w") as out:
         for info in source.infolist():
             forged = info.filename == "output_mode_shapes.npy"
-            out.writestr(info.filename, header.getvalue() + bytes(65536) if forged
-                         else source.read(info))
+            out.writestr(
+                info.filename, header.getvalue() + bytes(65536) if forged else source.read(info)
+            )
     return buffer.getvalue()
 
 
@@ -333,24 +336,40 @@ def _modal_toml(**changes) -> str:
 
 def _chains(count: int, segments: int) -> str:
     """``count`` uniform 3-DOF chains of ``segments`` segments around the nominal hub."""
-    data = {"name": "chains", "hub": {"mass_kg": 150.0, "radius_m": 0.6, "height_m": 1.5},
-            "appendages": []}
+    data = {
+        "name": "chains",
+        "hub": {"mass_kg": 150.0, "radius_m": 0.6, "height_m": 1.5},
+        "appendages": [],
+    }
     for k in range(count):
         angle = 2.0 * math.pi * k / count
-        data["appendages"].append({
-            "name": f"c{k}", "model": "chain", "segments": segments, "span_direction": "+y",
-            "mount_point_m": [0.8 * math.sin(-angle), 0.8 * math.cos(angle), 0.0],
-            "mount_yaw_deg": math.degrees(angle), "length_m": 4.5, "width_m": 1.5,
-            "thickness_m": 0.02, "surface_density_kg_m2": 1.0,
-            "joint": {"dofs": ["rx", "ry", "rz"], "damping_ratio": 0.005},
-            "beam": {"EI_flap_N_m2": 123.0, "EI_in_plane_N_m2": 491.0, "GJ_N_m2": 58.3}})
+        data["appendages"].append(
+            {
+                "name": f"c{k}",
+                "model": "chain",
+                "segments": segments,
+                "span_direction": "+y",
+                "mount_point_m": [0.8 * math.sin(-angle), 0.8 * math.cos(angle), 0.0],
+                "mount_yaw_deg": math.degrees(angle),
+                "length_m": 4.5,
+                "width_m": 1.5,
+                "thickness_m": 0.02,
+                "surface_density_kg_m2": 1.0,
+                "joint": {"dofs": ["rx", "ry", "rz"], "damping_ratio": 0.005},
+                "beam": {"EI_flap_N_m2": 123.0, "EI_in_plane_N_m2": 491.0, "GJ_N_m2": 58.3},
+            }
+        )
     return to_toml(data)
 
 
 def _chain_joint(**joint) -> str:
     data = tomllib.loads(_chains(2, 4))
-    data["appendages"][0]["joint"] = {"dofs": ["x", "rx"], "stiffness": {"x": 1e3, "rx": 10.0},
-                                      "damping_ratio": 0.005, **joint}
+    data["appendages"][0]["joint"] = {
+        "dofs": ["x", "rx"],
+        "stiffness": {"x": 1e3, "rx": 10.0},
+        "damping_ratio": 0.005,
+        **joint,
+    }
     del data["appendages"][0]["beam"]
     return to_toml(data)
 

@@ -34,23 +34,71 @@ BAD_CONFIGS = [
     ("misspelt key gets a hint", _edit("hub.mass", 150.0), "did you mean 'mass_kg'"),
     ("radians-style key", _edit("appendages.0.sadm_angle", 0.5), "did you mean 'sadm_angle_deg'"),
     ("missing hub mass", _edit("hub.mass_kg", ...), "missing required field 'hub.mass_kg'"),
-    ("negative hub mass", _edit("hub.mass_kg", -150.0), "hub.mass_kg: Input should be greater than or equal to 0.0001"),
-    ("zero panel length", _edit("appendages.0.length_m", 0.0), "appendages[0].length_m: Input should be greater than or equal to 0.001"),
-    ("string for a number", _edit("hub.radius_m", "0.6"), "hub.radius_m: Input should be a valid number"),
+    (
+        "negative hub mass",
+        _edit("hub.mass_kg", -150.0),
+        "hub.mass_kg: Input should be greater than or equal to 0.0001",
+    ),
+    (
+        "zero panel length",
+        _edit("appendages.0.length_m", 0.0),
+        "appendages[0].length_m: Input should be greater than or equal to 0.001",
+    ),
+    (
+        "string for a number",
+        _edit("hub.radius_m", "0.6"),
+        "hub.radius_m: Input should be a valid number",
+    ),
     ("boolean for a number", _edit("appendages.1.width_m", True), "appendages[1].width_m"),
     ("NaN mass", _edit("hub.mass_kg", math.nan), "hub.mass_kg: Input should be a finite number"),
     ("infinite density", _edit("appendages.0.surface_density_kg_m2", math.inf), "finite number"),
-    ("zero frequency", _edit("appendages.0.target_frequencies_hz.flapping", 0.0), "target_frequencies_hz.flapping: Input should be greater than or equal to 0.001"),
-    ("negative damping ratio", _edit("appendages.0.damping_ratio", -0.01), "damping_ratio: Input should be greater than or equal to 0"),
-    ("damping ratio of one", _edit("appendages.1.damping_ratio", 1.0), "damping_ratio: Input should be less than 1"),
-    ("SADM angle out of range", _edit("appendages.0.sadm_angle_deg", 400.0), "sadm_angle_deg: Input should be less than or equal to 360"),
-    ("both mass and density", _edit("appendages.0.mass_kg", 6.75), "exactly one of surface_density_kg_m2 and mass_kg"),
-    ("neither mass nor density", _edit("appendages.0.surface_density_kg_m2", ...), "exactly one of surface_density_kg_m2 and mass_kg"),
-    ("mount point of two numbers", _edit("appendages.0.mount_point_m", [0.0, 0.8]), "appendages[0].mount_point_m"),
-    ("bad span direction", _edit("appendages.0.span_direction", "+x"), "span_direction: Input should be '+y' or '-y'"),
+    (
+        "zero frequency",
+        _edit("appendages.0.target_frequencies_hz.flapping", 0.0),
+        "target_frequencies_hz.flapping: Input should be greater than or equal to 0.001",
+    ),
+    (
+        "negative damping ratio",
+        _edit("appendages.0.damping_ratio", -0.01),
+        "damping_ratio: Input should be greater than or equal to 0",
+    ),
+    (
+        "damping ratio of one",
+        _edit("appendages.1.damping_ratio", 1.0),
+        "damping_ratio: Input should be less than 1",
+    ),
+    (
+        "SADM angle out of range",
+        _edit("appendages.0.sadm_angle_deg", 400.0),
+        "sadm_angle_deg: Input should be less than or equal to 360",
+    ),
+    (
+        "both mass and density",
+        _edit("appendages.0.mass_kg", 6.75),
+        "exactly one of surface_density_kg_m2 and mass_kg",
+    ),
+    (
+        "neither mass nor density",
+        _edit("appendages.0.surface_density_kg_m2", ...),
+        "exactly one of surface_density_kg_m2 and mass_kg",
+    ),
+    (
+        "mount point of two numbers",
+        _edit("appendages.0.mount_point_m", [0.0, 0.8]),
+        "appendages[0].mount_point_m",
+    ),
+    (
+        "bad span direction",
+        _edit("appendages.0.span_direction", "+x"),
+        "span_direction: Input should be '+y' or '-y'",
+    ),
     ("no appendages", _edit("appendages", []), "appendages: List should have at least 1 item"),
     ("duplicate names", _edit("appendages.1.name", "panel_1"), "appendage names must be unique"),
-    ("hub cylinder and inertia", _edit("hub.inertia_kg_m2", [[1, 0, 0], [0, 1, 0], [0, 0, 1]]), "not both"),
+    (
+        "hub cylinder and inertia",
+        _edit("hub.inertia_kg_m2", [[1, 0, 0], [0, 1, 0], [0, 0, 1]]),
+        "not both",
+    ),
     ("hub without geometry", _edit("hub.radius_m", ...), "give both radius_m and height_m"),
     ("thick plate", _edit("appendages.0.thickness_m", 2.0), "thickness_m must not exceed"),
     ("hub as a number", _edit("hub", 3), "hub: expected a TOML table"),
@@ -74,7 +122,9 @@ def test_bad_config_is_refused_with_a_clear_message(what, data, fragment):
     assert "\n" not in message  # one message, one line
 
 
-@pytest.mark.parametrize(("what", "inertia", "fragment"), BAD_INERTIAS, ids=[c[0] for c in BAD_INERTIAS])
+@pytest.mark.parametrize(
+    ("what", "inertia", "fragment"), BAD_INERTIAS, ids=[c[0] for c in BAD_INERTIAS]
+)
 def test_bad_hub_inertia_is_refused(what, inertia, fragment):
     data = nominal_dict()
     data["hub"] = dict(_HUB_NO_CYLINDER, inertia_kg_m2=inertia)
@@ -85,7 +135,9 @@ def test_bad_hub_inertia_is_refused(what, inertia, fragment):
 
 def test_explicit_hub_inertia_is_accepted():
     data = nominal_dict()
-    data["hub"] = dict(_HUB_NO_CYLINDER, inertia_kg_m2=[[41.625, 0, 0], [0, 41.625, 0], [0, 0, 27.0]])
+    data["hub"] = dict(
+        _HUB_NO_CYLINDER, inertia_kg_m2=[[41.625, 0, 0], [0, 41.625, 0], [0, 0, 27.0]]
+    )
     cfg = validate_config(data)
     assert cfg.hub.inertia()[2, 2] == 27.0
 
@@ -197,7 +249,9 @@ def test_a_plate_may_touch_the_hub_but_not_enter_it(mount, yaw, span, refused):
     data = nominal_dict()
     data["appendages"][0].update(mount_point_m=mount, mount_yaw_deg=yaw, span_direction=span)
     if refused:
-        with pytest.raises(ConfigError, match=r"appendages\[0\] \(panel_1\) passes through the hub"):
+        with pytest.raises(
+            ConfigError, match=r"appendages\[0\] \(panel_1\) passes through the hub"
+        ):
             validate_config(data)
     else:
         validate_config(data)

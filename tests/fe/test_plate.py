@@ -63,8 +63,14 @@ def _direct_coupled_hz(plate) -> np.ndarray:
 
 
 def _modal_coupled_hz(plate, n_modes: int) -> np.ndarray:
-    data = craig_bampton(plate.M, plate.K, plate.interface_dofs, n_modes,
-                         interface_map=plate.interface_map, rigid_modes=plate.rigid_modes)
+    data = craig_bampton(
+        plate.M,
+        plate.K,
+        plate.interface_dofs,
+        n_modes,
+        interface_map=plate.interface_map,
+        rigid_modes=plate.rigid_modes,
+    )
     plant = Plant.from_config(validate_config({
         "hub": {"mass_kg": HUB_MASS, "inertia_kg_m2": HUB_J.tolist()},
         "appendages": [{"name": "plate", "model": "modal", "mount_point_m": ROOT.tolist(),

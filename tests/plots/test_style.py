@@ -73,7 +73,7 @@ def test_fixed_layout_keeps_labels_titles_and_legend_apart(shape, size, sharex):
     for i, a in enumerate(boxes):
         assert not a.padded(-1).overlaps(legend)
         assert not a.padded(-1).overlaps(title)
-        for b in boxes[i + 1:]:
+        for b in boxes[i + 1 :]:
             assert not a.padded(-1).overlaps(b.padded(-1))
 
 

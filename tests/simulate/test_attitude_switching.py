@@ -68,9 +68,7 @@ def test_the_energy_balance_stays_at_round_off(nominal_plant, through_the_pole, 
     assert np.abs(ds["energy_balance_error"].values).max() <= 1e-12
 
 
-def test_through_the_pole_equals_the_same_motion_away_from_it(
-    through_the_pole, away_from_the_pole
-):
+def test_through_the_pole_equals_the_same_motion_away_from_it(through_the_pole, away_from_the_pole):
     # Same motion, inertial frames 90 deg apart: R_N'B = R_0 R_NB, same body rates,
     # same panels, same energies. Both are RK4 at 1 ms on different Euler charts, so
     # their truncation errors differ, by (omega dt)^4 ~ 1e-16 per step on the hub
@@ -157,7 +155,7 @@ def test_a_slew_through_the_pole_reaches_its_target(nominal_plant, target_deg):
     # deg ends, which never comes near the pole. Both settle to the thesis slew's
     # steady pointing error (disturbances at their maximum: 2.3e-3 deg).
     through = _slew(nominal_plant, target_deg)
-    target_away = (_ROLL_90 * Rotation.from_euler("ZYX", target_deg[::-1], degrees=True))
+    target_away = _ROLL_90 * Rotation.from_euler("ZYX", target_deg[::-1], degrees=True)
     away = _slew(nominal_plant, tuple(target_away.as_euler("ZYX", degrees=True)[::-1]),
                  initial_deg=(90.0, 0.0, 0.0))  # fmt: skip
     assert through.attrs["status"] == "ok"

@@ -81,8 +81,10 @@ def _check(plant: Plant, scenario: SlewScenario) -> None:
     # states, so the recorded ones are equal bit for bit.
     assert np.array_equal(ds["joint_force"].values, Q)
     residual, rate = _errors(plant, ds, Q)
-    print(f"peak |Q| {np.abs(Q).max():.3g}: Euler residual {residual:.1e}, omega_dot error "
-          f"{rate:.1e} of the peak")
+    print(
+        f"peak |Q| {np.abs(Q).max():.3g}: Euler residual {residual:.1e}, omega_dot error "
+        f"{rate:.1e} of the peak"
+    )
     # Both sides come from one state's q_ddot (the hub solve against the joints'
     # wrench): round-off, 1e-10 of the peak leaves four orders of margin.
     assert residual <= 1e-10

@@ -41,7 +41,8 @@ def test_the_study_states_its_estimate_per_part(quick_study):
                  for lane in (0, 1))  # fmt: skip
     # the longer lane's sum; on one core (one lane), every part's
     assert estimate["total_s"] == pytest.approx(
-        longer if figure_workers() > 1 else sum(estimate["parts"].values()), rel=1e-12)
+        longer if figure_workers() > 1 else sum(estimate["parts"].values()), rel=1e-12
+    )
     assert estimate["basis"].startswith("basis: a 10 s slew flown now took")
 
 

@@ -291,4 +291,3 @@ def rank_correlations(parameters: pd.DataFrame, metrics: pd.DataFrame) -> pd.Dat
             if keep.sum() > 2 and x[keep].nunique() > 1 and y[keep].nunique() > 1:
                 out.loc[p, m] = stats.spearmanr(x[keep], y[keep]).statistic
     return out
-

@@ -160,8 +160,10 @@ def linearize(
     ] = None,
     actuated: Annotated[
         list[str] | None,
-        typer.Option(help="An appendage coordinate with a root actuator ('<appendage>."
-                     "<coordinate>' or '<coordinate>'): one more input. Repeatable."),
+        typer.Option(
+            help="An appendage coordinate with a root actuator ('<appendage>."
+            "<coordinate>' or '<coordinate>'): one more input. Repeatable."
+        ),
     ] = None,
     json_output: JsonOption = False,
     out: Annotated[
@@ -534,14 +536,18 @@ def campaign(
     ] = None,
     runner: Annotated[
         CampaignRunner,
-        typer.Option(help="Local runs: 'pool' (a case per worker process) or 'ensemble' "
-                     "(batches in one compiled call, --workers threads)."),
+        typer.Option(
+            help="Local runs: 'pool' (a case per worker process) or 'ensemble' "
+            "(batches in one compiled call, --workers threads)."
+        ),
     ] = CampaignRunner.pool,
     cases: Annotated[
         int | None,
-        typer.Option(help="Random cases to draw (random campaigns; default the campaign's "
-                     "[random] n). The nominal case comes on top when the campaign "
-                     "includes it: --cases 100 runs 101 cases."),
+        typer.Option(
+            help="Random cases to draw (random campaigns; default the campaign's "
+            "[random] n). The nominal case comes on top when the campaign "
+            "includes it: --cases 100 runs 101 cases."
+        ),
     ] = None,
     duration: Annotated[
         float | None, typer.Option(help="Override every case's duration [s] (quick looks).")
@@ -553,8 +559,10 @@ def campaign(
     json_output: JsonOption = False,
     controller: Annotated[
         str | None,
-        typer.Option(help="Fly every case with this registered law (its default gains) "
-                     "instead of the campaign's [base.controller]."),
+        typer.Option(
+            help="Fly every case with this registered law (its default gains) "
+            "instead of the campaign's [base.controller]."
+        ),
     ] = None,
 ) -> None:
     """Robustness campaign: many slews of a varied plant, stored case by case (Parquet, CSV).

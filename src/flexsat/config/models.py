@@ -80,27 +80,24 @@ class HubConfig(_Frozen):
     mass_kg: Mass = Field(description="hub mass [kg]")
     radius_m: Size | None = Field(None, description="cylinder radius [m]")
     height_m: Size | None = Field(None, description="cylinder height along hub Z [m]")
-    inertia_kg_m2: tuple[
-        tuple[InertiaEntry, InertiaEntry, InertiaEntry],
-        tuple[InertiaEntry, InertiaEntry, InertiaEntry],
-        tuple[InertiaEntry, InertiaEntry, InertiaEntry],
-    ] | None = Field(
-        None, description="inertia about the hub centre of mass, hub frame B [kg m^2]"
-    )
+    inertia_kg_m2: (
+        tuple[
+            tuple[InertiaEntry, InertiaEntry, InertiaEntry],
+            tuple[InertiaEntry, InertiaEntry, InertiaEntry],
+            tuple[InertiaEntry, InertiaEntry, InertiaEntry],
+        ]
+        | None
+    ) = Field(None, description="inertia about the hub centre of mass, hub frame B [kg m^2]")
 
     @model_validator(mode="after")
     def _geometry_or_inertia(self) -> HubConfig:
         has_cylinder = self.radius_m is not None or self.height_m is not None
         if self.inertia_kg_m2 is not None:
             if has_cylinder:
-                raise ValueError(
-                    "give either radius_m and height_m or inertia_kg_m2, not both"
-                )
+                raise ValueError("give either radius_m and height_m or inertia_kg_m2, not both")
             _check_inertia(np.array(self.inertia_kg_m2, dtype=float))
         elif self.radius_m is None or self.height_m is None:
-            raise ValueError(
-                "give both radius_m and height_m (cylinder), or inertia_kg_m2 (3x3)"
-            )
+            raise ValueError("give both radius_m and height_m (cylinder), or inertia_kg_m2 (3x3)")
         return self
 
     def inertia(self) -> np.ndarray:
@@ -128,8 +125,7 @@ def _check_inertia(j: np.ndarray) -> None:
     # A rigid body's principal moments obey the triangle inequality J1 + J2 >= J3.
     if principal[0] + principal[1] < principal[2] * (1.0 - 1e-9):
         raise ValueError(
-            "inertia_kg_m2 is not a rigid body's: the principal moments must satisfy "
-            "J1 + J2 >= J3"
+            "inertia_kg_m2 is not a rigid body's: the principal moments must satisfy J1 + J2 >= J3"
         )
 
 

@@ -148,4 +148,3 @@ def pointing_errors(q_d, euler):
     for k in range(euler.shape[0]):
         out[k] = pointing_error(q_d, euler_zyx_to_quaternion(euler[k, 0], euler[k, 1], euler[k, 2]))
     return out
-

@@ -462,8 +462,7 @@ def hub_joint_wrench(q, qd, qdd, Q, packed, out):
     """
     out[:] = 0.0
     for g in range(len(packed.joint_wrench)):
-        status = packed.joint_wrench[g](q, qd, qdd, Q, packed.members[g], packed.params[g],
-                                        out)
+        status = packed.joint_wrench[g](q, qd, qdd, Q, packed.members[g], packed.params[g], out)
         if status != STATUS_OK:
             return status
     return STATUS_OK

@@ -81,9 +81,7 @@ def uniform_beam(length_m: float, n_elements: int, *, mass_per_length_kg_m: floa
         from skfem import Basis, BilinearForm, ElementLineHermite, ElementLineP1, MeshLine
         from skfem.helpers import dd, ddot, dot, grad
     except ImportError:  # pragma: no cover - the fe extra is not installed
-        raise ConfigError(
-            "uniform_beam needs scikit-fem: pip install 'flexsat[fe]'"
-        ) from None
+        raise ConfigError("uniform_beam needs scikit-fem: pip install 'flexsat[fe]'") from None
     if n_elements < 1:
         raise ConfigError(f"n_elements: must be >= 1, got {n_elements}")
     mesh = MeshLine(np.linspace(0.0, length_m, n_elements + 1))
@@ -104,10 +102,22 @@ def uniform_beam(length_m: float, n_elements: int, *, mass_per_length_kg_m: floa
     m_l, m_h = mass.assemble(lagrange), mass.assemble(hermite)
     k_l, k_h = stretch.assemble(lagrange), bend.assemble(hermite)
     # Fields in order u_y, phi_y, w_x, w_z.
-    M = sp.block_diag([mass_per_length_kg_m * m_l, polar_inertia_per_length_kg_m * m_l,
-                       mass_per_length_kg_m * m_h, mass_per_length_kg_m * m_h]).tocsr()
-    K = sp.block_diag([axial_stiffness_n * k_l, torsional_stiffness_n_m2 * k_l,
-                       bending_stiffness_z_n_m2 * k_h, bending_stiffness_x_n_m2 * k_h]).tocsr()
+    M = sp.block_diag(
+        [
+            mass_per_length_kg_m * m_l,
+            polar_inertia_per_length_kg_m * m_l,
+            mass_per_length_kg_m * m_h,
+            mass_per_length_kg_m * m_h,
+        ]
+    ).tocsr()
+    K = sp.block_diag(
+        [
+            axial_stiffness_n * k_l,
+            torsional_stiffness_n_m2 * k_l,
+            bending_stiffness_z_n_m2 * k_h,
+            bending_stiffness_x_n_m2 * k_h,
+        ]
+    ).tocsr()
     # w_x bends about Z (stiffness EI_z), w_z about X (EI_x).
     n_l, n_h = lagrange.N, hermite.N
     offsets = (0, n_l, 2 * n_l, 2 * n_l + n_h)

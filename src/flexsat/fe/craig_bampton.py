@@ -107,8 +107,7 @@ def craig_bampton(
         psi = np.asarray(rigid_modes, dtype=float)
         if psi.shape != (n, 6) or not np.allclose(psi[b], T_b, rtol=0.0, atol=1e-12):
             raise ConfigError(
-                f"rigid_modes: expected shape ({n}, 6) with the interface_map as its "
-                "interface rows"
+                f"rigid_modes: expected shape ({n}, 6) with the interface_map as its interface rows"
             )
     M_rr = psi.T @ (M @ psi)
     M_rr = 0.5 * (M_rr + M_rr.T)

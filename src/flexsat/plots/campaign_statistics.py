@@ -116,8 +116,13 @@ def _parameters(store: CampaignStore) -> pd.DataFrame:
     numeric = table.apply(pd.to_numeric, errors="coerce")
     numeric = numeric.loc[:, numeric.nunique() > 1]
     physical = {c.rsplit(" [", 1)[0] for c in numeric.columns if not c.endswith(" [factor]")}
-    return numeric[[c for c in numeric.columns
-                    if not c.endswith(" [factor]") or c.removesuffix(" [factor]") not in physical]]
+    return numeric[
+        [
+            c
+            for c in numeric.columns
+            if not c.endswith(" [factor]") or c.removesuffix(" [factor]") not in physical
+        ]
+    ]
 
 
 def plot_parameter_scatter(store_dir: str | Path, metric: str = DEFAULT_METRIC) -> Figure:

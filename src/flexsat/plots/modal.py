@@ -515,6 +515,7 @@ def write_modal_figures(
         _shape(analysis, k)  # validate every index before writing anything
     static = {"interaction_map": plot_interaction_map, "frequencies": plot_frequencies}
     written = style.write_figures(out, static, lambda name: static[name](analysis), dpi=150)
+
     def animate(k: int) -> list[Path]:
         still = out / f"mode_{int(k)}.png"
         gif = animate_mode(analysis, int(k), out / f"mode_{int(k)}.gif", frames=frames, fps=fps,

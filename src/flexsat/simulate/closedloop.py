@@ -66,6 +66,7 @@ class Controller(Protocol):
 
     def __call__(self, t: float, q: np.ndarray, omega_B: np.ndarray) -> np.ndarray: ...
 
+
 def design_inertia(config: SatelliteConfig | None = None) -> np.ndarray:
     """J_tot of a rigidized satellite [kg m^2], shape (3, 3): the controllers' design model.
 
@@ -146,8 +147,10 @@ def run_slew(
     scenario = scenario or SlewScenario()
     run = prepare_slew(plant, scenario, design_J)
     layout = run.layout
-    if controller is not None and (layout.reference.name != REFERENCES.default
-                                   or layout.joint_actuator.name != JOINT_ACTUATORS.default):
+    if controller is not None and (
+        layout.reference.name != REFERENCES.default
+        or layout.joint_actuator.name != JOINT_ACTUATORS.default
+    ):
         raise ConfigError("a Python controller flies the step reference without joint "
                           "actuators: remove [reference] and [joint_actuator]")  # fmt: skip
     steps = scenario.n_steps
@@ -346,8 +349,6 @@ def finish_slew(run: PreparedSlew, status: int, done: int, rows: int, wall: floa
         attrs, frames=rec_frame, joint_force=rec_Q, solved=rec_solved, more=added,
     )  # fmt: skip
     return Result(ds)
-
-
 
 
 def flown_chain(scenario: SlewScenario) -> tuple[list, int]:

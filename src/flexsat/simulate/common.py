@@ -118,8 +118,6 @@ class progress_bar:
             self.progress.stop()
 
 
-
-
 # Measured on the nominal satellite (18 DOF): about 830 B per record of an open-loop
 # dataset and 1130 B of a slew's (its joint forces included), i.e. 8 B x (6 per DOF
 # + 40) at most; the records, the dataset built from them and the NetCDF writer hold

@@ -194,7 +194,6 @@ def sadm_study(plant, duration_s: float | None = None) -> dict:
     return _sadm_summary(*(_sadm_run(driven, fields, duration_s) for fields in runs))
 
 
-
 def sadm_plant(config: SatelliteConfig) -> Plant:
     """The satellite of (c): its plates on the drive :data:`SADM_DRIVE`.
 
@@ -212,7 +211,8 @@ def sadm_plant(config: SatelliteConfig) -> Plant:
 
     drive = SADM_DRIVE
     return Plant.from_config(
-        with_sadm(config, drive["rotor_inertia_kg_m2"], drive["rotor_mass_kg"]))
+        with_sadm(config, drive["rotor_inertia_kg_m2"], drive["rotor_mass_kg"])
+    )
 
 
 def sadm_runs(config: SatelliteConfig) -> list[dict]:
@@ -348,7 +348,7 @@ def avionics_study(plant, out: str | Path, quick: bool = False,
     flown = forked_map(fly, runs)
     (ideal, _), (avionics, stage_figures), *rest = flown
     swept = [metrics for metrics, _ in rest[: len(periods)]]
-    driven_runs = [metrics for metrics, _ in rest[len(periods):]]
+    driven_runs = [metrics for metrics, _ in rest[len(periods) :]]
     side_by_side = {"ideal": ideal, "avionics": avionics}
     sweep = []
     for n, row in zip(periods, swept, strict=True):

@@ -110,8 +110,9 @@ def derived_properties(plant: Plant) -> dict:
         "hub_inertia_kg_m2": plant.hub_J.tolist(),
         "appendages": [
             {"name": app.name, "model": model.name, **model.describe(app, params)}
-            for app, model, params in zip(plant.config.appendages, plant.models, plant.params,
-                                          strict=True)
+            for app, model, params in zip(
+                plant.config.appendages, plant.models, plant.params, strict=True
+            )
         ],
     }
 

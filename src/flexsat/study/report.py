@@ -528,8 +528,11 @@ def _campaigns(root: Path, outputs: dict, context: dict) -> str:
         )
         parts.append(_campaign_worst(src))
         parts.append(_campaign_cases(root, store))
-        figures = [f for f in outputs["figures"]
-                   if f.startswith(store + "/") and not f.endswith(_SUMMARY_TABLE_FIGURE)]
+        figures = [
+            f
+            for f in outputs["figures"]
+            if f.startswith(store + "/") and not f.endswith(_SUMMARY_TABLE_FIGURE)
+        ]
         parts.append(_figures(root, figures))  # fmt: skip
     return "".join(parts)
 

@@ -39,9 +39,7 @@ def test_quaternion_error_is_identity_at_the_target():
     q = euler_zyx_to_quaternion(*np.radians([10.0, -20.0, 30.0]))
     np.testing.assert_allclose(quaternion_error(q_d, q), [1, 0, 0, 0], atol=1e-15)
     # and picks the shorter rotation: -q is the same attitude
-    np.testing.assert_allclose(
-        quaternion_error(q_d, tuple(-np.array(q))), [1, 0, 0, 0], atol=1e-15
-    )
+    np.testing.assert_allclose(quaternion_error(q_d, tuple(-np.array(q))), [1, 0, 0, 0], atol=1e-15)
 
 
 def test_asmc_far_from_target_uses_lambda_min_and_the_whole_budget():

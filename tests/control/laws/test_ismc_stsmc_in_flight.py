@@ -111,7 +111,12 @@ def test_python_callback_path_reproduces_the_compiled_loop(nominal_plant, kind):
     # between calls as the loop does: the same slew to round-off.
     scenario = SlewScenario.model_validate({"duration_s": 5.0, "controller": {"kind": kind}})
     compiled = run_slew(nominal_plant, scenario).dataset
-    law = CompiledLaw(scenario.controller, scenario.actuator, design_inertia(),
-                      target_quaternion(scenario.target_euler_deg), scenario.control_dt_s)
+    law = CompiledLaw(
+        scenario.controller,
+        scenario.actuator,
+        design_inertia(),
+        target_quaternion(scenario.target_euler_deg),
+        scenario.control_dt_s,
+    )
     python = run_slew(nominal_plant, scenario, controller=law).dataset  # fmt: skip
     np.testing.assert_allclose(python["q"].values, compiled["q"].values, rtol=0, atol=1e-12)

@@ -33,8 +33,9 @@ def _static_samples(step, params, state_size, n, every):
 
 
 def _scenario(**fields) -> SlewScenario:
-    return SlewScenario.model_validate({"duration_s": 3600.0, "dt_s": 0.01,
-                                        "control_dt_s": 0.01, "record_dt_s": 1.0, **fields})
+    return SlewScenario.model_validate(
+        {"duration_s": 3600.0, "dt_s": 0.01, "control_dt_s": 0.01, "record_dt_s": 1.0, **fields}
+    )
 
 
 def _gyro(config: GyroConfig, seconds: float = 3600.0) -> np.ndarray:
@@ -117,7 +118,6 @@ def test_mekf_attitude_error_is_consistent_with_its_covariance(nominal_plant):
     assert 2.0 <= nees.mean() <= 4.0
 
 
-
 def test_mekf_records_its_bias_estimate_inside_its_3_sigma(nominal_plant):
     # The bias's sqrt(diag P) starts at initial_bias_std_deg_h (0.05 deg/h; the record
     # at t = 0 precedes the filter's first step and is zero) and grows by the bias's
@@ -139,20 +139,37 @@ def test_mekf_records_its_bias_estimate_inside_its_3_sigma(nominal_plant):
 
 
 BAD = [
-    ("wheel axes", '[actuator]\nkind = "wheels"\naxes = [[1, 0, 0], [0, 1, 0], [1, 1, 0]]\n',
-     "actuator: axes: the spin axes must span 3D"),
-    ("negative noise", '[[sensor_stages]]\nkind = "gyro"\narw_deg_rt_h = -0.1\n',
-     "sensor_stages[0].arw_deg_rt_h: Input should be greater than or equal to 0"),
-    ("negative star tracker noise",
-     '[[sensor_stages]]\nkind = "star_tracker"\nnoise_arcsec = [5, -5, 30]\n',
-     "sensor_stages[0].noise_arcsec[1]: Input should be greater than or equal to 0"),
-    ("delay longer than the run",
-     'duration_s = 1.0\ncontrol_dt_s = 0.01\n[[actuator_stages]]\nkind = "delay"\n'
-     "periods = 200\n", "actuator_stages[0].periods: a delay of 200 control periods"),
-    ("gyro rate not a multiple", '[[sensor_stages]]\nkind = "gyro"\nsample_dt_s = 0.0025\n',
-     "sensor_stages[0].sample_dt_s must be a whole multiple of control_dt_s"),
-    ("limitless final actuator", '[actuator]\nkind = "delay"\n',
-     "can only be one of the actuator_stages"),
+    (
+        "wheel axes",
+        '[actuator]\nkind = "wheels"\naxes = [[1, 0, 0], [0, 1, 0], [1, 1, 0]]\n',
+        "actuator: axes: the spin axes must span 3D",
+    ),
+    (
+        "negative noise",
+        '[[sensor_stages]]\nkind = "gyro"\narw_deg_rt_h = -0.1\n',
+        "sensor_stages[0].arw_deg_rt_h: Input should be greater than or equal to 0",
+    ),
+    (
+        "negative star tracker noise",
+        '[[sensor_stages]]\nkind = "star_tracker"\nnoise_arcsec = [5, -5, 30]\n',
+        "sensor_stages[0].noise_arcsec[1]: Input should be greater than or equal to 0",
+    ),
+    (
+        "delay longer than the run",
+        'duration_s = 1.0\ncontrol_dt_s = 0.01\n[[actuator_stages]]\nkind = "delay"\n'
+        "periods = 200\n",
+        "actuator_stages[0].periods: a delay of 200 control periods",
+    ),
+    (
+        "gyro rate not a multiple",
+        '[[sensor_stages]]\nkind = "gyro"\nsample_dt_s = 0.0025\n',
+        "sensor_stages[0].sample_dt_s must be a whole multiple of control_dt_s",
+    ),
+    (
+        "limitless final actuator",
+        '[actuator]\nkind = "delay"\n',
+        "can only be one of the actuator_stages",
+    ),
 ]
 
 

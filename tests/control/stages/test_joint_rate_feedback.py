@@ -86,10 +86,10 @@ def test_joint_forces_react_on_the_hub_through_the_joint_equations(nominal_plant
         Q[names.index(name)] = value
     scratch = np.empty((5, x.size))
     energy = lambda q, qd: plant.kinetic_energy(q, qd) + plant.elastic_energy(q)  # noqa: E731
-    H0, E0 = plant.angular_momentum(x[:n], x[n:2 * n]), energy(x[:n], x[n:2 * n])
+    H0, E0 = plant.angular_momentum(x[:n], x[n : 2 * n]), energy(x[:n], x[n : 2 * n])
     for _ in range(50_000):
         assert rk4_step(x, 1e-4, (0.0, 0.0, 0.0), n, Q, scratch, plant.packed) == 0
-    q, qd = x[:n], x[n:2 * n]
+    q, qd = x[:n], x[n : 2 * n]
     H = plant.angular_momentum(q, qd)
     assert np.abs(H - H0).max() <= 1e-9 * np.linalg.norm(H0)
     work_in, dissipated = x[2 * n], x[2 * n + 1]

@@ -47,8 +47,7 @@ def test_torque_is_the_pd_law_on_the_driven_coordinates_only(driven):
     x = np.zeros(2 * n + 2)
     x[drive[0]], x[n + drive[0]] = 0.001, 0.0005  # ahead of the command, faster
     Q, record, J = np.zeros(n), np.zeros(4), np.eye(3)
-    assert STEP(x, n, 2.0, 1e-3, np.array([1.0, 0, 0, 0]), J, params, np.zeros(10), Q,
-                record) == 0
+    assert STEP(x, n, 2.0, 1e-3, np.array([1.0, 0, 0, 0]), J, params, np.zeros(10), Q, record) == 0
     assert np.array_equal(J, np.eye(3))  # design_model "initial": left as it is
     r = np.radians(0.06)
     expected = 4.0 * (2.0 * r - 0.001) + 1.0 * (r - 0.0005)

@@ -93,8 +93,10 @@ def test_the_followed_design_inertia_is_the_rigid_model_at_the_measured_angles(d
 
 
 def test_measured_needs_rotations_each_of_its_own_appendage(driven):
-    bad = [(["eta_x_1"], "'measured' follows rotation angles only"),
-           (["panel_1.eta_ry_0", "panel_1.eta_ry_1"], "one driven coordinate per appendage")]
+    bad = [
+        (["eta_x_1"], "'measured' follows rotation angles only"),
+        (["panel_1.eta_ry_0", "panel_1.eta_ry_1"], "one driven coordinate per appendage"),
+    ]
     for coordinates, fragment in bad:
         config = SADMDriveConfig(**{**_DRIVE, "coordinates": coordinates}, design_model="measured")
         with pytest.raises(ConfigError, match=f"joint_actuator.design_model: .*{fragment}"):

@@ -94,8 +94,15 @@ def test_far_limit_wheels_fly_the_ideal_slew(nominal_plant):
         "duration_s": 60.0, "controller": {"kind": "pd"},
         "actuator": {"kind": "static", "gain": [1.0, 1.0, 1.0]}, "disturbances": QUIET,
     })).dataset  # fmt: skip
-    wheels = _slew(nominal_plant, duration_s=60.0, max_speed_rpm=1e5, max_torque_nm=100.0,
-                   viscous_nm_s_rad=0.0, coulomb_nm=0.0, motor_time_constant_s=1e-3)
+    wheels = _slew(
+        nominal_plant,
+        duration_s=60.0,
+        max_speed_rpm=1e5,
+        max_torque_nm=100.0,
+        viscous_nm_s_rad=0.0,
+        coulomb_nm=0.0,
+        motor_time_constant_s=1e-3,
+    )
     # What differs physically: the wheels keep the slew's momentum inside the
     # satellite (omega x h_w, which the PD's omega x J omega does not compensate) and
     # lag the command by tau_m = 1 ms. Both are second order at slew rates
@@ -151,8 +158,9 @@ def test_a_python_controller_flies_the_wheels_like_the_compiled_loop(nominal_pla
     # The Python-controller path steps the coupled RK4 in compiled blocks
     # (rk4_coupled_hold): a zero command leaves the wheels' momentum where the
     # initial speed put it and the satellite at rest, as the compiled path does.
-    scenario = SlewScenario.model_validate({
-        "duration_s": 1.0, "actuator": {"kind": "wheels", "initial_speed_rpm": 100.0}})
+    scenario = SlewScenario.model_validate(
+        {"duration_s": 1.0, "actuator": {"kind": "wheels", "initial_speed_rpm": 100.0}}
+    )
     ds = run_slew(nominal_plant, scenario, controller=lambda t, q, w: np.zeros(3)).dataset
     assert ds.attrs["status"] == "ok", ds.attrs.get("message")
     h0 = 0.1 * 100.0 * np.pi / 30.0 * 4.0 * np.cos(np.radians(54.7356))  # sum a_z h_i

@@ -135,8 +135,10 @@ def test_hinge_wrench_equals_the_locked_6dof_joint(segments):
             out.append(plant.joint_wrench_on_hub(q, qd, Q)[0])
     force_a, force_b = np.array(force_a), np.array(force_b)
     force_error = np.abs(force_a - force_b).max() / np.abs(force_b).max()
-    print(f"N = {segments}: torque {np.abs(tau_a - tau_b).max() / peak:.1e}, "
-          f"force {force_error:.1e} of the peak")
+    print(
+        f"N = {segments}: torque {np.abs(tau_a - tau_b).max() / peak:.1e}, "
+        f"force {force_error:.1e} of the peak"
+    )
     assert force_error <= 1e-9
     # The hinge's own torque -tau_ry R_BM e_y (the free-direction wrench, S_r = e_y)
     # misses the reactions by a good part of the peak (measured 27 % for N = 1).

@@ -120,8 +120,10 @@ def test_drive_torque_is_internal_momentum_and_energy(driven):
     work = log[:, 2 * n]
     balance = np.abs(energy - energy[0] - work).max() / np.abs(work).max()
     drive = [driven.layout.dof_names().index(f"panel_{k}.{DRIVE_COORDINATE}") for k in (1, 2)]
-    print(f"momentum drift {drift:.1e}, energy balance {balance:.1e} of the drive work "
-          f"{np.abs(work).max():.2e} J")
+    print(
+        f"momentum drift {drift:.1e}, energy balance {balance:.1e} of the drive work "
+        f"{np.abs(work).max():.2e} J"
+    )
     assert np.degrees(q[-1, drive]) == pytest.approx([60.0, 60.0], abs=0.01)
     assert drift <= 1e-10
     assert np.abs(work).max() > 1e-4  # the drive did work, and it is booked
@@ -149,6 +151,7 @@ def test_drive_energy_balance_closes_to_round_off_as_the_step_shrinks(driven):
     print(f"energy balance {residual[2.5e-4]:.1e} J, {residual[1.25e-4]:.1e} J; E0 {e0:.3f} J")
     assert residual[2.5e-4] >= 16.0 * residual[1.25e-4]
     assert residual[1.25e-4] <= 1e-12 * e0
+
 
 def test_hub_reaction_is_the_rigid_body_momentum_argument(driven):
     # Hub at rest, both arrays driven about Y_B: each array's centre of mass and its
@@ -191,8 +194,10 @@ def test_drive_angle_tracks_a_constant_rate(driven):
     beta = log[:, names.index(f"panel_1.{DRIVE_COORDINATE}")]
     error = np.abs(beta - rate * t)
     peak = rate / (np.e * OMEGA_N)
-    print(f"peak error {error.max():.2e} rad (bound {peak:.2e}), after 20 s "
-          f"{error[t >= 20.0].max():.2e}")
+    print(
+        f"peak error {error.max():.2e} rad (bound {peak:.2e}), after 20 s "
+        f"{error[t >= 20.0].max():.2e}"
+    )
     assert error.max() <= peak
     assert error[t >= 20.0].max() <= 0.01 * peak
     assert n == Plant.from_config(nominal()).n_dof + 2

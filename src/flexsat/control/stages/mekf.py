@@ -195,7 +195,13 @@ def mekf_step(x, n_dof, t, params, state, q_meas, omega_meas, record):
         for i in range(6):
             G[i, i] = 1.0
         G[0, 1], G[0, 2], G[1, 0], G[1, 2], G[2, 0], G[2, 1] = (
-            w2 * dt, -w1 * dt, -w2 * dt, w0 * dt, w1 * dt, -w0 * dt)  # I - [w x] dt
+            w2 * dt,
+            -w1 * dt,
+            -w2 * dt,
+            w0 * dt,
+            w1 * dt,
+            -w0 * dt,
+        )  # I - [w x] dt
         for i in range(3):
             G[i, 3 + i] = -dt
         _sandwich(P, G, T)

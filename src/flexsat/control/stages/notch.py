@@ -100,9 +100,11 @@ def _bilinear(num, den, frequency_hz: float, dt: float) -> list[float]:
     prewarped so that the response at ``frequency_hz`` is exact."""
     w = 2.0 * pi * frequency_hz
     c = w / tan(w * dt / 2.0)  # s = c (z - 1) / (z + 1)
+
     def poly(p):
         p0, p1, p2 = p[0] * c * c, p[1] * w * c, p[2] * w * w
         return p0 + p1 + p2, 2.0 * (p2 - p0), p0 - p1 + p2
+
     b, a = poly(num), poly(den)
     return [b[0] / a[0], b[1] / a[0], b[2] / a[0], a[1] / a[0], a[2] / a[0]]
 

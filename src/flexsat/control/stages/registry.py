@@ -125,8 +125,16 @@ ACTUATOR_SIGNATURE = types.int64(_vec, types.float64, types.float64, _vec, _vec,
 REFERENCE_SIGNATURE = types.int64(types.float64, _vec, _vec, _vec, _vec, _vec, _vec)
 """t, params, state, q_d (out), omega_d (out), omega_dot_d (out), record (out)."""
 JOINT_ACTUATOR_SIGNATURE = types.int64(
-    _vec, types.int64, types.float64, types.float64, _vec, types.float64[:, ::1], _vec, _vec,
-    _vec, _vec,
+    _vec,
+    types.int64,
+    types.float64,
+    types.float64,
+    _vec,
+    types.float64[:, ::1],
+    _vec,
+    _vec,
+    _vec,
+    _vec,
 )
 """x, n_dof, t, dt, q_d, J_design (in/out), params, state, Q (out), record (out)."""
 DERIVATIVE_SIGNATURE = types.int64(_vec, types.int64, types.float64, _vec, _vec, _vec, _vec, _vec)

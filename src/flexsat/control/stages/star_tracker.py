@@ -38,9 +38,7 @@ _COUNT, _DRAWN, _HELD, _PENDING, _DUE = 0, 1, 2, 6, 10
 class StarTrackerConfig(StageConfig):
     """A star tracker (module docstring); replaces the measured attitude."""
 
-    kind: Literal["star_tracker"] = Field(
-        "star_tracker", description="the stage's registered name"
-    )
+    kind: Literal["star_tracker"] = Field("star_tracker", description="the stage's registered name")
     sample_dt_s: Positive = Field(0.1, description="sample period [s]")
     noise_arcsec: tuple[NonNegative, NonNegative, NonNegative] = Field(
         (5.0, 5.0, 30.0), description="1-sigma noise about body x, y, z [arcsec]"

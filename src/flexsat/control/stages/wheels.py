@@ -58,8 +58,9 @@ __all__ = ["MAX_WHEELS", "SATURATED_RATIO", "WHEELS", "WheelsConfig", "wheel_axe
 MAX_WHEELS = 6
 """Most wheels in one cluster (the stage's state is sized for them)."""
 # the disturbances first, as the static actuator packs them (DisturbanceConfig.packed)
-_ENV, _RATIO, _HZ, _RES = (DISTURBANCES[k] for k in ("environment_nm", "sloshing_ratio",
-                                                     "sloshing_hz", "residual_nm"))
+_ENV, _RATIO, _HZ, _RES = (
+    DISTURBANCES[k] for k in ("environment_nm", "sloshing_ratio", "sloshing_hz", "residual_nm")
+)
 _D = DISTURBANCES["t_max_nm"] + 1  # then the wheels'
 _N, _IS, _UMAX, _WMAX, _CV, _CC, _WC, _TAU, _KNULL, _WBIAS, _W0 = range(_D, _D + 11)
 _A = _D + 11  # A, row-major (3, MAX_WHEELS)
@@ -161,8 +162,10 @@ class WheelsConfig(ActuatorStageConfig):
 
     def check(self, scenario) -> None:
         if self.motor_time_constant_s < scenario.dt_s:
-            raise ValueError(f"motor_time_constant_s must be at least dt_s ({scenario.dt_s} s) "
-                             f"for the RK4 step to follow it, got {self.motor_time_constant_s}")
+            raise ValueError(
+                f"motor_time_constant_s must be at least dt_s ({scenario.dt_s} s) "
+                f"for the RK4 step to follow it, got {self.motor_time_constant_s}"
+            )
 
     def packed(self, scenario) -> np.ndarray:
         axes = self.spin_axes()

@@ -434,4 +434,3 @@ def _with_point_mass(seg, tip_mass: float, point: np.ndarray):
     inertia = (seg.inertia + seg.mass * (d1 @ d1 * np.eye(3) - np.outer(d1, d1))
                + tip_mass * (d2 @ d2 * np.eye(3) - np.outer(d2, d2)))  # fmt: skip
     return mass, com, inertia
-

@@ -350,8 +350,10 @@ def bias_forces(q, qd, members, params, hub, h):
         c1 = add(load_seg(p, P_FIRST), s)
         J, J_dot = _inertia(q, qd, o, p)
         a_I = add(cross(alpha, r), cross(omega, cross(omega, r)))
-        F = add(add(scale(m, a_I), cross(alpha, c1)),
-                add(cross(omega, cross(omega, c1)), scale(2.0, cross(omega, s_dot))))
+        F = add(
+            add(scale(m, a_I), cross(alpha, c1)),
+            add(cross(omega, cross(omega, c1)), scale(2.0, cross(omega, s_dot))),
+        )
         N = add(add(add(cross(c1, a_I), mv(J, alpha)), mv(J_dot, omega)),
                 add(cross(omega, mv(J, omega)), cross(omega, h_r)))  # fmt: skip
         F_N = mv(R_NB, F)
@@ -361,8 +363,11 @@ def bias_forces(q, qd, members, params, hub, h):
             hub[HUB_TORQUE + a] += T[a]
         for k in range(int(p[P_N])):
             b = P_MODES + MODE_SIZE * k
-            h[o + k] = (dot(load_seg(p, b + MODE_LT), a_I) + dot(load_seg(p, b + MODE_LR), alpha)
-                        - _centrifugal(p, k, omega))
+            h[o + k] = (
+                dot(load_seg(p, b + MODE_LT), a_I)
+                + dot(load_seg(p, b + MODE_LR), alpha)
+                - _centrifugal(p, k, omega)
+            )
 
 
 @njit(cache=True, error_model="numpy")  # compiled with OBSERVE_SIGNATURE on first use

@@ -560,7 +560,6 @@ def _passes(holds_locks: bool) -> tuple:
         hub[HUB_DISSIPATION] = dissipated
         return STATUS_OK
 
-
     @njit(cache=True, error_model="numpy")  # compiled with PASS2_SIGNATURE on first use
     def pass2(q, qd, members, params, work, hub, qdd):
         """Relative accelerations of each joint from the absolute ones left by :func:`pass1`."""
@@ -610,8 +609,8 @@ free_pass1, free_pass2 = _passes(holds_locks=False)
 def mass_matrix(q, members, params, M):
     """The plates' share of M(q) (eq. 2.39), from their velocity Jacobians::
 
-        v_G = R_BN r_dot - [r_G]x S Theta_dot + R_BM eta_dot - R_BP [d]x S(rho) rho_dot
-        w_P = R_BP^T S Theta_dot + S(rho) rho_dot
+    v_G = R_BN r_dot - [r_G]x S Theta_dot + R_BM eta_dot - R_BP [d]x S(rho) rho_dot
+    w_P = R_BP^T S Theta_dot + S(rho) rho_dot
     """
     R_NB = rot_zyx(q[3], q[4], q[5])
     S = euler_rate_matrix(q[3], q[4])
