@@ -39,8 +39,8 @@ LAYERS: tuple[tuple[str, tuple[str, ...]], ...] = (
     ("physics", ("flexsat.dynamics",)),
     ("configuration", ("flexsat.config",)),
     ("compiled toolkit", ("flexsat.compiled",)),
-    ("shared", ("flexsat.errors", "flexsat.files", "flexsat.jsonable", "flexsat.parallel",
-                "flexsat.pool", "flexsat.processes", "flexsat._version")),
+    ("shared", ("flexsat.errors", "flexsat.files", "flexsat.parallel", "flexsat.pool",
+                "flexsat.processes", "flexsat.strict_json", "flexsat._version")),
 )  # fmt: skip
 
 

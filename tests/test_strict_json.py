@@ -12,7 +12,7 @@ import math
 from hypothesis import given
 from hypothesis import strategies as st
 
-from flexsat.jsonable import dumps, jsonable
+from flexsat.strict_json import dumps, jsonable
 
 _scalars = st.none() | st.booleans() | st.integers() | st.text(max_size=8) | st.floats()
 _trees = st.recursive(

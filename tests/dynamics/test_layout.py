@@ -7,7 +7,7 @@ import numpy as np
 from flexsat.compiled import status
 from flexsat.dynamics.appendages import PlateModel, appendage_model, appendage_model_names
 from flexsat.dynamics.plant import Plant
-from flexsat.simulate.common import run_attributes
+from flexsat.simulate.run_setup import run_attributes
 from tests.conftest import three_panels
 
 

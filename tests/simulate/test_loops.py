@@ -10,7 +10,7 @@ from numba import njit, typeof
 
 from flexsat.control import StageConfig, StageSpec, register_stage
 from flexsat.control.stages import ACTUATOR_SIGNATURE, ACTUATORS
-from flexsat.simulate import SlewScenario, closedloop, run_slew
+from flexsat.simulate import SlewScenario, run_slew, stage_chain
 from flexsat.simulate.closedloop import prepare_slew
 from flexsat.simulate.coupled import CHAIN_SLOTS
 
@@ -84,7 +84,7 @@ def test_a_chain_longer_than_the_slots_runs_each_of_its_stages(nominal_plant, ga
 )
 def test_the_ideal_sensor_runs_only_where_something_reads_it(stages, ideal_runs):
     scenario = SlewScenario.model_validate({"sensor_stages": [{"kind": k} for k in stages]})
-    chain, n_sensors = closedloop.flown_chain(scenario)
+    chain, n_sensors = stage_chain.flown_chain(scenario)
     kinds = [config.kind for _, config in chain[:n_sensors]]
     assert kinds == (["ideal"] if ideal_runs else []) + stages
 
@@ -94,7 +94,7 @@ def test_leaving_the_unread_ideal_sensor_out_changes_no_output(nominal_plant, mo
     # left out: every recorded variable bit for bit, so nothing read its outputs.
     scenario = SlewScenario.model_validate({**AVIONICS, **SHORT})
     lean = run_slew(nominal_plant, scenario, progress=False).dataset
-    monkeypatch.setattr(closedloop, "flown_chain", lambda s: (
+    monkeypatch.setattr(stage_chain, "flown_chain", lambda s: (
         s.stage_chain(), 1 + len(s.sensor_stages)))  # fmt: skip
     full = run_slew(nominal_plant, scenario, progress=False).dataset
     for name in full.data_vars:

@@ -11,11 +11,11 @@ from matplotlib.figure import Figure
 from flexsat.analysis.openloop import openloop_metrics
 from flexsat.analysis.requirements import slew_metrics
 from flexsat.errors import FlexsatError
-from flexsat.jsonable import jsonable
 from flexsat.plots.openloop import OPENLOOP_FIGURES
 from flexsat.plots.slew import SLEW_FIGURES
 from flexsat.simulate import OpenLoopScenario, SlewScenario, run_openloop, run_slew
 from flexsat.simulate.result import Result
+from flexsat.strict_json import jsonable
 
 
 @pytest.fixture(scope="module")

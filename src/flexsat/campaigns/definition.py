@@ -563,7 +563,7 @@ class CaseStream:
 
     def resolve(self, spec) -> ResolvedCase:
         """Resolve one case from ``(id, (root seed, index), plant mods, scenario mods)``."""
-        from flexsat.simulate.common import check_run_size
+        from flexsat.simulate.run_setup import check_run_size
 
         case_id, (root, index), plant_mods, scenario_mods = spec
         # The stream SeedSequence(root).spawn(n)[index] would give, built directly.

@@ -40,7 +40,7 @@ import xarray as xr
 
 from flexsat.errors import ConfigError
 from flexsat.files import ensure_dir, open_lock, output_root, replacing, replacing_name
-from flexsat.jsonable import dumps
+from flexsat.strict_json import dumps
 
 __all__ = ["HISTORY_UNITS", "CampaignStore"]
 

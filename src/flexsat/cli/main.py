@@ -26,7 +26,7 @@ from flexsat import __version__
 from flexsat._compiled_cache import kernels_cached
 from flexsat.cli.tables import format_number, print_table
 from flexsat.errors import MAX_MESSAGE_CHARS, FlexsatError, shorten
-from flexsat.jsonable import dumps
+from flexsat.strict_json import dumps
 
 __all__ = ["app", "main"]
 

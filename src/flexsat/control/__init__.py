@@ -4,7 +4,7 @@ Laws live in :mod:`flexsat.control.laws`, sensors and actuators in
 :mod:`flexsat.control.stages`, one module each.
 """
 
-from flexsat.control.config import DisturbanceConfig
+from flexsat.control.disturbances import DisturbanceConfig
 from flexsat.control.laws import LawConfig, LawSpec, get_law, law_names, register_law
 from flexsat.control.quaternion import target_quaternion
 from flexsat.control.registry import Channel

@@ -17,8 +17,8 @@ import numpy as np
 from numba import config, njit, prange, set_num_threads, typeof
 
 from flexsat.compiled.typed_call import typed_append, typed_list
-from flexsat.simulate.common import chunk_steps
 from flexsat.simulate.loops import LoopClock, LoopRecords, rk4_closed_loop
+from flexsat.simulate.run_setup import chunk_steps
 
 __all__ = [
     "BatchItem",
@@ -45,7 +45,7 @@ class SlewTiming(NamedTuple):
     record_every : int
         Plant steps per record [-].
     chunk : int
-        Steps per compiled chunk (:func:`flexsat.simulate.common.chunk_steps`) [-].
+        Steps per compiled chunk (:func:`flexsat.simulate.run_setup.chunk_steps`) [-].
     continuous : bool
         An actuation stage integrates states in the RK4 steps [-].
     """
@@ -54,7 +54,7 @@ class SlewTiming(NamedTuple):
     n_steps: int  # steps of the whole run
     control_every: int  # plant steps per control period
     record_every: int  # plant steps per record
-    chunk: int  # steps per compiled chunk (flexsat.simulate.common.chunk_steps)
+    chunk: int  # steps per compiled chunk (flexsat.simulate.run_setup.chunk_steps)
     continuous: bool  # an actuation stage integrates states in the RK4 steps
 
 

@@ -2,51 +2,35 @@
 
 from __future__ import annotations
 
-import math
 import time
 from typing import NamedTuple, Protocol
 
 import numpy as np
-from numba import njit
 
-from flexsat.compiled.first_class import first_class
-from flexsat.compiled.status import STATUS_CONTROL_FAILED
-from flexsat.compiled.typed_call import TypedOnce, typed_list
 from flexsat.config import nominal
 from flexsat.config.models import SatelliteConfig
-from flexsat.control.laws import LAW_SIGNATURE, get_law
+from flexsat.control.laws import get_law
 from flexsat.control.quaternion import pointing_errors, target_quaternion
-from flexsat.control.stages import ACTUATORS, JOINT_ACTUATORS, REFERENCES, SENSORS
-from flexsat.control.stages.registry import (
-    ACTUATOR_SIGNATURE,
-    DERIVATIVE_SIGNATURE,
-    JOINT_ACTUATOR_SIGNATURE,
-    REFERENCE_SIGNATURE,
-    SENSOR_SIGNATURE,
-    no_derivative,
-)
-from flexsat.dynamics.attitude import identity_frame, inertial_view, is_identity, rebase
-from flexsat.dynamics.integrators import rk4_hold
+from flexsat.control.stages import JOINT_ACTUATORS, REFERENCES
+from flexsat.dynamics.attitude import identity_frame
 from flexsat.dynamics.plant import Plant
 from flexsat.dynamics.rigid import design_coordinates, rigid_inertia
-from flexsat.errors import ConfigError, SimulationError
+from flexsat.errors import ConfigError
 from flexsat.simulate.batch import fly, slew_timing
-from flexsat.simulate.common import PROGRESS_MIN_STEPS, progress_bar, run_attributes
-from flexsat.simulate.coupled import CHAIN_SLOTS, LoopFlow, rk4_coupled_hold
 from flexsat.simulate.layout import LoopLayout
-from flexsat.simulate.loops import LoopData, LoopStages, run_actuators, run_sensors
+from flexsat.simulate.loops import LoopData, LoopStages
 from flexsat.simulate.openloop import initial_state
+from flexsat.simulate.python_loop import python_loop
 from flexsat.simulate.result import Result, build_dataset
+from flexsat.simulate.run_setup import PROGRESS_MIN_STEPS, progress_bar, run_attributes
 from flexsat.simulate.scenario import SlewScenario
+from flexsat.simulate.stage_chain import loop_data, loop_layout, loop_stages
 
 __all__ = [
     "Controller",
     "PreparedSlew",
     "design_inertia",
     "finish_slew",
-    "flown_chain",
-    "loop_layout",
-    "loop_stages",
     "prepare_slew",
     "run_slew",
     "slew_design_inertia",
@@ -162,10 +146,10 @@ def run_slew(
         if controller is None:
             status, done, rows = _compiled_loop(run, bar, task)
         else:
-            status, done, rows = _python_loop(plant, scenario, run.x, run.frame, run.stages,
-                                              run.data, run.rec_t, run.rec_x, run.rec_ctrl,
-                                              run.rec_frame, bar, task, controller,
-                                              layout.continuous)  # fmt: skip
+            status, done, rows = python_loop(plant, scenario, run.x, run.frame, run.stages,
+                                             run.data, run.rec_t, run.rec_x, run.rec_ctrl,
+                                             run.rec_frame, bar, task, controller,
+                                             layout.continuous)  # fmt: skip
     return finish_slew(run, status, done, rows, time.perf_counter() - start, controller is None)
 
 
@@ -256,7 +240,7 @@ def prepare_slew(plant: Plant, scenario: SlewScenario,
     layout = loop_layout(plant, scenario)
     q0, qd0 = initial_state(plant, scenario)
     n_records = scenario.n_steps // scenario.record_every + 2  # + the last good state
-    data = _loop_data(layout, scenario, J, plant)
+    data = loop_data(layout, scenario, J, plant)
     stages = loop_stages(scenario)
     return PreparedSlew(
         plant, scenario, law, layout, J, np.concatenate([q0, qd0, [0.0, 0.0]]),
@@ -351,189 +335,6 @@ def finish_slew(run: PreparedSlew, status: int, done: int, rows: int, wall: floa
     return Result(ds)
 
 
-def flown_chain(scenario: SlewScenario) -> tuple[list, int]:
-    """The stages the loop runs, in order, and how many of them sense.
-
-    :meth:`SlewScenario.stage_chain` less the sensing stages whose work nothing reads:
-    a stage without state or records each of whose outputs a later stage overwrites
-    (``StageSpec.overwrites``) before any stage reads it (a stage that neither
-    ``overwrites`` nor ``leaves`` an output reads it; the law reads both). So the
-    ideal ``[sensor]`` ahead of a gyro and a star tracker, whose outputs they replace
-    before the estimator reads them, is not run (about 0.1 us per control instant);
-    every output is the same, bit for bit.
-
-    Parameters
-    ----------
-    scenario : SlewScenario
-        The slew.
-
-    Returns
-    -------
-    chain : list of (str, StageConfig)
-        The flown stages with their field paths: sensing, then actuation.
-    n_sensors : int
-        How many of them sense.
-    """
-    chain = scenario.stage_chain()
-    n = 1 + len(scenario.sensor_stages)
-    specs = [SENSORS.get(c.kind) for _, c in chain[:n]]
-
-    def unread(i: int) -> bool:
-        spec = specs[i]
-        if spec.state_size or spec.records or not spec.overwrites:
-            return False
-        for output in spec.overwrites:
-            for later in specs[i + 1 :]:
-                if output in later.overwrites:
-                    break  # replaced before anyone read it
-                if output not in later.leaves:
-                    return False  # read
-            else:
-                return False  # the law reads it
-        return True
-
-    sensing = [entry for i, entry in enumerate(chain[:n]) if not unread(i)]
-    return sensing + chain[n:], len(sensing)
-
-
-def _specs(scenario: SlewScenario) -> tuple:
-    """The registered law, sensing and actuation stages, reference and joint actuator."""
-    chain, n_sensors = flown_chain(scenario)
-    sensors = tuple(SENSORS.get(c.kind) for _, c in chain[:n_sensors])
-    actuators = tuple(ACTUATORS.get(c.kind) for _, c in chain[n_sensors:])
-    return (get_law(scenario.controller.kind), sensors, actuators,
-            REFERENCES.get(scenario.reference.kind),
-            JOINT_ACTUATORS.get(scenario.joint_actuator.kind))  # fmt: skip
-
-
-def loop_layout(plant: Plant, scenario: SlewScenario) -> LoopLayout:
-    """Where a slew's states and records live: its law, its two stage chains, its
-    reference generator and its joint actuator.
-
-    Parameters
-    ----------
-    plant : Plant
-        The plant flown (its state layout).
-    scenario : SlewScenario
-        The slew (its law and stages, by kind).
-
-    Returns
-    -------
-    LoopLayout
-        The offsets of the plant state, control state and record row.
-    """
-    return LoopLayout(plant.layout, *_specs(scenario))
-
-
-def loop_stages(scenario: SlewScenario) -> LoopStages:
-    """The compiled law and stages of a slew, as the loop takes them.
-
-    Each is compiled with its role's signature on first use and cached on disk
-    (:func:`flexsat.compiled.first_class.first_class`); no plant is needed. The chains are
-    padded to a multiple of :data:`~flexsat.simulate.coupled.CHAIN_SLOTS` entries.
-
-    Parameters
-    ----------
-    scenario : SlewScenario
-        The slew (its law and stages, by kind).
-
-    Returns
-    -------
-    LoopStages
-        The first-class functions and the chains' lengths.
-    """
-    law, sensors, actuators, reference, joint_actuator = _specs(scenario)
-    return LoopStages(
-        _padded(tuple(first_class(s.step, SENSOR_SIGNATURE) for s in sensors)),
-        (first_class(law.step, LAW_SIGNATURE),),
-        _padded(tuple(first_class(s.step, ACTUATOR_SIGNATURE) for s in actuators)),
-        _padded(tuple(first_class(s.derivative or no_derivative, DERIVATIVE_SIGNATURE)
-                      for s in actuators)),
-        (first_class(reference.step, REFERENCE_SIGNATURE),),
-        (first_class(joint_actuator.step, JOINT_ACTUATOR_SIGNATURE),),
-        len(sensors), len(actuators),
-    )  # fmt: skip
-
-
-def _padded(entries: tuple, filler=None) -> tuple:
-    """``entries`` padded to a multiple of :data:`~flexsat.simulate.coupled.CHAIN_SLOTS`
-    with ``filler`` (default: the first entry), so every chain of up to that many
-    stages has one numba type and shares one compiled loop; the loop never reads the
-    padding (it runs the chain's own stages, ``LoopStages.n_sensor``, ``n_actuator``).
-    Arrays are padded with an empty array of their type."""
-    if filler is None:
-        filler = entries[0][:0] if isinstance(entries[0], np.ndarray) else entries[0]
-    return entries + (filler,) * (-len(entries) % CHAIN_SLOTS)
-
-
-def _loop_data(layout: LoopLayout, scenario: SlewScenario, J: np.ndarray,
-               plant: Plant) -> LoopData:  # fmt: skip
-    """The arrays of one run, record-row pieces as views into ``held``."""
-    held = np.zeros(layout.record_size)
-    state = np.zeros(layout.state_size)
-    chain = [c for _, c in flown_chain(scenario)[0]]
-    n_sensors = len(layout.sensors)
-
-    def packed(values) -> np.ndarray:
-        return np.ascontiguousarray(values, dtype=float)
-
-    # The coupled RK4 step carries each stage's integrated entries (the block ends with
-    # the last stage that integrates any, StageConfig.integrated_size).
-    block, last = layout.continuous_state, -1
-    if layout.continuous:
-        last = max(i for i, s in enumerate(layout.actuators) if s.derivative is not None)
-        size = chain[n_sensors + last].integrated_size()
-        if size is not None:
-            block = slice(block.start, layout.actuator_states[last].start + size)
-    m = block.stop - block.start
-    evaluation, rate = np.zeros(m), np.zeros(m)
-
-    def local(array: np.ndarray, pieces: tuple[slice, ...]) -> tuple:
-        """Each stage's part of a flow array (empty for a stage outside the block)."""
-        return tuple(array[max(p.start, block.start) - block.start :
-                           min(p.stop, block.stop) - block.start]
-                     if p.start < block.stop and block.start < p.stop else array[:0]
-                     for p in pieces)  # fmt: skip
-
-    flow = LoopFlow(
-        state=state[block], eval=evaluation,
-        eval_views=_padded(local(evaluation, layout.actuator_states), evaluation[:0]),
-        dot=rate, dot_views=_padded(local(rate, layout.actuator_states), rate[:0]),
-        rates=np.zeros(m), wrench=np.zeros(3), held=np.zeros(3), omega=np.zeros(3),
-        n_derivative=last + 1,
-    )  # fmt: skip
-
-    return LoopData(
-        J_design=J.copy(),  # a joint actuator may update it in place (sadm_drive, "measured")
-        q_d=packed(target_quaternion(scenario.target_euler_deg)),  # the reference writes these
-        omega_d=np.zeros(3),
-        omega_dot_d=np.zeros(3),
-        law_gains=packed(scenario.controller.gains(scenario.actuator)),
-        law_state=state[layout.law_state],
-        sensor_params=_padded(tuple(packed(c.packed(scenario)) for c in chain[:n_sensors])),
-        sensor_state=_padded(tuple(state[p] for p in layout.sensor_states)),
-        actuator_params=_padded(tuple(packed(c.packed(scenario)) for c in chain[n_sensors:])),
-        actuator_state=_padded(tuple(state[p] for p in layout.actuator_states)),
-        q_meas=np.zeros(4),
-        omega_meas=np.zeros(3),
-        held=held,
-        tau_cmd=held[layout.tau_cmd],
-        tau_applied=held[layout.tau_applied],
-        law_diag=held[layout.law_diag],
-        sensor_record=_padded(tuple(held[p] for p in layout.sensor_records)),
-        actuator_record=_padded(tuple(held[p] for p in layout.actuator_records)),
-        tau_between=np.zeros(3),
-        flow=flow,
-        reference_params=packed(scenario.reference.packed(scenario, plant)),
-        reference_state=state[layout.reference_state],
-        reference_record=held[layout.reference_record],
-        joint_params=packed(scenario.joint_actuator.packed(scenario, plant)),
-        joint_state=state[layout.joint_state],
-        joint_record=held[layout.joint_record],
-        Q=np.zeros(layout.plant.n_dof),
-    )
-
-
 def _compiled_loop(run: PreparedSlew, bar, task) -> tuple[int, int, int]:
     """The whole loop, stages and law included, in compiled chunks (one call without a bar)."""
     per_call = 1 if bar is not None else run.scenario.n_steps + 1
@@ -551,86 +352,3 @@ def _fly_arguments(run: PreparedSlew, done: int, rows: int, max_chunks: int) -> 
     return (run.x, slew_timing(run), run.stages, run.data, run.rec_t, run.rec_x, run.rec_ctrl,
             run.rec_frame, run.rec_Q, run.rec_solved, run.plant.packed, run.frame, done, rows,
             max_chunks)  # fmt: skip
-
-
-@njit(cache=True)
-def _listed_sensors(x, n, t, loop):
-    """:func:`~flexsat.simulate.loops.run_sensors` on the structures in ``loop``, a typed
-    list of one (stages, data, packed plant) tuple: unboxed as one pointer, where
-    the structures themselves would unbox every array and first-class function at
-    every call (:mod:`flexsat.compiled.typed_call`)."""
-    stages, d, _ = loop[0]
-    return run_sensors(x, n, t, stages, d)
-
-
-@njit(cache=True)
-def _listed_actuators(x, n, t, control_dt, continuous, loop):
-    """:func:`~flexsat.simulate.loops.run_actuators` on ``loop`` (:func:`_listed_sensors`)."""
-    stages, d, _ = loop[0]
-    return run_actuators(x, n, t, control_dt, continuous, stages, d)
-
-
-@njit(cache=True)
-def _listed_coupled_hold(x, t0, dt, n_steps, loop):
-    """:func:`~flexsat.simulate.coupled.rk4_coupled_hold` on ``loop`` (:func:`_listed_sensors`)."""
-    stages, d, packed = loop[0]
-    return rk4_coupled_hold(x, t0, dt, n_steps, stages.derivative, d.actuator_params, d.flow,
-                            packed)  # fmt: skip
-
-
-@njit(cache=True)
-def _listed_hold(x, dt, n_steps, frame, loop):
-    """:func:`~flexsat.dynamics.integrators.rk4_hold` under the held ``tau_applied``, on
-    ``loop`` (:func:`_listed_sensors`)."""
-    _, d, packed = loop[0]
-    torque = (d.tau_applied[0], d.tau_applied[1], d.tau_applied[2])
-    return rk4_hold(x, dt, n_steps, torque, packed, frame)
-
-
-def _python_loop(plant, scenario, x, frame, stages, d, rec_t, rec_x, rec_ctrl, rec_frame, bar,
-                 task, controller, continuous):  # fmt: skip
-    """Python controller at each control instant between the compiled stages; the plant
-    steps compiled in between."""
-    n = plant.n_dof
-    steps, every, control = scenario.n_steps, scenario.record_every, scenario.control_every
-    block = math.gcd(every, control)
-    control_dt = control * scenario.dt_s
-    limit = scenario.actuator.reduction_factor * scenario.actuator.t_max_nm
-    d.law_diag[:] = np.nan
-    view = np.empty_like(x)
-    # the same arguments at every instant: typed once, and the loop's structures in a
-    # typed list, unboxed as one pointer (flexsat.compiled.typed_call)
-    loop = typed_list((stages, d, plant.packed))
-    sensors, actuators = TypedOnce(_listed_sensors), TypedOnce(_listed_actuators)
-    coupled_hold, hold = TypedOnce(_listed_coupled_hold), TypedOnce(_listed_hold)
-    rows, status, k = 0, 0, 0
-    while True:
-        t = k * scenario.dt_s
-        if k % control == 0:
-            sensed = x
-            if not is_identity(frame):  # re-based between steps: the sensors read N
-                inertial_view(x, n, frame, view)
-                sensed = view
-            status = sensors(sensed, n, t, loop)
-            tau_cmd = np.asarray(controller(t, d.q_meas.copy(), d.omega_meas.copy()), dtype=float)
-            if tau_cmd.shape != (3,) or not np.all(np.isfinite(tau_cmd)):
-                raise SimulationError(f"controller returned {tau_cmd!r} at t = {t:.6g} s")
-            d.tau_cmd[:] = np.clip(tau_cmd, -limit, limit)
-            status |= actuators(x, n, t, control_dt, continuous, loop)
-            if status:
-                return STATUS_CONTROL_FAILED, k, rows
-        if k % every == 0:
-            rec_t[rows], rec_x[rows], rec_ctrl[rows], rec_frame[rows] = t, x, d.held, frame
-            rows += 1
-        if k == steps:
-            return 0, k, rows
-        if continuous:  # re-based once per block (a few steps: far from the pole)
-            rebase(x, n, frame)
-            status, ran = coupled_hold(x, t, scenario.dt_s, block, loop)
-        else:
-            status, ran = hold(x, scenario.dt_s, block, frame, loop)
-        k += ran
-        if status:
-            return status, k, rows
-        if bar is not None and k % 10_000 < block:
-            bar.update(task, completed=t)

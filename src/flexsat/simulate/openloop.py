@@ -24,14 +24,14 @@ from flexsat.dynamics.integrators import (
 )
 from flexsat.dynamics.kernels import STATUS_OK, hub_cs
 from flexsat.dynamics.plant import Plant
-from flexsat.simulate.common import (
+from flexsat.simulate.result import Result, build_dataset
+from flexsat.simulate.run_setup import (
     PROGRESS_MIN_STEPS,
     check_run_size,
     chunk_steps,
     progress_bar,
     run_attributes,
 )
-from flexsat.simulate.result import Result, build_dataset
 from flexsat.simulate.scenario import OpenLoopScenario, thesis_openloop
 from flexsat.simulate.stream import RecordStream, check_disk_space
 
@@ -81,7 +81,7 @@ def run_openloop(
         temporary file.
     record_budget_bytes : float, optional
         Memory the records may use before they are streamed [bytes]; default: half the
-        machine's memory (:func:`flexsat.simulate.common.check_run_size`).
+        machine's memory (:func:`flexsat.simulate.run_setup.check_run_size`).
 
     Returns
     -------

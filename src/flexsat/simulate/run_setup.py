@@ -1,4 +1,4 @@
-"""Pieces shared by the open-loop and closed-loop drivers."""
+"""What every run sets up: its size check, compiled chunks, progress bar, dataset attributes."""
 
 from __future__ import annotations
 

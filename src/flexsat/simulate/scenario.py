@@ -25,7 +25,7 @@ from pydantic import (
 from flexsat.analysis.requirements import Requirements
 from flexsat.config.load import read_toml, validate_config
 from flexsat.config.models import Matrix3, Positive, Real, Vector3, _Frozen
-from flexsat.control.config import DisturbanceConfig
+from flexsat.control.disturbances import DisturbanceConfig
 from flexsat.control.laws import LAWS, LawConfig, validate_law_config
 from flexsat.control.stages import (
     ACTUATORS,

@@ -1,6 +1,6 @@
 """Long records streamed to disk: a NetCDF file that grows block by block along time.
 
-A run whose records would not fit in memory (:func:`flexsat.simulate.common.check_run_size`)
+A run whose records would not fit in memory (:func:`flexsat.simulate.run_setup.check_run_size`)
 is recorded into a bounded buffer; each full buffer becomes a dataset block
 (:func:`flexsat.simulate.result.build_dataset`) appended to one NetCDF file, whose
 ``time`` dimension is unlimited. The first block creates the file with xarray (so

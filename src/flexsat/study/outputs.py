@@ -16,7 +16,7 @@ from typing import TYPE_CHECKING
 
 from flexsat.errors import ConfigError
 from flexsat.files import ensure_dir, output_root, write_text
-from flexsat.jsonable import dumps
+from flexsat.strict_json import dumps
 
 if TYPE_CHECKING:  # the CLI imports this module at start-up: keep numba out of it
     from flexsat.dynamics.plant import Plant
@@ -193,7 +193,7 @@ def fly_openloop(plant: Plant, scenario=None, out: Path | None = None, progress=
 
         return write_openloop_figures(result.dataset, modal_analysis(plant), Path(out))
 
-    from flexsat.simulate.common import check_run_size
+    from flexsat.simulate.run_setup import check_run_size
 
     scenario = scenario or OpenLoopScenario()
     record_path = None
@@ -235,7 +235,7 @@ def fly_slew(plant: Plant, scenario=None, out: Path | None = None, progress=None
     """
     from flexsat.analysis.requirements import slew_metrics
     from flexsat.simulate import SlewScenario, run_slew
-    from flexsat.simulate.common import check_run_size
+    from flexsat.simulate.run_setup import check_run_size
 
     def draw() -> list[Path]:
         from flexsat.plots.slew import write_slew_figures

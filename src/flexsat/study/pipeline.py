@@ -442,7 +442,7 @@ def _compile_runs(ctx: StudyContext) -> list[tuple[dict | str | None, frozenset[
 def _fly_short(ctx: StudyContext, fields: dict | str | None) -> None:
     """Fly one run of :func:`_compile_runs` for 20 ms (it compiles or loads its loop)."""
     from flexsat.simulate import OpenLoopScenario, SlewScenario, run_openloop, run_slew
-    from flexsat.simulate.closedloop import loop_stages
+    from flexsat.simulate.stage_chain import loop_stages
     from flexsat.study.avionics import sadm_plant, sadm_runs, sadm_study
 
     short = {"duration_s": 0.02, "record_dt_s": 0.01}

@@ -261,7 +261,7 @@ class StageSpec:
         reading their incoming value, and those it neither reads nor writes. A stage
         declaring neither is taken to read both. A stage without state or records
         whose every output a later stage overwrites before any reads it is left out
-        of the flown chain (:func:`flexsat.simulate.closedloop.flown_chain`).
+        of the flown chain (:func:`flexsat.simulate.stage_chain.flown_chain`).
     """
 
     role: Role

@@ -4,7 +4,7 @@ Order: tau_cmd is already clipped to the software limit RF * T_max by the law; t
 applied torque is clip_Tmax(G_act tau_cmd + environment + sloshing + residual),
 with sloshing_i = ratio * tau_cmd,i * sin(2 pi f t) (proportional to the effort,
 so it vanishes at rest). The disturbances are the scenario's ``[disturbances]``
-table (:class:`~flexsat.control.config.DisturbanceConfig`), "forced to maximum" in
+table (:class:`~flexsat.control.disturbances.DisturbanceConfig`), "forced to maximum" in
 the nominal validation: gain 0.95, environment +0.005 N m, sloshing 2 % at 0.52 Hz
 on every axis, residual off (``docs/control.md``).
 """
