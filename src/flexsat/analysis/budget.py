@@ -8,8 +8,8 @@ Each contributes to each index (APE, MPE, RPE, PDE, PRE; the knowledge indices f
 knowledge contributors) a mean μ and a standard deviation σ per axis
 (:func:`contribution`); the handbook's two summation rules give the index:
 
-* statistical: |Σ μ_i| + n_P sqrt(Σ σ_i²), n_P = Φ⁻¹((1 + P)/2);
-* worst case: Σ e_i(P), each contributor's own P-level value of |e_i|.
+* statistical: ``|Σ μ_i|`` + n_P sqrt(Σ σ_i²), n_P = Φ⁻¹((1 + P)/2);
+* worst case: Σ e_i(P), each contributor's own P-level value of ``|e_i|``.
 
 A requirement file's ``[pointing]`` table gives each index's bound, window and
 confidence; :func:`evaluate` sets the budget and the indices measured on a run or a
@@ -294,9 +294,9 @@ def contribution(contributor: Contributor, index: str, req: IndexRequirement) ->
     the absolute one, its spread to the relative one, its mean to the mean one (its
     spread averages out of a window, its correlation time taken much shorter than
     Δt). Periodic, amplitude A and period T: a sinusoid of amplitude A for APE,
-    A |sinc(Δt/T)| for MPE (its window mean), A |1 - sinc(Δt/T)| for RPE (a record
+    A ``|sinc(Δt/T)|`` for MPE (its window mean), A ``|1 - sinc(Δt/T)|`` for RPE (a record
     against the mean of the window centred on it), and
-    2 A |sinc(Δt/T) sin(π Δ/T)| for PDE and PRE (Δ = Δt_s or Δt_o), with
+    2 A ``|sinc(Δt/T) sin(π Δ/T)|`` for PDE and PRE (Δ = Δt_s or Δt_o), with
     sinc(x) = sin(πx)/(πx): exact for the indices of :mod:`flexsat.analysis.pointing`.
 
     Parameters
@@ -357,7 +357,7 @@ def _moments(part: dict) -> tuple[np.ndarray, np.ndarray]:
 
 
 def _own_value(part: dict, confidence: float) -> np.ndarray:
-    """The P-level value of |e_i| for one contribution, per axis [deg]."""
+    """The P-level value of ``|e_i|`` for one contribution, per axis [deg]."""
     mean = np.abs(part["mean"])
     if part["distribution"] == "uniform":
         return mean + confidence * part["scale"]  # |U(-B, B)|'s P-quantile is P B
@@ -380,7 +380,7 @@ def summed(parts: list[dict], confidence: float) -> dict:
     -------
     dict
         Each shape (3,) [deg]: ``mean`` Σ μ_i, ``sigma`` sqrt(Σ σ_i²),
-        ``statistical`` |Σ μ_i| + n_P sqrt(Σ σ_i²) and ``worst_case`` Σ e_i(P).
+        ``statistical`` ``|Σ μ_i|`` + n_P sqrt(Σ σ_i²) and ``worst_case`` Σ e_i(P).
     """
     mean, variance, worst = np.zeros(3), np.zeros(3), np.zeros(3)
     for part in parts:

@@ -8,11 +8,11 @@ against the truth). Windows of length Δt hold n = round(Δt / dt) records and s
 one record at a time; every window's mean is one cumulative-sum difference, so no
 index loops over windows. ``docs/pointing.md`` states the definitions:
 
-* APE / AKE: |e(t)| at every record;
-* MPE / MKE: |ē(w)|, the mean over each window w;
-* RPE / RKE: |e(t) - ē(w_t)|, each record against the mean of the window centred
+* APE / AKE: ``|e(t)|`` at every record;
+* MPE / MKE: ``|ē(w)|``, the mean over each window w;
+* RPE / RKE: ``|e(t) - ē(w_t)|``, each record against the mean of the window centred
   on it;
-* PDE / KDE: |ē(w + Δt_s) - ē(w)|, two windows Δt_s apart (the stability time)
+* PDE / KDE: ``|ē(w + Δt_s) - ē(w)|``, two windows Δt_s apart (the stability time)
   within one observation;
 * PRE / KRE: the same with the two windows one observation period Δt_o apart.
 
@@ -250,7 +250,7 @@ def line_of_sight_error(rotation: np.ndarray, boresight: Sequence[float]) -> np.
     """The line-of-sight error of a boresight fixed in the hub [rad], two components.
 
     The error rotation R(θ) moves the boresight b to b' = R b; the line-of-sight
-    error is the rotation that takes b to b', ε = angle(b, b') (b x b') / |b x b'|,
+    error is the rotation that takes b to b', ε = angle(b, b') (b x b') / ``|b x b'|``,
     perpendicular to b. Its components along u and v = b x u (u the hub axis
     least aligned with b, made perpendicular to b) are returned; their norm is the
     angle between b and b', exactly (no small-angle approximation).

@@ -196,12 +196,12 @@ def pd_loop(model: LinearModel, K: np.ndarray, axis: str) -> LinearModel:
 
 @dataclass(frozen=True)
 class Crossover:
-    """One gain crossover of a loop gain: |L| = 1 (0 dB).
+    """One gain crossover of a loop gain: ``|L|`` = 1 (0 dB).
 
     Attributes
     ----------
     frequency_hz : float
-        Where |L| crosses 1 [Hz].
+        Where ``|L|`` crosses 1 [Hz].
     phase_margin_deg : float
         180 deg + the phase of L there, in (-180, 180] [deg].
     delay_margin_s : float
@@ -229,9 +229,9 @@ class FlexiblePeak:
     mode_hz : float
         Natural frequency of the satellite's flexible mode (free model) [Hz].
     peak_hz : float
-        Where |L| peaks [Hz].
+        Where ``|L|`` peaks [Hz].
     peak_gain_db : float
-        20 log10 max |L| near the mode [dB]; inf for an undamped mode.
+        20 log10 max ``|L|`` near the mode [dB]; inf for an undamped mode.
     stabilized : str
         ``"gain"`` (peak below 0 dB) or ``"phase"`` (at or above 0 dB).
     """
@@ -251,7 +251,7 @@ class LoopMargins:
     gain crossovers (a flexible peak above 0 dB adds crossovers); the frequencies
     are those of the limiting crossing [Hz]; ``crossovers_hz`` lists them all, and
     ``crossovers`` each with its own phase and delay margins; ``flexible_peaks`` the
-    flexible modes that show as a peak of |L|, each gain- or phase-stabilized.
+    flexible modes that show as a peak of ``|L|``, each gain- or phase-stabilized.
 
     Attributes
     ----------
@@ -272,7 +272,7 @@ class LoopMargins:
     crossovers : tuple of Crossover
         Every gain crossover with its phase and delay margins, ascending.
     flexible_peaks : tuple of FlexiblePeak
-        Every peak of |L| at a flexible mode of the satellite, ascending.
+        Every peak of ``|L|`` at a flexible mode of the satellite, ascending.
     """
 
     gain_margin: float
@@ -303,7 +303,7 @@ def loop_margins(
     every pole of the loop is added with a point just below and just above it (so
     the two crossings beside a sharp or undamped peak are always bracketed), and are
     refined with Brent's method on the exact response (no fitting); phase crossings
-    likewise. The peaks of |L| are the grid's local maxima refined by a bounded
+    likewise. The peaks of ``|L|`` are the grid's local maxima refined by a bounded
     scalar search between their neighbouring grid points; one within 5 % of a
     flexible mode's frequency is that mode's peak (:class:`FlexiblePeak`).
 
@@ -372,7 +372,7 @@ def loop_margins(
 
 def _flexible_peaks(L, lam: np.ndarray, f: np.ndarray, mag: np.ndarray,
                     modes_hz: np.ndarray) -> tuple[FlexiblePeak, ...]:  # fmt: skip
-    """The local maxima of |L| on the grid, refined, each named by its flexible mode."""
+    """The local maxima of ``|L|`` on the grid, refined, each named by its flexible mode."""
     if modes_hz.size == 0:
         return ()
     undamped = np.abs(lam[(lam.imag > 0) & (-lam.real <= 1e-9 * np.abs(lam))]) / (2 * np.pi)
