@@ -70,28 +70,44 @@ def _hostile(rng: np.random.Generator):
     return {} if rng.integers(2) else {"x": 1}
 
 
-def _mutate(rng: np.random.Generator) -> str:
-    data = nominal_dict()
+def _edit_table(data: dict, rng: np.random.Generator, edits: int, actions: tuple, scale) -> None:
+    """Up to ``edits - 1`` random edits of ``data`` in place, each at a random leaf.
+
+    ``actions = (n, scaled, removed, unknown)``: an action drawn in ``range(n)`` below
+    ``scaled`` rescales a float leaf with ``scale(value, rng)``; ``removed`` drops the
+    key, ``unknown`` adds an unknown key beside it; any other puts a hostile value there.
+    """
+    n, scaled, removed, unknown = actions
     paths = _leaf_paths(data)
-    for _ in range(rng.integers(1, 5)):
+    for _ in range(rng.integers(1, edits)):
         path = paths[rng.integers(len(paths))]
         node = data
         try:
             for part in path[:-1]:
                 node = node[part]
-            action = rng.integers(10)
+            action = rng.integers(n)
             current = node[path[-1]]
-            if action < 5 and isinstance(current, float):  # a valid type, an extreme size
-                sign = rng.choice([1.0, 1.0, -1.0])
-                node[path[-1]] = float(sign * current * 10.0 ** rng.uniform(-3, 3))
-            elif action == 0 and isinstance(node, dict):
+            if action < scaled and isinstance(current, float):
+                node[path[-1]] = scale(current, rng)
+            elif action == removed and isinstance(node, dict):
                 node.pop(path[-1], None)
-            elif action == 1 and isinstance(node, dict):
+            elif action == unknown and isinstance(node, dict):
                 node[f"unknown_{rng.integers(100)}"] = _hostile(rng)
             else:
                 node[path[-1]] = _hostile(rng)
         except (KeyError, IndexError, TypeError):
             continue  # an earlier edit replaced a parent: skip this one
+
+
+def _extreme_size(value: float, rng: np.random.Generator) -> float:
+    """A valid type, an extreme size: the value scaled by up to 1e+-3, its sign flipped at times."""
+    sign = rng.choice([1.0, 1.0, -1.0])
+    return float(sign * value * 10.0 ** rng.uniform(-3, 3))
+
+
+def _mutate(rng: np.random.Generator) -> str:
+    data = nominal_dict()
+    _edit_table(data, rng, 5, (10, 5, 0, 1), _extreme_size)
     text = to_toml(data)
     if rng.random() < 0.15:  # damaged text: cut, or one character replaced
         cut = int(rng.integers(len(text)))
@@ -196,25 +212,8 @@ def _modal_npz(rng: np.random.Generator) -> bytes:
 
 def _modal_toml(rng: np.random.Generator) -> bytes:
     data = modal_table()
-    paths = _leaf_paths(data)
-    for _ in range(rng.integers(1, 4)):
-        path = paths[rng.integers(len(paths))]
-        node = data
-        try:
-            for part in path[:-1]:
-                node = node[part]
-            action = rng.integers(8)
-            current = node[path[-1]]
-            if action < 3 and isinstance(current, float):
-                node[path[-1]] = float(current * 10.0 ** rng.uniform(-300, 300))
-            elif action == 3 and isinstance(node, dict):
-                node.pop(path[-1], None)
-            elif action == 4 and isinstance(node, dict):
-                node[f"unknown_{rng.integers(100)}"] = _hostile(rng)
-            else:
-                node[path[-1]] = _hostile(rng)
-        except (KeyError, IndexError, TypeError):
-            continue  # an earlier edit replaced a parent: skip this one
+    _edit_table(data, rng, 4, (8, 3, 3, 4),
+                lambda value, rng: float(value * 10.0 ** rng.uniform(-300, 300)))  # fmt: skip
     return to_toml(data).encode()
 
 
