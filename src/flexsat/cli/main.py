@@ -47,6 +47,12 @@ config_app = typer.Typer(
     help="Inspect and copy satellite configurations.", no_args_is_help=True, rich_markup_mode=None
 )
 app.add_typer(config_app, name="config")
+fe_app = typer.Typer(
+    help="Finite-element models to modal data (NASTRAN decks).",
+    no_args_is_help=True,
+    rich_markup_mode=None,
+)
+app.add_typer(fe_app, name="fe")
 
 _console = Console(markup=False)  # names and paths are printed as written, never as markup
 _errors = Console(stderr=True, soft_wrap=True)
@@ -143,6 +149,63 @@ def _print_modal(summary: dict) -> None:
                 ("", "x", "y", "z"), rows)  # fmt: skip
     for path in summary.get("files", []):
         _console.print(f"wrote {path}")
+
+
+@fe_app.command("import")
+def fe_import(
+    deck: Annotated[Path, typer.Argument(help="NASTRAN bulk data (BDF): grids, sets, RBE2.")],
+    op4: Annotated[Path, typer.Option("--op4", help="OP4 file with KAA/MAA (or KFF, KGG).")],
+    output: Annotated[Path, typer.Option("--output", "-o", help="Modal data file (.npz, .toml).")],
+    interface: Annotated[
+        int | None, typer.Option(help="Interface grid id. Default: the deck's b-set grid.")
+    ] = None,
+    op2: Annotated[
+        Path | None, typer.Option(help="SOL 103 OP2 of the deck clamped at the interface.")
+    ] = None,
+    modes: Annotated[int | None, typer.Option(help="Modes kept, lowest first.")] = None,
+    stiffness: Annotated[str | None, typer.Option(help="OP4 stiffness name.")] = None,
+    mass: Annotated[str | None, typer.Option(help="OP4 mass name.")] = None,
+    damping: Annotated[float, typer.Option(help="Modal damping ratio of every mode [-].")] = 0.0,
+    json_output: JsonOption = False,
+) -> None:
+    """Import a NASTRAN model (OP4 matrices, BDF grids and sets) as modal data."""
+    import numpy as np
+
+    from flexsat.config.modal_data import save_modal_data
+    from flexsat.fe.nastran import import_nastran
+
+    if not 0.0 <= damping < 1.0:
+        raise FlexsatError(f"--damping: must be in [0, 1), got {damping}")
+    model = import_nastran(deck, op4, interface=interface, n_modes=modes, op2=op2,
+                           stiffness=stiffness, mass=mass, damping_ratio=damping)  # fmt: skip
+    path = save_modal_data(model.modal, output)
+    freqs = list(model.modal.frequencies_hz)
+    errors = model.frequency_errors
+    summary = {
+        "interface_grid": model.interface_grid, "tip_grid": model.tip_grid,
+        "matrices": [model.stiffness_name, model.mass_name], "dofs": len(model.dofs),
+        "mass_kg": model.modal.mass_kg, "frequencies_hz": freqs,
+        "op2_frequencies_hz": None if errors is None
+        else model.reference_frequencies_hz[: len(errors)].tolist(),
+        "file": str(path),
+    }  # fmt: skip
+    if json_output:
+        typer.echo(dumps(summary))
+        return
+    effective = np.asarray(model.modal.participation_matrix()) ** 2
+    rows = []
+    for k, f in enumerate(freqs):
+        row = [k + 1, f, *(effective[k, :3] / model.modal.mass_kg)]
+        if errors is not None:
+            row += [model.reference_frequencies_hz[k], errors[k]] if k < len(errors) else ["-"] * 2
+        rows.append(row)
+    header = ["mode", "f [Hz]", "m_eff,x / m", "m_eff,y / m", "m_eff,z / m"]
+    if errors is not None:
+        header += ["OP2 f [Hz]", "rel. diff"]
+    print_table(_console, f"{model.stiffness_name}/{model.mass_name}: {len(model.dofs)} DOFs, "
+                f"clamped at grid {model.interface_grid}, {model.modal.mass_kg:.6g} kg",
+                header, rows)  # fmt: skip
+    _console.print(f"wrote {path}")
 
 
 @app.command()
