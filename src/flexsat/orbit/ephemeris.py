@@ -144,7 +144,7 @@ def build_ephemeris(
     table[:, 0] = times
     table[:, 1:7] = state
     fill_sun_and_shadow(table, jd_whole, jd_fraction)
-    angle = earth_rotation_angle(jd_whole + (jd_fraction + times / _SECONDS_PER_DAY))
+    angle = earth_rotation_angle(jd_whole, jd_fraction + times / _SECONDS_PER_DAY)
     table[:, 12] = angle - 2.0 * pi * floor(angle[0] / (2.0 * pi))
     return Ephemeris(table=np.ascontiguousarray(table), epoch=epoch, step_s=step)
 

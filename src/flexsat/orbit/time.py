@@ -134,7 +134,9 @@ def precession_matrix(t_centuries):
     )
 
 
-def earth_rotation_angle(jd_utc: float | np.ndarray) -> float | np.ndarray:
+def earth_rotation_angle(
+    jd_utc: float | np.ndarray, jd_fraction: float | np.ndarray = 0.0
+) -> float | np.ndarray:
     """The rotation angle about z from the J2000 frame to the Earth-fixed frame.
 
     GMST (IAU 1982, Vallado eq. 3-47, UT1 = UTC) less the precession in right
@@ -145,14 +147,17 @@ def earth_rotation_angle(jd_utc: float | np.ndarray) -> float | np.ndarray:
     Parameters
     ----------
     jd_utc : float or ndarray
-        Julian date (UTC) [d].
+        Julian date (UTC), or its whole-day part [d].
+    jd_fraction : float or ndarray
+        The rest of the Julian date [d]: the two parts keep the time to 1e-7 s
+        (a Julian date alone resolves 4e-5 s).
 
     Returns
     -------
     float or ndarray
         The angle [rad], not reduced to [0, 2 pi).
     """
-    t = (np.asarray(jd_utc, dtype=float) - J2000_JD) / 36525.0
+    t = ((np.asarray(jd_utc, dtype=float) - J2000_JD) + jd_fraction) / 36525.0
     gmst_s = (
         67310.54841 + (876600.0 * 3600.0 + 8640184.812866) * t + 0.093104 * t**2 - 6.2e-6 * t**3
     )
