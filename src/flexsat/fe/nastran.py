@@ -545,14 +545,14 @@ def import_nastran(bdf: str | Path, op4: str | Path, *, interface: int | None = 
             "write KAA/MAA (or KFF/MFF) instead"
         )
     dofs = dof_set(bulk, which)
-    if which == "g":
-        keep = np.array([tuple(d) not in bulk.constrained for d in dofs.tolist()])
-        K, M, dofs = K[keep][:, keep], M[keep][:, keep], dofs[keep]
     if K.shape[0] != len(dofs):
         raise ConfigError(
             f"{k_name} is {K.shape[0]} x {K.shape[0]} but the deck's {which}-set has "
             f"{len(dofs)} DOFs: the matrices are not this deck's"
         )
+    if which == "g":  # the permanent and single-point constraints leave the g-set
+        keep = np.array([tuple(d) not in bulk.constrained for d in dofs.tolist()])
+        K, M, dofs = K[keep][:, keep], M[keep][:, keep], dofs[keep]
     grid = _interface(bulk, dofs, interface)
     origin = bulk.grid_xyz_m[np.searchsorted(bulk.grid_ids, grid)]
     b = np.array([np.nonzero((dofs[:, 0] == grid) & (dofs[:, 1] == c))[0][0] for c in range(1, 7)])
@@ -657,14 +657,15 @@ def read_op2_frequencies(path: str | Path) -> np.ndarray:
     op2 = _pyyeti("op2")
     try:
         with op2.OP2(str(path)) as handle:
-            names = [n.upper() for n in handle.dbnames] if handle.dbnames else []
-            lama = next((n for n in names if n.startswith("LAMA")), None)
+            names = list(handle.dbdct)
+            lama = next((n for n in names if n.upper().startswith("LAMA")), None)
             if lama is None:
                 raise ConfigError(
                     f"{path}: no eigenvalue table (LAMA) in the OP2 (it holds "
                     f"{shorten(', '.join(names) or 'nothing', 120)}): not a SOL 103 output"
                 )
             handle.set_position(lama)
+            handle.rdop2nt()
             table = np.asarray(handle._rdop2lama(), dtype=float)
     except ConfigError:
         raise
