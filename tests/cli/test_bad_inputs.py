@@ -9,6 +9,7 @@ command was given, and the message is one line of bounded length.
 from __future__ import annotations
 
 import copy
+import importlib.util
 import math
 import os
 import tomllib
@@ -457,7 +458,34 @@ BUDGET = [
     Bad("budget of a missing result", ["budget", "{tmp}/none.nc", "--requirements", "{tmp}/req.toml"], "RESULT_OR_CAMPAIGN {tmp}/none.nc: no such file or folder", {"req.toml": "[pointing]\n"}),
 ]  # fmt: skip
 
-TABLE = CONFIGS + SCENARIOS + PATHS + SPECIAL_FILES + ROBUSTNESS + CAMPAIGNS + BUDGET
+
+
+def _nastran(id: str, change: str, extra: list[str], fragment: str) -> Bad:
+    """``flexsat fe import`` of the frame deck of tests/fe/nastran_decks.py, changed."""
+    from tests.fe.nastran_decks import deck_files
+
+    argv = ["fe", "import", "{tmp}/d.bdf", "--op4", "{tmp}/m.op4", "-o", "{tmp}/w.npz",
+            "--interface", "10", *extra]  # fmt: skip
+    return Bad(id, argv, fragment, deck_files(change))
+
+
+NASTRAN = [
+    _nastran("NASTRAN interface grid not in the deck", "", ["--interface", "999"], "interface: grid 999 is not in the deck"),
+    _nastran("NASTRAN singular stiffness", "singular", [], "KGG: singular stiffness: point 40 component 1 has no stiffness with grid 10 clamped"),
+    _nastran("NASTRAN matrix size not the deck's", "size", [], "KGG is 24 x 24 but the deck's g-set has 30 DOFs"),
+    _nastran("NASTRAN non-symmetric stiffness", "asymmetric", [], "KGG is not symmetric"),
+    _nastran("NASTRAN OP4 without the named matrix", "", ["--stiffness", "KAA"], "no matrix 'KAA' (it holds KGG, MGG)"),
+    _nastran("NASTRAN BDF that does not parse", "binary", [], "not a NASTRAN bulk data file"),
+    _nastran("NASTRAN OP4 that is no OP4", "garbage", [], "m.op4: not an OP4 file"),
+    _nastran("NASTRAN OP2 without eigenvalues", "", ["--op2", "{tmp}/x.op2"], "no eigenvalue table (LAMA)"),
+    _nastran("NASTRAN modes out of range", "", ["--modes", "0"], "modes: must be in 1..18"),
+    _nastran("NASTRAN damping out of range", "", ["--damping", "1.5"], "--damping: must be in [0, 1)"),
+    _nastran("NASTRAN stiffness not free-free", "grounded", [], "KGG: rigid motions about grid 10 are not free"),
+    Bad("NASTRAN deck is a FIFO", ["fe", "import", "{tmp}/d.bdf", "--op4", "{tmp}/m.op4", "-o", "{tmp}/w.npz"], f"cannot read NASTRAN bulk data file {{tmp}}/d.bdf: {_NOT_REGULAR}", {"d.bdf": FIFO}, 10),
+    Bad("NASTRAN deck missing", ["fe", "import", "{tmp}/none.bdf", "--op4", "{tmp}/m.op4", "-o", "{tmp}/w.npz"], "NASTRAN bulk data file not found"),
+] if importlib.util.find_spec("pyyeti") else []  # fmt: skip
+
+TABLE = CONFIGS + SCENARIOS + PATHS + SPECIAL_FILES + ROBUSTNESS + CAMPAIGNS + BUDGET + NASTRAN
 
 
 def test_the_table_is_at_least_sixty_rows():

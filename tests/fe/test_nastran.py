@@ -11,8 +11,6 @@ clamped eigenvalues of the deck's own matrices from scipy.linalg.eigh.
 from __future__ import annotations
 
 import importlib.util
-import io
-import struct
 from pathlib import Path
 
 import numpy as np
@@ -29,86 +27,12 @@ from flexsat.fe.nastran import (
     read_op2_frequencies,
     read_op4_matrices,
 )
+from tests.fe.nastran_decks import frame, scrambled_ids, write_frame_deck, write_lama_op2
 
 op4 = pytest.importorskip("pyyeti.nastran.op4")
 bulk = pytest.importorskip("pyyeti.nastran.bulk")
 
 DATA = Path(__file__).resolve().parents[2] / "examples" / "data"
-SEED = 20261207  # the frame's grid-id permutation and section properties
-
-
-# --- a well-conditioned frame: 3D beam elements along Y, lumped masses --------------
-
-
-def _frame_element(length: float, ea: float, gj: float, ei_x: float, ei_z: float) -> np.ndarray:
-    """12 x 12 stiffness of a beam element along Y, DOFs (tx ty tz rx ry rz) x 2 nodes.
-
-    Bending in the X-Y plane: w_x with slope dw_x/dy = -r_z; in the Y-Z plane: w_z
-    with slope dw_z/dy = +r_x (a rigid rotation r moves a point at y by r x (0, y, 0)).
-    """
-    k = np.zeros((12, 12))
-
-    def bar(dofs, stiffness):
-        k[np.ix_(dofs, dofs)] += stiffness / length * np.array([[1.0, -1.0], [-1.0, 1.0]])
-
-    def bend(w, r, sign, ei):
-        L = length
-        h = np.array([[12, 6 * L, -12, 6 * L], [6 * L, 4 * L**2, -6 * L, 2 * L**2],
-                      [-12, -6 * L, 12, -6 * L], [6 * L, 2 * L**2, -6 * L, 4 * L**2]])  # fmt: skip
-        h *= ei / L**3
-        t = np.diag([1.0, sign, 1.0, sign])
-        dofs = [w, r, w + 6, r + 6]
-        k[np.ix_(dofs, dofs)] += t @ h @ t
-
-    bar([1, 7], ea)
-    bar([4, 10], gj)
-    bend(0, 5, -1.0, ei_z)
-    bend(2, 3, +1.0, ei_x)
-    return k
-
-
-def _frame(n_nodes: int = 6, length: float = 2.0, elements: int | None = None):
-    """A free-free frame of ``n_nodes`` grids on Y (node 0 at the origin, the interface).
-
-    ``elements``: how many of the ``n_nodes - 1`` elements to assemble (fewer: the last
-    grids hang free).
-    """
-    rng = np.random.default_rng(SEED)
-    print(f"frame seed {SEED}")
-    y = np.linspace(0.0, length, n_nodes)
-    K = np.zeros((6 * n_nodes, 6 * n_nodes))
-    for e in range(n_nodes - 1):
-        props = rng.uniform(0.5, 2.0, 4) * np.array([1e6, 2e3, 3e3, 1e3])  # EA, GJ, EI_x, EI_z
-        if elements is not None and e >= elements:
-            continue
-        dofs = np.r_[6 * e : 6 * e + 12]
-        K[np.ix_(dofs, dofs)] += _frame_element(y[e + 1] - y[e], *props)
-    masses = rng.uniform(0.5, 1.5, n_nodes)
-    M = np.diag(np.repeat(masses, 6) * np.tile([1, 1, 1, 0.01, 0.02, 0.01], n_nodes))
-    xyz = np.column_stack([np.zeros(n_nodes), y, np.zeros(n_nodes)])
-    return K, M, xyz
-
-
-def _write_frame_deck(tmp_path: Path, K, M, xyz, ids, extra: str = "", names=("KGG", "MGG")):
-    """BDF with GRID ``ids[k]`` at ``xyz[k]``; OP4 with K, M in ascending-id order."""
-    text = io.StringIO()
-    text.write("BEGIN BULK\n")
-    for gid, (x, y, z) in zip(ids, xyz, strict=True):
-        bulk.wtcard16(text, ["GRID*", int(gid), "", float(x), float(y), float(z), ""])
-    text.write(extra)
-    text.write("ENDDATA\n")
-    bdf = tmp_path / "frame.bdf"
-    bdf.write_text(text.getvalue())
-    order = np.repeat(6 * np.argsort(ids), 6) + np.tile(np.arange(6), len(ids))
-    path = tmp_path / "frame.op4"
-    op4.write(str(path), {names[0]: K[np.ix_(order, order)], names[1]: M[np.ix_(order, order)]},
-              binary=False, digits=16)  # fmt: skip
-    return bdf, path, order
-
-
-def _scrambled_ids(n: int) -> np.ndarray:
-    rng = np.random.default_rng(SEED)
-    return 10 + rng.permutation(n) * 7  # ids not in node order, not contiguous
 
 
 def _same_modes(a, b, rtol: float) -> None:
@@ -127,9 +51,9 @@ def test_frame_import_is_the_direct_craig_bampton_to_round_off(tmp_path):
     # stiffness has a condition number of 1.3e5, so the eigensolver's round-off in a
     # different DOF order is ~1e-16 x 1.3e5 ~ 1e-11 (measured: frequencies 1.4e-12,
     # participation 4.9e-13, rigid mass 1.9e-16).
-    K, M, xyz = _frame()
-    ids = _scrambled_ids(len(xyz))
-    bdf, path, order = _write_frame_deck(tmp_path, K, M, xyz, ids)
+    K, M, xyz = frame()
+    ids = scrambled_ids(len(xyz))
+    bdf, path, order = write_frame_deck(tmp_path, K, M, xyz, ids)
     model = import_nastran(bdf, path, interface=int(ids[0]), n_modes=8)
     rigid = np.zeros((K.shape[0], 6))
     for k, p in enumerate(xyz):
@@ -147,9 +71,9 @@ def test_frame_import_is_the_direct_craig_bampton_to_round_off(tmp_path):
 def test_dof_order_round_trip(tmp_path):
     # The rows the import assigns to (grid, component) put the OP4 matrix back into
     # the frame's own order exactly (no arithmetic: 0 difference).
-    K, M, xyz = _frame(4)
-    ids = _scrambled_ids(4)
-    bdf, path, order = _write_frame_deck(tmp_path, K, M, xyz, ids)
+    K, M, xyz = frame(4)
+    ids = scrambled_ids(4)
+    bdf, path, order = write_frame_deck(tmp_path, K, M, xyz, ids)
     dofs = dof_set(read_bulk(bdf), "g")
     _, _, K_op4, _ = read_op4_matrices(path)
     node = {int(g): k for k, g in enumerate(ids)}
@@ -222,54 +146,14 @@ def test_shipped_plate_deck_is_flexsats_plate():
     assert model.interface_grid == maker.INTERFACE_GRID
 
 
-# --- the OP2 check --------------------------------------------------------------------
-
-
-def _key(value: int) -> bytes:
-    return struct.pack("<iii", 4, value, 4)
-
-
-def _record(data: bytes) -> bytes:
-    return struct.pack("<i", len(data)) + data + struct.pack("<i", len(data))
-
-
-def write_lama_op2(path: Path, eigenvalues: np.ndarray, table: bool = True) -> None:
-    """An OP2 file (32-bit, little-endian) holding one LAMA table, as OUTPUT2 writes it.
-
-    ``table=False``: the file header alone (an OP2 without eigenvalues).
-    """
-    out = [_key(3), _record(struct.pack("<3i", 12, 7, 26)), _key(7),
-           _record(b"NASTRAN FORT TAPE ID CODE - "), _key(2), _record(b"XXXXXXXX"),
-           _key(-1), _key(0)]  # fmt: skip
-    if not table:
-        path.write_bytes(b"".join(out) + _key(0))
-        return
-    out += [
-        _key(2),
-        _record(b"LAMA    "),
-        _key(-1),
-        _key(7),
-        _record(struct.pack("<7i", 101, *[0] * 6)),
-    ]
-    out += [_key(-2), _key(1), _key(0), _key(2), _record(b"LAMA    "), _key(-3), _key(1), _key(0)]
-    header = struct.pack("<146i", 21, 7, 0, *[0] * 143)
-    out += [_key(146), _record(header), _key(-4), _key(1), _key(0)]
-    rows = b"".join(
-        struct.pack("<2i5f", k + 1, k + 1, lam, np.sqrt(lam), np.sqrt(lam) / (2 * np.pi), 1.0, lam)
-        for k, lam in enumerate(eigenvalues)
-    )
-    out += [_key(len(rows) // 4), _record(rows), _key(-5), _key(1), _key(0), _key(0)]
-    path.write_bytes(b"".join(out))
-
-
 def test_op2_frequencies_check_the_import(tmp_path):
     # The OP2 holds the clamped eigenvalues of the deck's own K and M (scipy eigh,
     # interface rows and columns removed), in single precision as OUTPUT2 writes
     # them: the import's frequencies agree to float32 round-off (2^-24 = 6e-8 on an
     # eigenvalue, half that on a frequency; tolerance 1e-7).
-    K, M, xyz = _frame()
-    ids = _scrambled_ids(len(xyz))
-    bdf, path, order = _write_frame_deck(tmp_path, K, M, xyz, ids)
+    K, M, xyz = frame()
+    ids = scrambled_ids(len(xyz))
+    bdf, path, order = write_frame_deck(tmp_path, K, M, xyz, ids)
     lam = eigh(K[6:, 6:], M[6:, 6:], eigvals_only=True)
     op2 = tmp_path / "modes.op2"
     write_lama_op2(op2, lam)
@@ -309,21 +193,21 @@ def test_imported_file_loads_as_modal_data(tmp_path):
     ],
 )
 def test_bad_decks_are_refused_with_one_message(tmp_path, change, message):
-    K, M, xyz = _frame(
+    K, M, xyz = frame(
         4, elements=2 if change == "singular" else None
     )  # singular: a grid hangs free
-    ids = _scrambled_ids(4)
+    ids = scrambled_ids(4)
     kwargs = {"interface": int(ids[0])}
     if change == "asymmetric":
         K = K.copy()
         K[7, 13] += 1e-3 * np.abs(K).max()
     if change == "not-free":
         K = K + np.diag(np.full(K.shape[0], 1e-3 * np.abs(K).max()))
-    bdf, path, _ = _write_frame_deck(tmp_path, K, M, xyz, ids)
+    bdf, path, _ = write_frame_deck(tmp_path, K, M, xyz, ids)
     if change == "interface":
         kwargs["interface"] = 999
     if change == "size":
-        _write_frame_deck(tmp_path, K, M, xyz, ids)
+        write_frame_deck(tmp_path, K, M, xyz, ids)
         bdf.write_text(bdf.read_text().replace("ENDDATA", "GRID,5000,,9.,9.,9.\nENDDATA"))
     if change == "name":
         kwargs["stiffness"] = "KXX"
