@@ -8,6 +8,7 @@ READING_ORDER = (
     "own_satellite.py",
     "three_panels.py",
     "higher_modes.py",
+    "nastran_wing.py",
     "openloop_validation.py",
     "slew_requirements.py",
     "compare_laws.py",

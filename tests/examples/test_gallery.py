@@ -17,7 +17,7 @@ from flexsat.control.laws import LAWS
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
 TESTED = {
     "avionics", "compare_laws", "compiled_law", "higher_modes", "linear_design",
-    "montecarlo_statistics", "openloop_validation", "own_satellite",
+    "montecarlo_statistics", "nastran_wing", "openloop_validation", "own_satellite",
     "python_controller", "replay_case", "sensitivity_campaign", "slew_requirements",
     "three_panels",
 }  # fmt: skip
@@ -38,6 +38,19 @@ def test_own_satellite(run_example):
     )
     assert g["J_tot"][2, 2] == pytest.approx(hub + plates, rel=1e-12)
     assert np.all(g["analysis"].frequencies_hz[:6] == 0.0)  # six rigid-body modes
+
+
+def test_nastran_wing(run_example):
+    pytest.importorskip("pyyeti")
+    pytest.importorskip("skfem")
+    g = run_example("nastran_wing", 1.0)
+    # Newton: the roll torque's impulse, 1 N m for min(2, 0.5) s, is the satellite's
+    # angular momentum about X when it ends (no other torque; RK4 conserves it to
+    # ~1e-12 here, tolerance 1e-9). The wing's mass is rho L w t of the plate, exact
+    # to round-off.
+    assert g["momentum_x"] == pytest.approx(0.5, rel=1e-9)
+    assert g["wing"].modal.mass_kg == pytest.approx(2700.0 * 0.8 * 0.3 * 0.006, rel=1e-12)
+    assert g["mass_difference"] < 1e-12 * g["wing"].modal.mass_kg
 
 
 def test_three_panels(run_example):
