@@ -652,10 +652,10 @@ def _reduce(plant: dict, scenario: dict, reduced: Reduced) -> None:
 
     The record period is raised to the reduced one when shorter.
     """
-    from flexsat.config.models import APPENDAGE_CONFIGS
+    from flexsat.config.models import appendage_config_class, table_model
 
     for appendage in plant["appendages"]:
-        fields = APPENDAGE_CONFIGS[appendage.get("model", "plate")].model_fields
+        fields = appendage_config_class(table_model(appendage)).model_fields
         if "locked_dofs" in fields:  # a model that can lock coordinates
             appendage["locked_dofs"] = list(reduced.locked_dofs)
     scenario["dt_s"], scenario["control_dt_s"] = reduced.dt_s, reduced.control_dt_s

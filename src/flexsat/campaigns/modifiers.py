@@ -23,7 +23,7 @@ import numpy as np
 from pydantic import Field, ValidationError, model_validator
 from scipy import special
 
-from flexsat.config.models import HubConfig, _Frozen
+from flexsat.config.models import HubConfig, _Frozen, table_model
 from flexsat.dynamics.appendages import DerivedPath, appendage_model
 
 __all__ = ["Modifier", "ModifierError", "apply_modifiers", "derived_path", "truncnormal_ppf"]
@@ -291,7 +291,7 @@ def _derived(prefix: str, node: Any) -> dict[str, DerivedPath]:
     if prefix == "hub":
         return {"inertia": DerivedPath(_scale_hub_inertia)}
     if _APPENDAGE.fullmatch(prefix) and isinstance(node, dict):
-        return appendage_model(node.get("model", "plate")).modifiers
+        return appendage_model(table_model(node)).modifiers
     return {}
 
 
@@ -368,7 +368,7 @@ def _missing(name: str, prefix: str, node: dict, path: str) -> str:
     where = prefix or "the top level"
     derived = sorted(_derived(prefix, node))
     if _APPENDAGE.fullmatch(prefix):
-        model = node.get("model", "plate")
+        model = table_model(node)
         fields = sorted(_leaves(node))
         return (f"no {name!r} at {where} (a {model!r} appendage) of {path!r}: its paths are "
                 f"{', '.join(fields + derived)}")  # fmt: skip

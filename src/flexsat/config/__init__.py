@@ -9,15 +9,13 @@ from flexsat.config.load import (
     templates,
     validate_config,
 )
-from flexsat.config.models import AppendageConfig, HubConfig, SatelliteConfig, TargetFrequencies
+from flexsat.config.models import HubConfig, SatelliteConfig
 
 __all__ = [
     "PRESETS",
     "TEMPLATES",
-    "AppendageConfig",
     "HubConfig",
     "SatelliteConfig",
-    "TargetFrequencies",
     "load_config",
     "nominal",
     "preset_path",

@@ -10,7 +10,7 @@ from typing import Any
 
 from pydantic import BaseModel, Tag, ValidationError
 
-from flexsat.config.models import SatelliteConfig
+from flexsat.config.models import SatelliteConfig, appendage_config_class, table_model
 from flexsat.errors import ConfigError, shorten
 from flexsat.files import read_user_file
 
@@ -187,17 +187,17 @@ def validate_config(
     try:
         return model.model_validate(data)
     except ValidationError as exc:
-        problems = [_describe(error, model) for error in exc.errors()[:_MAX_REPORTED]]
+        problems = [_describe(error, model, data) for error in exc.errors()[:_MAX_REPORTED]]
         more = exc.error_count() - len(problems)
         suffix = f"; and {more} more" if more > 0 else ""
         raise ConfigError(f"{source}: {'; '.join(problems)}{suffix}") from None
 
 
-def _describe(error: dict[str, Any], model: type[BaseModel]) -> str:
+def _describe(error: dict[str, Any], model: type[BaseModel], data: Any = None) -> str:
     location = shorten(_location(error["loc"]))
     kind = error["type"]
     if kind == "extra_forbidden":
-        known = _known_keys(model, error["loc"][:-1])
+        known = _known_keys(model, error["loc"][:-1], data)
         hint = difflib.get_close_matches(str(error["loc"][-1]), known, n=1)
         suggestion = f"; did you mean {hint[0]!r}?" if hint else ""
         return f"unknown key {location!r}{suggestion} (allowed here: {', '.join(known)})"
@@ -226,25 +226,54 @@ def _location(loc: tuple[Any, ...]) -> str:
     return text or "(top level)"
 
 
-def _known_keys(model: type[BaseModel], loc: tuple[Any, ...]) -> list[str]:
+def _known_keys(model: type[BaseModel], loc: tuple[Any, ...], data: Any = None) -> list[str]:
     """Field names of the (sub)model at ``loc``, for unknown-key suggestions.
 
     A discriminated union (the controller's ``kind``) puts the member's tag in the
-    error path (``controller.asmc.gain``): that segment selects the member.
+    error path (``controller.asmc.gain``): that segment selects the member. An
+    appendage table is validated by the class its ``model`` key names: the table
+    itself, found in ``data`` along ``loc``, selects it.
     """
     candidates: list[tuple[str | None, type[BaseModel]]] = [(None, model)]
+    node = data  # the table the candidates describe
     for part in loc:
         if isinstance(part, int):
+            node = _child(node, part)
             continue
+        candidates = _by_table(candidates, node)
         models = [m for _, m in candidates]
         if any(part in m.model_fields for m in models):
             candidates = [member for m in models if part in m.model_fields
                           for member in _members(m.model_fields[part].annotation)]  # fmt: skip
-        else:
+            node = _child(node, part)
+        else:  # a union member's tag: the same table
             candidates = [(tag, m) for tag, m in candidates if tag == part]
         if not candidates:
             return []
-    return sorted({name for _, m in candidates for name in m.model_fields})
+    return sorted({name for _, m in _by_table(candidates, node) for name in m.model_fields})
+
+
+def _child(node: Any, part: Any) -> Any:
+    """``node[part]`` of parsed TOML data, None where the path leaves it."""
+    try:
+        return node[part]
+    except (KeyError, IndexError, TypeError):
+        return None
+
+
+def _by_table(candidates: list[tuple[str | None, type[BaseModel]]],
+              table: Any) -> list[tuple[str | None, type[BaseModel]]]:  # fmt: skip
+    """The candidates with an appendage table's open class (``BaseModel``) replaced by the
+    config class its ``model`` key names (the default model's without ``table``)."""
+    resolved = []
+    for tag, m in candidates:
+        if m is BaseModel:
+            try:
+                m = appendage_config_class(table_model(table))
+            except ValueError:  # an unknown model: its own error says so
+                continue
+        resolved.append((tag, m))
+    return resolved
 
 
 def _members(annotation: Any) -> list[tuple[str | None, type[BaseModel]]]:

@@ -13,8 +13,9 @@ the appendage root), panel frame P_i (moves with the appendage); see
 
 from __future__ import annotations
 
+from importlib import import_module
 from importlib.metadata import entry_points
-from typing import Annotated, Any, Literal
+from typing import Annotated, Any
 
 import numpy as np
 from pydantic import (
@@ -32,13 +33,15 @@ from pydantic import (
 __all__ = [
     "APPENDAGE_CONFIGS",
     "APPENDAGE_ENTRY_POINTS",
-    "AppendageConfig",
+    "BUILTIN_APPENDAGES",
+    "DEFAULT_APPENDAGE_MODEL",
     "DriveConfig",
     "HubConfig",
     "SatelliteConfig",
-    "TargetFrequencies",
+    "appendage_config_class",
     "load_appendage_plugins",
     "register_appendage_config",
+    "table_model",
 ]
 
 # A real number: ints are accepted, strings and booleans are not, NaN and inf are not.
@@ -129,42 +132,11 @@ def _check_inertia(j: np.ndarray) -> None:
         )
 
 
-class TargetFrequencies(_Frozen):
-    """Cantilever (clamped-root) natural frequencies of one appendage, per joint DOF [Hz].
-
-    Rotations are about the mount frame axes: flapping about X_M (out-of-plane
-    bending), torsion about Y_M (the span axis), in-plane bending about Z_M.
-    """
-
-    flapping: Frequency = Field(description="out-of-plane bending, rotation about X_M [Hz]")
-    in_plane: Frequency = Field(description="in-plane bending, rotation about Z_M [Hz]")
-    torsion: Frequency = Field(description="torsion, rotation about Y_M [Hz]")
-    translation_x: Frequency = Field(description="root translation along X_M [Hz]")
-    translation_y: Frequency = Field(description="root translation along Y_M [Hz]")
-    translation_z: Frequency = Field(description="root translation along Z_M [Hz]")
-
-    def per_dof(self) -> np.ndarray:
-        """Frequencies in joint-DOF order, shape (6,) [Hz].
-
-        Order: [eta_x, eta_y, eta_z, eta_rx, eta_ry, eta_rz].
-        """
-        return np.array(
-            [
-                self.translation_x,
-                self.translation_y,
-                self.translation_z,
-                self.flapping,
-                self.torsion,
-                self.in_plane,
-            ]
-        )
-
-
 class DriveConfig(_Frozen):
-    """A solar-array drive (SADM) turning a plate about its SADM axis Y_M.
+    """A solar-array drive (SADM) turning an appendage about its SADM axis.
 
-    The plate becomes a two-segment chain, the rotor then the panel, its drive angle
-    alpha_sadm a generalized coordinate (``eta_ry_0``) starting at the plate's
+    The appendage becomes a chain whose first segment is the rotor, its drive angle
+    alpha_sadm a generalized coordinate (``eta_ry_0``) starting at the appendage's
     ``sadm_angle_deg`` (``docs/model.md``, "Driven mount coordinate (SADM)"). A
     ``[joint_actuator] kind = "sadm_drive"`` is its motor.
     """
@@ -176,99 +148,16 @@ class DriveConfig(_Frozen):
     rotor_mass_kg: Mass = Field(description="rotor mass, on the axis at the root [kg]")
 
 
-class AppendageConfig(_Frozen):
-    """One flexible appendage: a rigid thin plate on a 6-DOF elastic root joint.
-
-    The mount frame M is the hub frame B rotated by ``mount_yaw_deg`` about Z_B and
-    then by the SADM angle about the resulting Y axis; its origin is
-    ``mount_point_m``. The plate spans ``length_m`` along +Y_P or -Y_P
-    (``span_direction``), ``width_m`` along X_P and ``thickness_m`` along Z_P.
-    Give the mass either as ``surface_density_kg_m2`` (eq. 2.6) or as ``mass_kg``.
-    """
-
-    name: Name = Field(description="unique name of the appendage")
-    model: Literal["plate"] = Field("plate", description="appendage model (registry key)")
-    mount_point_m: Point3 = Field(description="root position from hub centre of mass, frame B [m]")
-    mount_yaw_deg: Angle = Field(0.0, description="mount frame rotation about Z_B [deg]")
-    sadm_angle_deg: Angle = Field(0.0, description="SADM angle about Y_M [deg]")
-    span_direction: Literal["+y", "-y"] = Field("+y", description="span along +Y_M or -Y_M")
-    length_m: Size = Field(description="span L_p [m]")
-    width_m: Size = Field(description="chord W_p [m]")
-    thickness_m: Thickness = Field(description="thickness t_p [m]")
-    surface_density_kg_m2: Density | None = Field(None, description="rho_sup [kg/m^2]")
-    mass_kg: Mass | None = Field(None, description="panel mass M_p [kg]")
-    target_frequencies_hz: TargetFrequencies = Field(
-        description="cantilever frequency of each joint DOF, tuning its stiffness (eq. 2.14)"
-    )
-    damping_ratio: Annotated[float, Strict(), AllowInfNan(False), Field(ge=0.0, lt=1.0)] = Field(
-        description="viscous damping ratio zeta of every joint DOF [-]"
-    )
-    locked_dofs: list[Literal["eta_x", "eta_y", "eta_z", "eta_rx", "eta_ry", "eta_rz"]] = Field(
-        default_factory=list,
-        max_length=6,
-        description="joint DOFs held rigid in time simulation (reduced model; "
-        "docs/campaigns.md, 'Reduced models')",
-    )
-    drive: DriveConfig | None = Field(
-        None, description="put the plate on a solar-array drive: its SADM angle becomes a "
-        "coordinate; default: the angle is fixed"
-    )  # fmt: skip
-
-    @model_validator(mode="after")
-    def _one_mass(self) -> AppendageConfig:
-        if len(set(self.locked_dofs)) != len(self.locked_dofs):
-            raise ValueError(f"locked_dofs names a DOF twice: {self.locked_dofs}")
-        if (self.surface_density_kg_m2 is None) == (self.mass_kg is None):
-            raise ValueError("give exactly one of surface_density_kg_m2 and mass_kg")
-        if self.thickness_m > min(self.length_m, self.width_m):
-            raise ValueError("thickness_m must not exceed length_m or width_m (thin plate)")
-        if self.drive is not None:
-            self._drivable()
-        return self
-
-    def _drivable(self) -> None:
-        """Refuse a plate the drive's chain (``driven_plate``) cannot be built from."""
-        if self.locked_dofs:
-            raise ValueError(f"drive: a plate on a drive takes no locked_dofs (got "
-                             f"{self.locked_dofs})")  # fmt: skip
-        if abs(self.sadm_angle_deg) >= 45.0:
-            angle = self.sadm_angle_deg
-            raise ValueError(f"sadm_angle_deg: a plate on a drive starts its drive angle "
-                             f"within -45 < alpha < 45 deg (got {angle:g})")  # fmt: skip
-        if not 1e-4 <= self.mass <= 1e7:
-            raise ValueError(f"drive: a plate on a drive needs a panel mass within [1e-4, 1e7] "
-                             f"kg (got {self.mass:g})")  # fmt: skip
-
-    @property
-    def mass(self) -> float:
-        """Panel mass M_p [kg] (eq. 2.6 when given as a surface density)."""
-        if self.mass_kg is not None:
-            return self.mass_kg
-        return self.surface_density_kg_m2 * self.length_m * self.width_m  # eq. 2.6
-
-    def centroidal_inertia(self) -> np.ndarray:
-        """Inertia about the panel centre of mass in panel frame P, shape (3, 3) [kg m^2].
-
-        Thin plate with the span along Y_P (eqs. 2.9-2.11).
-        """
-        m, length, width, t = self.mass, self.length_m, self.width_m, self.thickness_m
-        return np.diag(
-            [
-                m * (length**2 + t**2) / 12.0,  # eq. 2.9
-                m * (width**2 + t**2) / 12.0,  # eq. 2.10
-                m * (length**2 + width**2) / 12.0,  # eq. 2.11
-            ]
-        )
-
-    def span_sign(self) -> float:
-        """+1 when the plate spans along +Y_P, -1 along -Y_P."""
-        return 1.0 if self.span_direction == "+y" else -1.0
-
-
-APPENDAGE_CONFIGS: dict[str, type[BaseModel]] = {"plate": AppendageConfig}
+APPENDAGE_CONFIGS: dict[str, type[BaseModel]] = {}
 """Config class of each appendage model, by its ``model`` key (the registry of
-:mod:`flexsat.dynamics.appendages` adds to it)."""
+:mod:`flexsat.dynamics.appendages` fills it)."""
 
+DEFAULT_APPENDAGE_MODEL = "plate"
+"""The model of an appendage table that names none: the thesis's plate."""
+
+BUILTIN_APPENDAGES = "flexsat.dynamics.appendages"
+"""The package whose import registers the built-in models (plate, chain, modal): found
+by name, as a plug-in is, so that the configuration layer imports no physics."""
 
 APPENDAGE_ENTRY_POINTS = "flexsat.appendages"
 """Entry-point group of third-party appendage models: each entry point names a module
@@ -277,11 +166,13 @@ _PLUGINS_LOADED = False
 
 
 def load_appendage_plugins() -> None:
-    """Import every module of the ``flexsat.appendages`` entry-point group, once."""
+    """Import the built-in models and every module of the ``flexsat.appendages``
+    entry-point group, once."""
     global _PLUGINS_LOADED
     if _PLUGINS_LOADED:
         return
     _PLUGINS_LOADED = True
+    import_module(BUILTIN_APPENDAGES)  # registers plate, chain and modal
     for point in entry_points(group=APPENDAGE_ENTRY_POINTS):
         point.load()  # importing the module registers its model
 
@@ -302,24 +193,51 @@ def register_appendage_config(model: str, config_class: type[BaseModel]) -> None
     APPENDAGE_CONFIGS[model] = config_class
 
 
-def _by_model(value: Any, handler: ValidatorFunctionWrapHandler) -> Any:
-    """Validate an appendage table with the config class its ``model`` key names."""
-    if isinstance(value, BaseModel):
-        return value if type(value) in APPENDAGE_CONFIGS.values() else handler(value)
-    model = value.get("model", "plate") if isinstance(value, dict) else "plate"
-    if model == "plate":
-        return handler(value)
+def appendage_config_class(model: str) -> type[BaseModel]:
+    """The config class of appendage model ``model`` (registered, built-in or plug-in).
+
+    Parameters
+    ----------
+    model : str
+        The ``model`` key of an appendage table.
+
+    Returns
+    -------
+    type of BaseModel
+        Its config class.
+
+    Raises
+    ------
+    ValueError
+        Naming the registered models when ``model`` is none of them.
+    """
     if model not in APPENDAGE_CONFIGS:
         load_appendage_plugins()
     if model not in APPENDAGE_CONFIGS:
         raise ValueError(
             f"model: unknown appendage model {model!r} (allowed: {', '.join(APPENDAGE_CONFIGS)})"
         )
-    return APPENDAGE_CONFIGS[model].model_validate(value)
+    return APPENDAGE_CONFIGS[model]
 
 
-# An appendage table: the plate's by default, else the config class of its model.
-Appendage = SerializeAsAny[Annotated[AppendageConfig, WrapValidator(_by_model)]]
+def table_model(value: Any) -> str:
+    """The ``model`` key of an appendage table, the default model when it names none."""
+    if isinstance(value, dict):
+        return value.get("model", DEFAULT_APPENDAGE_MODEL)
+    return DEFAULT_APPENDAGE_MODEL
+
+
+def _by_model(value: Any, handler: ValidatorFunctionWrapHandler) -> Any:
+    """Validate an appendage table with the config class its ``model`` key names."""
+    if isinstance(value, BaseModel):
+        if type(value) in APPENDAGE_CONFIGS.values():
+            return value
+        value = value.model_dump()
+    return appendage_config_class(table_model(value)).model_validate(value)
+
+
+# An appendage table, validated by the config class of its model (default the plate).
+Appendage = SerializeAsAny[Annotated[BaseModel, WrapValidator(_by_model)]]
 
 
 class SatelliteConfig(_Frozen):
@@ -377,27 +295,19 @@ def _check_interference(config: SatelliteConfig) -> None:
     hub = config.hub
     if hub.radius_m is None:  # an inertia without a shape: nothing to intersect
         return
-    u = np.linspace(-0.5, 0.5, 65)[:, None]  # across the chord, times the width
-    v = np.linspace(0.0, 1.0, 257)[None, :]  # along the span, times the length
     for k, app in enumerate(config.appendages):
-        if not isinstance(app, AppendageConfig):
+        surface = getattr(app, "surface_points_m", None)  # a model that declares its surface
+        if surface is None:
             continue
-        yaw, sadm = np.radians(app.mount_yaw_deg), np.radians(app.sadm_angle_deg)
-        # R_BM = Rz(yaw) Ry(sadm): the chord X_M and the span +-Y_M in B.
-        chord = np.array([np.cos(yaw) * np.cos(sadm), np.sin(yaw) * np.cos(sadm), -np.sin(sadm)])
-        span = app.span_sign() * np.array([-np.sin(yaw), np.cos(yaw), 0.0])
-        points = (np.array(app.mount_point_m)[:, None, None] + chord[:, None, None] * u
-                  * app.width_m + span[:, None, None] * v * app.length_m)  # fmt: skip
+        points = np.asarray(surface(), dtype=float).reshape(3, -1)
         depth_r = hub.radius_m - np.hypot(points[0], points[1])
         depth_z = 0.5 * hub.height_m - np.abs(points[2])
         inside = np.minimum(depth_r, depth_z) > 1e-9 * hub.radius_m
         if inside.any():
-            j = np.argwhere(inside)[0]
-            where = points[:, j[0], j[1]]
+            where = points[:, np.argmax(inside)]
             raise ValueError(
                 f"appendages[{k}] ({app.name}) passes through the hub: its point "
-                f"{np.round(where, 4).tolist()} m of the plate (width {app.width_m:g} m, "
-                f"length {app.length_m:g} m from mount_point_m) is inside the hub (radius "
-                f"{hub.radius_m:g} m, height {hub.height_m:g} m); a plate must lie outside "
-                "the hub"
+                f"{np.round(where, 4).tolist()} m is inside the hub (radius "
+                f"{hub.radius_m:g} m, height {hub.height_m:g} m); an appendage must lie "
+                "outside the hub"
             )

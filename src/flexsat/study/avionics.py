@@ -27,7 +27,7 @@ from pathlib import Path
 import numpy as np
 
 from flexsat.analysis.requirements import Requirements, residual_rate_verdict, slew_metrics
-from flexsat.config.models import AppendageConfig, SatelliteConfig
+from flexsat.config.models import SatelliteConfig
 from flexsat.dynamics.plant import Plant
 from flexsat.simulate import SlewScenario, run_slew
 
@@ -229,10 +229,11 @@ def sadm_runs(config: SatelliteConfig) -> list[dict]:
         The fields of the holding run (rate 0) and of the turning run
         (:data:`SADM_RATE_DEG_S`), or none for a satellite without plates [-].
     """
+    from flexsat.dynamics.appendages.plate_config import PlateConfig
     from flexsat.dynamics.appendages.sadm import DRIVE_COORDINATE
 
     drive = SADM_DRIVE
-    plates = [a for a in config.appendages if isinstance(a, AppendageConfig)]
+    plates = [a for a in config.appendages if isinstance(a, PlateConfig)]
     if not plates:
         return []
     inertia = drive["rotor_inertia_kg_m2"] + max(a.centroidal_inertia()[1, 1] for a in plates)

@@ -61,6 +61,7 @@ from flexsat.dynamics.appendages.contract import (
     DerivedPath,
     RigidBody,
 )
+from flexsat.dynamics.appendages.sadm import driven_chain
 
 __all__ = ["ChainModel"]
 
@@ -206,6 +207,13 @@ class ChainModel(AppendageModel):
         cols = [HEADER + SEG * k + base + i for k in range(n) for i in range(6)
                 if params[HEADER + SEG * k + G_FREE + i] != 0.0]  # fmt: skip
         return np.array(cols, dtype=int)
+
+    def on_drive(self, config: ChainConfig, params: np.ndarray) -> ChainConfig | None:
+        if config.drive is None:
+            return None
+        drive = config.drive
+        return driven_chain(config, self.stiffness(params), self.damping(params),
+                            drive.rotor_inertia_kg_m2, drive.rotor_mass_kg)  # fmt: skip
 
     def stiffness(self, params: np.ndarray) -> np.ndarray:
         return params[self._free_columns(params, G_K)].copy()

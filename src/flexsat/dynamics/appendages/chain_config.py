@@ -29,6 +29,7 @@ from scipy.spatial.transform import Rotation
 from flexsat.config.models import (
     Angle,
     Density,
+    DriveConfig,
     Frequency,
     Mass,
     Matrix3,
@@ -319,6 +320,10 @@ class ChainConfig(_Frozen):
     tip_mass_kg: Annotated[float, Strict(), AllowInfNan(False), Field(ge=0.0, le=1e7)] = Field(
         0.0, description="point mass at the free end [kg]"
     )
+    drive: DriveConfig | None = Field(
+        None, description="put the chain on a solar-array drive turning it about its span "
+        "axis: its SADM angle becomes a coordinate; default: the angle is fixed"
+    )  # fmt: skip
 
     @model_validator(mode="before")
     @classmethod
@@ -406,6 +411,13 @@ class ChainConfig(_Frozen):
         axis[self.span_axis()[0]] = 1.0
         return base @ Rotation.from_rotvec(np.radians(self.sadm_angle_deg) * axis).as_matrix()
 
+    def joints(self) -> list[JointConfig]:
+        """The joint of each segment as configured, root first."""
+        if self.segment_list is not None:
+            return [s.joint for s in self.segment_list]
+        return [self.root_joint if (k == 0 and self.root_joint is not None) else self.joint
+                for k in range(self.segments)]  # fmt: skip
+
     def resolved_segments(self) -> list[Segment]:
         """One :class:`Segment` per body, root first (SI)."""
         if self.segment_list is not None:
@@ -424,8 +436,7 @@ class ChainConfig(_Frozen):
         step = np.zeros(3)
         step[axis] = sign * seg_length
         out = []
-        for k in range(n):
-            joint = self.root_joint if (k == 0 and self.root_joint is not None) else self.joint
+        for k, joint in enumerate(self.joints()):
             stiffness = None
             if self.beam is not None:
                 stiffness = self._beam_stiffness(joint, 2.0 if k == 0 else 1.0)

@@ -387,6 +387,20 @@ class AppendageModel(ABC):
         nan = np.full((q_block.shape[0], 3), np.nan)
         return nan, nan.copy()
 
+    def on_drive(self, config: BaseModel, params: np.ndarray) -> BaseModel | None:
+        """The appendage on its solar-array drive, written as a model without one, or None.
+
+        A model whose config has a ``drive`` key (a
+        :class:`~flexsat.config.models.DriveConfig`) returns, when it is set, the
+        appendage as a chain whose segment 0 is the drive rotor on a free revolute
+        joint (``eta_ry_0``, the drive angle) and whose joints keep the stiffness and
+        damping of ``params``, the row tuned with the drive held (docs/model.md,
+        'Driven mount coordinate (SADM)'). The plant builds every driven appendage
+        through this hook (:func:`flexsat.dynamics.appendages.sadm.expand_drives`).
+        Default: None, the mount is fixed.
+        """
+        return None
+
     def mirror_block(self, params_i: np.ndarray, params_j: np.ndarray, reflect: np.ndarray,
                      rtol: float) -> np.ndarray | None:  # fmt: skip
         """The map from appendage i's coordinates to j's under a hub reflection, or None.

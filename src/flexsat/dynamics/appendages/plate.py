@@ -59,7 +59,7 @@ from flexsat.compiled.linalg3 import (
     transpose,
 )
 from flexsat.compiled.status import STATUS_JOINT_GIMBAL_LOCK, STATUS_OK
-from flexsat.config.models import AppendageConfig
+from flexsat.dynamics.appendages.chain_config import ChainConfig
 from flexsat.dynamics.appendages.contract import (
     HUB_ACC,
     HUB_ALPHA,
@@ -80,6 +80,8 @@ from flexsat.dynamics.appendages.contract import (
     DerivedPath,
     RigidBody,
 )
+from flexsat.dynamics.appendages.plate_config import PlateConfig
+from flexsat.dynamics.appendages.sadm import driven_plate
 from flexsat.dynamics.tuning import tune_joints
 
 __all__ = ["JOINT_DOFS", "PlateModel"]
@@ -753,17 +755,18 @@ def _scale_mass(table: dict, factor: float) -> None:
 
 
 class PlateModel(AppendageModel):
-    """The thesis plate (:class:`flexsat.config.models.AppendageConfig`) on its 6-DOF root joint."""
+    """The thesis plate (:class:`~flexsat.dynamics.appendages.plate_config.PlateConfig`)
+    on its 6-DOF root joint."""
 
     name = "plate"
-    config_class = AppendageConfig
+    config_class = PlateConfig
     kernels = AppendageKernels(pass1, pass2, mass_matrix, bias_forces, observe, joint_wrench, tips)
     transmits_inertia = False
     holds_locked = True
     modifiers: ClassVar[dict] = {"inertia": DerivedPath(_scale_mass)}
     work_size = WORK_SIZE
 
-    def coordinates(self, config: AppendageConfig) -> tuple[Coordinate, ...]:
+    def coordinates(self, config: PlateConfig) -> tuple[Coordinate, ...]:
         return tuple(Coordinate(n, u) for n, u in zip(JOINT_DOFS, _UNITS, strict=True))
 
     def group_kernels(self, rows: Sequence[np.ndarray]) -> AppendageKernels:
@@ -771,7 +774,7 @@ class PlateModel(AppendageModel):
             return self.kernels
         return self.kernels._replace(pass1=free_pass1, pass2=free_pass2)
 
-    def pack(self, config: AppendageConfig) -> np.ndarray:
+    def pack(self, config: PlateConfig) -> np.ndarray:
         sign = config.span_sign()
         J = config.centroidal_inertia()
         # R_BM = Rz(yaw) Ry(alpha_sadm): intrinsic Z then Y.
@@ -796,7 +799,14 @@ class PlateModel(AppendageModel):
             row[P_LOCKED + JOINT_DOFS.index(name)] = 1.0
         return row
 
-    def tune(self, config: AppendageConfig, params: np.ndarray, inertia_diag: np.ndarray
+    def on_drive(self, config: PlateConfig, params: np.ndarray) -> ChainConfig | None:
+        if config.drive is None:
+            return None
+        drive = config.drive
+        return driven_plate(config, self.stiffness(params), self.damping(params),
+                            drive.rotor_inertia_kg_m2, drive.rotor_mass_kg)  # fmt: skip
+
+    def tune(self, config: PlateConfig, params: np.ndarray, inertia_diag: np.ndarray
              ) -> np.ndarray:  # fmt: skip
         stiffness, damping = tune_joints(
             inertia_diag, config.target_frequencies_hz.per_dof(), config.damping_ratio
@@ -822,13 +832,13 @@ class PlateModel(AppendageModel):
         J = params[P_J : P_J + 9].reshape(3, 3)
         return RigidBody(float(params[P_MASS]), r, R_BM @ J @ R_BM.T)
 
-    def initial_state(self, config: AppendageConfig, entry) -> tuple[np.ndarray, np.ndarray]:
+    def initial_state(self, config: PlateConfig, entry) -> tuple[np.ndarray, np.ndarray]:
         q = np.concatenate([entry.eta_m, np.radians(entry.rho_deg)])
         # Relative rate given as ZYX angle rates [deg/s].
         qd = np.concatenate([entry.eta_rate_m_s, np.radians(entry.rho_rate_deg_s)])
         return q, qd
 
-    def describe(self, config: AppendageConfig, params: np.ndarray) -> dict:
+    def describe(self, config: PlateConfig, params: np.ndarray) -> dict:
         return {
             "mass_kg": float(params[P_MASS]),
             "centroidal_inertia_kg_m2": params[P_J : P_J + 9].reshape(3, 3).tolist(),
@@ -836,7 +846,7 @@ class PlateModel(AppendageModel):
             "damping": self.damping(params).tolist(),
         }
 
-    def shape_points(self, config: AppendageConfig, params: np.ndarray, q_block: np.ndarray
+    def shape_points(self, config: PlateConfig, params: np.ndarray, q_block: np.ndarray
                      ) -> np.ndarray:  # fmt: skip
         # x_B = r_m + R_BM (eta + R_MP x_P) for the corners, the root and the tip, with
         # the corners spanning 0..L along +-Y_P and -W/2..W/2 along X_P (mid-plane).
@@ -849,7 +859,7 @@ class PlateModel(AppendageModel):
         in_mount = q_block[:3] + local @ R_MP.T
         return params[P_MOUNT : P_MOUNT + 3] + in_mount @ self.mount_rotation(params).T
 
-    def target_frequencies(self, config: AppendageConfig) -> tuple[tuple[str, float], ...]:
+    def target_frequencies(self, config: PlateConfig) -> tuple[tuple[str, float], ...]:
         t = config.target_frequencies_hz
         return (
             ("flapping", t.flapping), ("in-plane", t.in_plane), ("torsion", t.torsion),
@@ -857,10 +867,10 @@ class PlateModel(AppendageModel):
             ("translation z", t.translation_z),
         )  # fmt: skip
 
-    def extent(self, config: AppendageConfig) -> float:
+    def extent(self, config: PlateConfig) -> float:
         return float(config.length_m)
 
-    def mode_kinds(self, config: AppendageConfig) -> tuple[str, ...]:
+    def mode_kinds(self, config: PlateConfig) -> tuple[str, ...]:
         return ("translation", "translation", "translation", "flapping", "torsion", "in_plane")
 
     def root_motion(self, q_block: np.ndarray, names: tuple[str, ...] = ()
