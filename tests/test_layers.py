@@ -34,6 +34,7 @@ LAYERS: tuple[tuple[str, tuple[str, ...]], ...] = (
     ("control", ("flexsat.control",)),
     ("analysis", ("flexsat.analysis",)),
     ("finite elements", ("flexsat.fe",)),
+    ("environment", ("flexsat.environment",)),
     ("orbit", ("flexsat.orbit",)),
     # The package itself: its version and the physics' public names, the compiled cache.
     ("package", ("flexsat", "flexsat._compiled_cache")),

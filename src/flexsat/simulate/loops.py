@@ -32,6 +32,13 @@ from flexsat.compiled.status import STATUS_CONTROL_FAILED, STATUS_OK
 from flexsat.dynamics.attitude import inertial_view, is_identity, rebase
 from flexsat.dynamics.integrators import augmented_derivative, rk4_step
 from flexsat.dynamics.kernels import hub_cs, keep_solution
+from flexsat.environment.loads import (
+    EnvironmentData,
+    applied_forces,
+    attitude_cbn,
+    environment_loads,
+    ephemeris_row,
+)
 from flexsat.simulate.coupled import LITERAL_STAGES, LoopFlow, chain_wrench, rk4_coupled_step
 
 __all__ = [
@@ -160,6 +167,10 @@ class LoopData(NamedTuple):
         View into ``held``: its records [per channel].
     Q : ndarray, shape (n_dof,)
         Generalized forces on the appendage coordinates, ``Q[6:]``, held [N or N m].
+    env : EnvironmentData
+        The environment's loads (:mod:`flexsat.environment.loads`): evaluated at each
+        control instant when ``env.active``, held like the torque; inactive without an
+        ``[environment]`` table (the loop then never reads it).
     """
 
     J_design: np.ndarray  # (3, 3) [kg m^2]
@@ -189,6 +200,7 @@ class LoopData(NamedTuple):
     joint_state: np.ndarray
     joint_record: np.ndarray  # view into held
     Q: np.ndarray  # (n_dof,) generalized forces on the appendage coordinates, Q[6:], held
+    env: EnvironmentData  # the environment's held loads (inactive without [environment])
 
 
 class LoopRecords(NamedTuple):
@@ -348,9 +360,10 @@ def rk4_closed_loop(x, clock, stages, d, records, plant, frame):
     At each step k (time t0 + k dt): re-base the attitude if due, run the reference,
     the sensing chain, the joint actuator (its ``Q`` held like the torque; it may
     update ``d.J_design`` for the law), the law and the actuation chain if k is a
-    control instant, record if
-    k is a record instant, then take one RK4 step under the held torque and joint
-    forces ``d.Q`` (coupled with the chain's continuous states if any), whose first
+    control instant (then the environment's loads, ``d.env``, when it is active), record
+    if k is a record instant, then take one RK4 step under the held torque and joint
+    forces ``d.Q`` (plus the environment's held torque and generalized forces, when it
+    is active; coupled with the chain's continuous states if any), whose first
     stage gives the record's q_ddot (:class:`LoopRecords`, without continuous stages). Chunk
     boundaries must be multiples of ``control_every`` and ``record_every``.
 
@@ -409,6 +422,12 @@ def rk4_closed_loop(x, clock, stages, d, records, plant, frame):
                 d.law_gains, d.law_state, t, control_dt, d.tau_cmd, d.law_diag,
             )  # fmt: skip
             status |= run_actuators(x, n, t, control_dt, clock.continuous, stages, d)
+            if d.env.active:  # held until the next instant, like the torque
+                env = d.env
+                ephemeris_row(env.ephemeris, t, env.row)
+                attitude_cbn(x, frame, env.C_BN)
+                status |= environment_loads(env)
+                applied_forces(env, d.Q, d.flow.held, clock.continuous)
             if status != 0:
                 return STATUS_CONTROL_FAILED, k, row - records.start
         if recorded:
@@ -417,23 +436,27 @@ def rk4_closed_loop(x, clock, stages, d, records, plant, frame):
             copy_into(records.frame[row], frame)
             copy_into(records.ctrl[row], d.held)
             records.Q[row, :6] = 0.0  # d.Q[:6] holds the integrator's last hub forces
-            copy_into(records.Q[row, 6:], d.Q[6:])
+            copy_into(records.Q[row, 6:], d.env.applied[6:] if d.env.active else d.Q[6:])
             row += 1
         if k == clock.n_steps:
             break
+        Q = d.env.applied if d.env.active else d.Q  # the joint actuator's + the environment's
         if clock.continuous:
             # at an instant, run_actuators evaluated the chain's rates at (x, t)
-            status = rk4_coupled_step(x, t, clock.dt, n, d.Q, scratch, stages.derivative,
+            status = rk4_coupled_step(x, t, clock.dt, n, Q, scratch, stages.derivative,
                                       d.actuator_params, d.flow, plant, instant)  # fmt: skip
         else:
             torque = (d.tau_applied[0], d.tau_applied[1], d.tau_applied[2])
+            if d.env.active:
+                e = d.env.torque
+                torque = (torque[0] + e[0], torque[1] + e[1], torque[2] + e[2])
             status = STATUS_OK
             if recorded:  # the first RK4 stage, kept for the record (LoopRecords.solved)
-                status = augmented_derivative(x, torque, n, d.Q, scratch[0], plant, hub_cs(x))
+                status = augmented_derivative(x, torque, n, Q, scratch[0], plant, hub_cs(x))
                 if status == STATUS_OK:
                     keep_solution(scratch[0, n : 2 * n], plant, records.solved[row - 1])
             if status == STATUS_OK:
-                status = rk4_step(x, clock.dt, torque, n, d.Q, scratch, plant, recorded)
+                status = rk4_step(x, clock.dt, torque, n, Q, scratch, plant, recorded)
         if status != STATUS_OK:
             return status, k, row - records.start
     return STATUS_OK, clock.n_steps, row - records.start

@@ -38,6 +38,7 @@ from flexsat.control.stages import (
     StageConfig,
     validate_stage,
 )
+from flexsat.environment.config import EnvironmentConfig
 
 __all__ = [
     "MAX_STEPS",
@@ -352,6 +353,10 @@ class SlewScenario(_TimedRun):
         default_factory=lambda: JOINT_ACTUATORS.get(JOINT_ACTUATORS.default).config(),
         description="actuators on appendage joint coordinates, by kind (default: none)",
     )
+    environment: EnvironmentConfig | None = Field(
+        None, description="environment models along the orbit (docs/environment.md); "
+        "default: none, the [disturbances] torques only"
+    )  # fmt: skip
 
     _MULTIPLES_OF_DT: ClassVar[tuple[str, ...]] = ("control_dt_s", "record_dt_s")
 

@@ -17,12 +17,25 @@ from flexsat.control.stages.registry import (
     no_derivative,
 )
 from flexsat.dynamics.plant import Plant
+from flexsat.environment.loads import EnvironmentData, environment_data, idle_environment
+from flexsat.errors import ConfigError
 from flexsat.simulate.coupled import CHAIN_SLOTS, LoopFlow
 from flexsat.simulate.layout import LoopLayout
 from flexsat.simulate.loops import LoopData, LoopStages
 from flexsat.simulate.scenario import SlewScenario
 
-__all__ = ["flown_chain", "loop_data", "loop_layout", "loop_stages"]
+EPHEMERIS_STEP_S = 10.0
+"""Step of the ephemeris a slew's environment is interpolated in [s]: the cubic Hermite
+position is within 1 mm of the orbit in low Earth orbit at this step (docs/environment.md)."""
+
+__all__ = [
+    "EPHEMERIS_STEP_S",
+    "flown_chain",
+    "loop_data",
+    "loop_layout",
+    "loop_stages",
+    "slew_environment",
+]
 
 
 def flown_chain(scenario: SlewScenario) -> tuple[list, int]:
@@ -227,4 +240,35 @@ def loop_data(layout: LoopLayout, scenario: SlewScenario, J: np.ndarray,
         joint_state=state[layout.joint_state],
         joint_record=held[layout.joint_record],
         Q=np.zeros(layout.plant.n_dof),
+        env=slew_environment(scenario, plant),
     )
+
+
+def slew_environment(scenario: SlewScenario, plant: Plant) -> EnvironmentData:
+    """The environment a slew flies in: its ``[environment]`` models along the orbit its
+    ``[orbit]`` table gives (the ephemeris built over the run), or none.
+
+    Parameters
+    ----------
+    scenario : SlewScenario
+        The slew (its ``environment`` and ``orbit`` tables, both optional).
+    plant : Plant
+        The plant flown (its geometry and mass elements).
+
+    Returns
+    -------
+    EnvironmentData
+        Active when the scenario has an ``[environment]`` with a model that acts.
+    """
+    config = getattr(scenario, "environment", None)
+    if config is None or not config.active():
+        return idle_environment(plant.n_dof)
+    orbit = getattr(scenario, "orbit", None)
+    if orbit is None:
+        raise ConfigError("environment: the environment models need the orbit: add an [orbit] "
+                          "table to the scenario")  # fmt: skip
+    from flexsat.orbit.ephemeris import build_ephemeris
+
+    step = EPHEMERIS_STEP_S
+    ephemeris = build_ephemeris(orbit, scenario.duration_s + step, step)
+    return environment_data(plant, config, ephemeris.table, ephemeris.epoch)
