@@ -1,7 +1,7 @@
 """NASTRAN decks to the modal data format: OP4 matrices, bulk-data sets, Craig–Bampton.
 
 A NASTRAN run writes the structure's stiffness and mass matrices to an OP4 file
-(a DMAP alter: ``OUTPUT4 KAA,MAA,,,//-1/31/-2/0/16``); the bulk data (BDF) says
+(a DMAP alter's ``OUTPUT4 KAA,MAA,,,//-1/31``); the bulk data (BDF) says
 which grid each matrix row belongs to and where the grids are. The rows of a
 matrix of the a-, f- or g-set are that set's DOFs in NASTRAN's internal order,
 which without resequencing (no ``SEQGP`` card, ``PARAM,OLDSEQ,-1``) is ascending
