@@ -67,7 +67,8 @@ def frame(n_nodes: int = 6, length: float = 2.0, elements: int | None = None):
     return K, M, xyz
 
 
-def write_frame_deck(tmp_path: Path, K, M, xyz, ids, extra: str = "", names=("KGG", "MGG")):
+def write_frame_deck(tmp_path: Path, K, M, xyz, ids, extra: str = "", names=("KGG", "MGG"),
+                     binary: bool = False):  # fmt: skip
     """BDF with GRID ``ids[k]`` at ``xyz[k]``; OP4 with K, M in ascending-id order."""
     from pyyeti.nastran import bulk, op4
 
@@ -82,7 +83,7 @@ def write_frame_deck(tmp_path: Path, K, M, xyz, ids, extra: str = "", names=("KG
     order = np.repeat(6 * np.argsort(ids), 6) + np.tile(np.arange(6), len(ids))
     path = tmp_path / "frame.op4"
     op4.write(str(path), {names[0]: K[np.ix_(order, order)], names[1]: M[np.ix_(order, order)]},
-              binary=False, digits=16)  # fmt: skip
+              binary=binary, digits=16)  # fmt: skip
     return bdf, path, order
 
 

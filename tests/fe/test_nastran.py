@@ -68,12 +68,14 @@ def test_frame_import_is_the_direct_craig_bampton_to_round_off(tmp_path):
     assert model.modal.mass_kg == pytest.approx(np.trace(M[0::6, 0::6]), rel=1e-12)  # sum m_k
 
 
-def test_dof_order_round_trip(tmp_path):
+@pytest.mark.parametrize("binary", [False, True])
+def test_dof_order_round_trip(tmp_path, binary):
     # The rows the import assigns to (grid, component) put the OP4 matrix back into
-    # the frame's own order exactly (no arithmetic: 0 difference).
+    # the frame's own order exactly (no arithmetic: 0 difference), from a formatted
+    # (16 digits) or a binary (double) OP4.
     K, M, xyz = frame(4)
     ids = scrambled_ids(4)
-    bdf, path, order = write_frame_deck(tmp_path, K, M, xyz, ids)
+    bdf, path, order = write_frame_deck(tmp_path, K, M, xyz, ids, binary=binary)
     dofs = dof_set(read_bulk(bdf), "g")
     _, _, K_op4, _ = read_op4_matrices(path)
     node = {int(g): k for k, g in enumerate(ids)}
@@ -87,6 +89,7 @@ def test_dof_order_round_trip(tmp_path):
 def test_sets_follow_nastran_rules(tmp_path):
     deck = tmp_path / "sets.bdf"
     deck.write_text(
+        "SOL 103\nCEND\nMPC = 2\nSPC = 1\n"  # case control: not bulk data
         "BEGIN BULK\n"
         "GRID,30,,0.,0.,0.,,456\n"
         "GRID,10,,1.,0.,0.\n"

@@ -192,7 +192,8 @@ def read_bulk(path: str | Path) -> BulkData:
     Parameters
     ----------
     path : str or Path
-        The BDF (small, large or free field; INCLUDE statements are not followed).
+        The BDF (small, large or free field; INCLUDE statements are not followed;
+        of a whole deck, the lines between BEGIN BULK and ENDDATA).
 
     Returns
     -------
@@ -213,7 +214,11 @@ def read_bulk(path: str | Path) -> BulkData:
             f"{path}: not a NASTRAN bulk data file (not ASCII text: a binary file?)"
         ) from None
     bulk = _pyyeti("bulk")
-    handle = io.StringIO(text)
+    lines = text.splitlines()
+    upper = [line.lstrip().upper() for line in lines]
+    start = next((k + 1 for k, line in enumerate(upper) if line.startswith("BEGIN BULK")), 0)
+    end = next((k for k, line in enumerate(upper) if line.startswith("ENDDATA")), len(lines))
+    handle = io.StringIO("\n".join(lines[start:end]) + "\n")  # case control is not bulk data
 
     def cards(name: str) -> list[list]:
         pattern = rf"{name}\*?(?=[ ,\t]|$)"
@@ -582,9 +587,9 @@ def import_nastran(bdf: str | Path, op4: str | Path, *, interface: int | None = 
     count = min(count, 2000) if n_modes is None else count
     if not 1 <= count <= interior.size:
         raise ConfigError(f"modes: must be in 1..{interior.size} (the interior DOFs), got {count}")
+    moving = set(map(tuple, dofs[interior].tolist()))
     tip_candidates = [int(g) for g in bulk.grid_ids
-                      if g != grid and all((int(g), c) in set(map(tuple, dofs[interior].tolist()))
-                                           for c in (1, 2, 3))]  # fmt: skip
+                      if all((int(g), c) in moving for c in (1, 2, 3))]  # fmt: skip
     outputs = None
     tip = grid
     if tip_candidates:
