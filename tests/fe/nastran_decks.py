@@ -52,7 +52,6 @@ def frame(n_nodes: int = 6, length: float = 2.0, elements: int | None = None):
     grids hang free).
     """
     rng = np.random.default_rng(SEED)
-    print(f"frame seed {SEED}")
     y = np.linspace(0.0, length, n_nodes)
     K = np.zeros((6 * n_nodes, 6 * n_nodes))
     for e in range(n_nodes - 1):

@@ -27,7 +27,7 @@ from flexsat.fe.nastran import (
     read_op2_frequencies,
     read_op4_matrices,
 )
-from tests.fe.nastran_decks import frame, scrambled_ids, write_frame_deck, write_lama_op2
+from tests.fe.nastran_decks import SEED, frame, scrambled_ids, write_frame_deck, write_lama_op2
 
 op4 = pytest.importorskip("pyyeti.nastran.op4")
 bulk = pytest.importorskip("pyyeti.nastran.bulk")
@@ -46,6 +46,7 @@ def _same_modes(a, b, rtol: float) -> None:
 
 
 def test_frame_import_is_the_direct_craig_bampton_to_round_off(tmp_path):
+    print(f"frame seed {SEED}")
     # The same K and M, written in NASTRAN's order (grid ids scrambled): frequencies,
     # rigid mass and participation agree to 1e-10 relative. The frame's clamped
     # stiffness has a condition number of 1.3e5, so the eigensolver's round-off in a
@@ -70,6 +71,7 @@ def test_frame_import_is_the_direct_craig_bampton_to_round_off(tmp_path):
 
 @pytest.mark.parametrize("binary", [False, True])
 def test_dof_order_round_trip(tmp_path, binary):
+    print(f"frame seed {SEED}")
     # The rows the import assigns to (grid, component) put the OP4 matrix back into
     # the frame's own order exactly (no arithmetic: 0 difference), from a formatted
     # (16 digits) or a binary (double) OP4.
@@ -150,6 +152,7 @@ def test_shipped_plate_deck_is_flexsats_plate():
 
 
 def test_op2_frequencies_check_the_import(tmp_path):
+    print(f"frame seed {SEED}")
     # The OP2 holds the clamped eigenvalues of the deck's own K and M (scipy eigh,
     # interface rows and columns removed), in single precision as OUTPUT2 writes
     # them: the import's frequencies agree to float32 round-off (2^-24 = 6e-8 on an
@@ -196,6 +199,7 @@ def test_imported_file_loads_as_modal_data(tmp_path):
     ],
 )
 def test_bad_decks_are_refused_with_one_message(tmp_path, change, message):
+    print(f"frame seed {SEED}")
     K, M, xyz = frame(
         4, elements=2 if change == "singular" else None
     )  # singular: a grid hangs free

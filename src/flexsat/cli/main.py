@@ -205,6 +205,10 @@ def fe_import(
     print_table(_console, f"{model.stiffness_name}/{model.mass_name}: {len(model.dofs)} DOFs, "
                 f"clamped at grid {model.interface_grid}, {model.modal.mass_kg:.6g} kg",
                 header, rows)  # fmt: skip
+    if errors is not None and np.abs(errors).max() > 1e-4:  # round-off is ~1e-6 (OP2 float32)
+        _console.print(f"warning: the OP2's frequencies differ by up to "
+                       f"{np.abs(errors).max():.2g}: is it this deck clamped at grid "
+                       f"{model.interface_grid}?")  # fmt: skip
     _console.print(f"wrote {path}")
 
 
