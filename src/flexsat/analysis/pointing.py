@@ -196,7 +196,8 @@ def error_rotation(ds: xr.Dataset) -> np.ndarray:
     Parameters
     ----------
     ds : xarray.Dataset
-        A slew's dataset (``quaternion``, ``attrs["target_quaternion"]``).
+        A slew's dataset (``quaternion``, and ``reference_quaternion`` for a moving
+        target, else ``attrs["target_quaternion"]``).
 
     Returns
     -------
@@ -205,6 +206,10 @@ def error_rotation(ds: xr.Dataset) -> np.ndarray:
     """
     from flexsat.analysis.requirements import error_rotation_vector
 
+    if "reference_quaternion" in ds.variables:  # a moving target: the reference produced
+        return error_rotation_vector(
+            ds.variables["quaternion"].values, ds.variables["reference_quaternion"].values
+        )
     return error_rotation_vector(
         ds.variables["quaternion"].values, np.asarray(ds.attrs["target_quaternion"], dtype=float)
     )

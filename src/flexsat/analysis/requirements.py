@@ -125,8 +125,9 @@ def error_rotation_vector(quaternion: np.ndarray, target: np.ndarray) -> np.ndar
     ----------
     quaternion : ndarray, shape (n, 4)
         Hub attitude q, scalar first [-].
-    target : ndarray, shape (4,)
-        Target attitude q_d, scalar first [-].
+    target : ndarray, shape (4,) or (n, 4)
+        Target attitude q_d, scalar first, fixed or one per record (a moving
+        target's ``reference_quaternion``) [-].
 
     Returns
     -------
@@ -135,8 +136,13 @@ def error_rotation_vector(quaternion: np.ndarray, target: np.ndarray) -> np.ndar
         shorter rotation, eq. 4.1); its norm is the pointing error.
     """
     q = np.asarray(quaternion, dtype=float)
-    d0, dv = target[0], np.asarray(target[1:], dtype=float)
-    e0 = q[:, 0] * d0 + q[:, 1:] @ dv  # eq. 4.1, scalar part
+    target = np.asarray(target, dtype=float)
+    if target.ndim == 1:
+        d0, dv = target[0], target[1:]
+        e0 = q[:, 0] * d0 + q[:, 1:] @ dv  # eq. 4.1, scalar part
+    else:  # one target per record
+        d0, dv = target[:, :1], target[:, 1:]
+        e0 = q[:, 0] * d0[:, 0] + (q[:, 1:] * dv).sum(axis=1)
     ev = d0 * q[:, 1:] - q[:, :1] * dv - np.cross(dv, q[:, 1:])  # eq. 4.1, vector part
     sign = np.where(e0 < 0.0, -1.0, 1.0)[:, None]
     e0, ev = np.abs(e0), sign * ev
@@ -375,11 +381,10 @@ def slew_metrics(ds: xr.Dataset, *, requirements: Requirements | None = None) ->
     start, end = observation_window(req, float(stored.get("duration_s", t[-1])))
     inside = (t >= start - _TIME_TOL) & (t <= end + _TIME_TOL)
     covered = bool(inside.any()) and t[-1] >= end - _TIME_TOL
-    error_deg = np.degrees(
-        error_rotation_vector(
-            ds.variables["quaternion"].values[inside], np.asarray(ds.attrs["target_quaternion"])
-        )
-    )
+    target = np.asarray(ds.attrs["target_quaternion"])
+    if "reference_quaternion" in ds.variables:  # a moving target: the reference produced
+        target = ds.variables["reference_quaternion"].values[inside]
+    error_deg = np.degrees(error_rotation_vector(ds.variables["quaternion"].values[inside], target))
     ape = absolute_performance_error(pointing[inside])
     max_rate = absolute_performance_error(jitter[inside])
     # a law without an adaptive slope records no lambda_act: no switch time

@@ -19,6 +19,7 @@ docs/orbit.md, 'The ephemeris'.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import lru_cache
 from math import ceil, floor, pi, sqrt
 
 import numpy as np
@@ -40,6 +41,7 @@ __all__ = [
     "Ephemeris",
     "build_ephemeris",
     "ephemeris_at",
+    "ephemeris_for_run",
     "fill_sun_and_shadow",
 ]
 
@@ -147,6 +149,29 @@ def build_ephemeris(
     angle = earth_rotation_angle(jd_whole, jd_fraction + times / _SECONDS_PER_DAY)
     table[:, 12] = angle - 2.0 * pi * floor(angle[0] / (2.0 * pi))
     return Ephemeris(table=np.ascontiguousarray(table), epoch=epoch, step_s=step)
+
+
+@lru_cache(maxsize=4)
+def ephemeris_for_run(orbit_config: OrbitConfig, duration_s: float) -> Ephemeris:
+    """The ephemeris of a run, built once for every reader of the run (memoized).
+
+    The references and the environment read the same table; a run's stages are
+    packed more than once (the layout, the data), and the propagation is not redone.
+    The table is shared: read it, do not write it.
+
+    Parameters
+    ----------
+    orbit_config : OrbitConfig
+        The ``[orbit]`` table.
+    duration_s : float
+        The run's duration [s].
+
+    Returns
+    -------
+    Ephemeris
+        :func:`build_ephemeris` at the orbit's ``ephemeris_step_s``.
+    """
+    return build_ephemeris(orbit_config, duration_s)
 
 
 @njit(cache=True, error_model="numpy")

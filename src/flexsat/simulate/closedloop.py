@@ -25,6 +25,7 @@ from flexsat.simulate.result import Result, build_dataset
 from flexsat.simulate.run_setup import PROGRESS_MIN_STEPS, progress_bar, run_attributes
 from flexsat.simulate.scenario import SlewScenario
 from flexsat.simulate.stage_chain import loop_data, loop_layout, loop_stages
+from flexsat.simulate.targets import reference_track, tracking_errors
 
 __all__ = [
     "Controller",
@@ -313,7 +314,16 @@ def finish_slew(run: PreparedSlew, status: int, done: int, rows: int, wall: floa
             more[channel.name] = (dims, values, attributes)
         # of the true attitude (relative to N), whatever the sensor measured
         q_N, omega = data_vars["q"][1], data_vars["omega"][1]
-        pointing = pointing_errors(target, np.ascontiguousarray(q_N[:, at.attitude]))
+        if scenario.reference.moving_target:  # against the target the reference produced
+            q_d, omega_d = reference_track(layout.reference.step, rec_t, data)
+            pointing, omega = tracking_errors(q_d, omega_d, q_N[:, at.attitude], omega)
+            more["reference_quaternion"] = (
+                ("time", "quat"), q_d,
+                {"units": "1", "long_name": "the reference attitude q_d the reference stage "
+                 "produced, scalar first"},
+            )  # fmt: skip
+        else:
+            pointing = pointing_errors(target, np.ascontiguousarray(q_N[:, at.attitude]))
         more["pointing_error_deg"] = (
             "time", np.degrees(pointing),
             {"units": "deg", "long_name": "2 asin |q_v,e| of the true attitude from the "

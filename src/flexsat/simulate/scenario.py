@@ -39,6 +39,7 @@ from flexsat.control.stages import (
     validate_stage,
 )
 from flexsat.environment.config import EnvironmentConfig
+from flexsat.orbit.config import OrbitConfig
 
 __all__ = [
     "MAX_STEPS",
@@ -358,6 +359,11 @@ class SlewScenario(_TimedRun):
         "default: none, the [disturbances] torques only"
     )  # fmt: skip
 
+    orbit: OrbitConfig | None = Field(
+        None, description="the satellite's orbit (docs/orbit.md); default none: the "
+        "attitude alone in an inertial frame"
+    )  # fmt: skip
+
     _MULTIPLES_OF_DT: ClassVar[tuple[str, ...]] = ("control_dt_s", "record_dt_s")
 
     @field_validator("controller", mode="before")
@@ -397,6 +403,15 @@ class SlewScenario(_TimedRun):
                     f"+-{limit:g} N m (it is added before the actuator's saturation), got "
                     f"{[float(f'{v:.6g}') for v in values]}"
                 )
+        return self
+
+    @model_validator(mode="after")
+    def _target_on_the_orbit(self) -> SlewScenario:
+        if self.reference.moving_target and self.orbit is None:
+            raise ValueError(
+                f"reference.kind = {self.reference.kind!r} points at a target along the "
+                "orbit: add an [orbit] table (docs/orbit.md, 'The orbit table')"
+            )
         return self
 
     @model_validator(mode="after")

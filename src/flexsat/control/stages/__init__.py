@@ -1,7 +1,8 @@
 """Loop stages around the law: sensors and actuators, one module each, one registry.
 
 Built in: the thesis's ideal sensor and static actuator; the reference generators
-(the thesis's ``step`` and the shaped ``eigenaxis`` slew) and the joint actuators
+(the thesis's ``step``, the shaped ``eigenaxis`` slew, and ``nadir`` and ``sun``
+pointing along an orbit) and the joint actuators
 (``none``, the thesis's hub-only control, ``rate_feedback``, hybrid active
 damping, and ``sadm_drive``, the solar-array drive). Write your own stage in your
 own file (see ``docs/control.md``): a parameter model, a compiled step of its role's
@@ -14,6 +15,7 @@ from flexsat.control.stages.gyro import GYRO
 from flexsat.control.stages.ideal_sensor import IDEAL_SENSOR
 from flexsat.control.stages.joint_rate_feedback import JOINT_RATE_FEEDBACK
 from flexsat.control.stages.mekf import MEKF
+from flexsat.control.stages.nadir_reference import NADIR_REFERENCE
 from flexsat.control.stages.no_joint_actuator import NO_JOINT_ACTUATOR
 from flexsat.control.stages.notch import NOTCH
 from flexsat.control.stages.registry import (
@@ -39,6 +41,7 @@ from flexsat.control.stages.sadm_drive import SADM_DRIVE
 from flexsat.control.stages.star_tracker import STAR_TRACKER
 from flexsat.control.stages.static_actuator import STATIC_ACTUATOR
 from flexsat.control.stages.step_reference import STEP_REFERENCE
+from flexsat.control.stages.sun_reference import SUN_REFERENCE
 from flexsat.control.stages.wheels import WHEELS
 
 __all__ = [
@@ -68,6 +71,8 @@ register_stage(MEKF)
 register_stage(STATIC_ACTUATOR, default=True)
 register_stage(STEP_REFERENCE, default=True)
 register_stage(EIGENAXIS_REFERENCE)
+register_stage(NADIR_REFERENCE)
+register_stage(SUN_REFERENCE)
 register_stage(NO_JOINT_ACTUATOR, default=True)
 register_stage(JOINT_RATE_FEEDBACK)
 register_stage(SADM_DRIVE)

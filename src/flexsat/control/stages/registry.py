@@ -216,7 +216,14 @@ class ActuatorStageConfig(StageConfig):
 
 
 class PlantStageConfig(StageConfig):
-    """Base of the stages designed against the plant they fly (reference, joint actuator)."""
+    """Base of the stages designed against the plant they fly (reference, joint actuator).
+
+    ``moving_target`` (class attribute, default False): a reference whose target moves
+    (nadir, Sun): the run's pointing and rate errors are then taken from the reference
+    it produced at each record, not from the scenario's fixed target.
+    """
+
+    moving_target: ClassVar[bool] = False
 
     def packed(self, scenario: Any, plant: Any = None) -> np.ndarray:
         """Packed parameters; ``plant`` is the :class:`~flexsat.dynamics.plant.Plant`
