@@ -480,12 +480,30 @@ NASTRAN = [
     _nastran("NASTRAN OP2 without eigenvalues", "", ["--op2", "{tmp}/x.op2"], "no eigenvalue table (LAMA)"),
     _nastran("NASTRAN modes out of range", "", ["--modes", "0"], "modes: must be in 1..18"),
     _nastran("NASTRAN damping out of range", "", ["--damping", "1.5"], "--damping: must be in [0, 1)"),
+    _nastran("NASTRAN output of another kind", "", ["-o", "{tmp}/w.txt"], "--output: the suffix must be .npz or .toml, got 'w.txt'"),
     _nastran("NASTRAN stiffness not free-free", "grounded", [], "KGG: rigid motions about grid 10 are not free"),
     Bad("NASTRAN deck is a FIFO", ["fe", "import", "{tmp}/d.bdf", "--op4", "{tmp}/m.op4", "-o", "{tmp}/w.npz"], f"cannot read NASTRAN bulk data file {{tmp}}/d.bdf: {_NOT_REGULAR}", {"d.bdf": FIFO}, 10),
     Bad("NASTRAN deck missing", ["fe", "import", "{tmp}/none.bdf", "--op4", "{tmp}/m.op4", "-o", "{tmp}/w.npz"], "NASTRAN bulk data file not found"),
 ] if importlib.util.find_spec("pyyeti") else []  # fmt: skip
 
-TABLE = CONFIGS + SCENARIOS + PATHS + SPECIAL_FILES + ROBUSTNESS + CAMPAIGNS + BUDGET + NASTRAN
+# The [orbit] table (docs/orbit.md, 'The orbit table'): closed orbits above the
+# atmosphere, well-formed element sets, a target on the orbit only with one.
+_TLE_1 = "1 25544U 98067A   26060.50000000  .00016717  00000-0  10270-3 0  9006"
+ORBIT = [
+    _scenario("orbit below the surface", "[orbit]\naltitude_m = -100e3\n", "orbit: the orbit's perigee a (1 - e) = 6278.14 km is -100 km above the surface", command="slew"),
+    _scenario("perigee inside the atmosphere", "[orbit]\nsemi_major_axis_m = 7.0e6\neccentricity = 0.1\n", "give semi_major_axis_m (1 - eccentricity) >= 6478.14 km", command="slew"),
+    _scenario("eccentricity 1", "[orbit]\neccentricity = 1.0\n", "orbit.eccentricity: must be in [0, 1) (a closed orbit), got 1", command="slew"),
+    _scenario("hyperbolic orbit", "[orbit]\neccentricity = 1.5\n", "orbit.eccentricity: must be in [0, 1)", command="slew"),
+    _scenario("TLE checksum wrong", f'[orbit]\ntle = ["{_TLE_1}", "2 25544  51.6400 208.9163 0006317  69.9862  25.2906 15.49560532  1008"]\n', "orbit.tle: tle line 2: checksum '8' does not match its contents (expected 9)", command="slew"),
+    _scenario("TLE line cut short", f'[orbit]\ntle = ["{_TLE_1[:60]}", "2 25544  51.6400 208.9163 0006317  69.9862  25.2906 15.49560532  1008"]\n', "orbit.tle: tle line 1 must be 69 characters, got 60", command="slew"),
+    _scenario("TLE lines swapped", f'[orbit]\ntle = ["2 25544  51.6400 208.9163 0006317  69.9862  25.2906 15.49560532  1008", "{_TLE_1}"]\n', "orbit.tle: tle line 1 must start with '1 '", command="slew"),
+    _scenario("TLE and elements", f'[orbit]\naltitude_m = 500e3\ntle = ["{_TLE_1}", "2 25544  51.6400 208.9163 0006317  69.9862  25.2906 15.49560532  1009"]\n', "give the tle or the elements, not both", command="slew"),
+    _scenario("epoch not a time", '[orbit]\nepoch = "yesterday"\n', "orbit.epoch: 'yesterday' is not an ISO 8601 UTC time", command="slew"),
+    _scenario("epoch not in UTC", '[orbit]\nepoch = "2026-03-20T12:00:00+02:00"\n', "is not in UTC", command="slew"),
+    _scenario("nadir pointing without an orbit", '[reference]\nkind = "nadir"\n', "reference.kind = 'nadir' points at a target along the orbit: add an [orbit] table", command="slew"),
+]  # fmt: skip
+
+TABLE = CONFIGS + SCENARIOS + PATHS + SPECIAL_FILES + ROBUSTNESS + CAMPAIGNS + BUDGET + NASTRAN + ORBIT
 
 
 def test_the_table_is_at_least_sixty_rows():
