@@ -229,3 +229,9 @@ def test_bad_decks_are_refused_with_one_message(tmp_path, change, message):
         kwargs.pop("interface")
     with pytest.raises(ConfigError, match=message.replace("(", r"\(").replace(")", r"\)")):
         import_nastran(bdf, path, n_modes=3, **kwargs)
+
+
+def test_without_pyyeti_one_message_names_the_extra(monkeypatch):
+    monkeypatch.setitem(__import__("sys").modules, "pyyeti.nastran.bulk", None)  # not importable
+    with pytest.raises(ConfigError, match=r"pip install 'flexsat\[nastran\]'"):
+        read_bulk(DATA / "nastran_plate.bdf")

@@ -176,6 +176,8 @@ def fe_import(
 
     if not 0.0 <= damping < 1.0:
         raise FlexsatError(f"--damping: must be in [0, 1), got {damping}")
+    if output.suffix.lower() not in (".npz", ".toml"):
+        raise FlexsatError(f"--output: the suffix must be .npz or .toml, got {output.name!r}")
     model = import_nastran(deck, op4, interface=interface, n_modes=modes, op2=op2,
                            stiffness=stiffness, mass=mass, damping_ratio=damping)  # fmt: skip
     path = save_modal_data(model.modal, output)
