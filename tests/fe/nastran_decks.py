@@ -45,18 +45,20 @@ def frame_element(length: float, ea: float, gj: float, ei_x: float, ei_z: float)
     return k
 
 
-def frame(n_nodes: int = 6, length: float = 2.0, elements: int | None = None):
+def frame(n_nodes: int = 6, length: float = 2.0, elements: int | None = None,
+          detached: bool = False):  # fmt: skip
     """A free-free frame of ``n_nodes`` grids on Y (node 0 at the origin, the interface).
 
     ``elements``: how many of the ``n_nodes - 1`` elements to assemble (fewer: the last
-    grids hang free).
+    grids hang free); ``detached``: without the first element (the other grids form
+    a free body that the interface does not hold).
     """
     rng = np.random.default_rng(SEED)
     y = np.linspace(0.0, length, n_nodes)
     K = np.zeros((6 * n_nodes, 6 * n_nodes))
     for e in range(n_nodes - 1):
         props = rng.uniform(0.5, 2.0, 4) * np.array([1e6, 2e3, 3e3, 1e3])  # EA, GJ, EI_x, EI_z
-        if elements is not None and e >= elements:
+        if (elements is not None and e >= elements) or (detached and e == 0):
             continue
         dofs = np.r_[6 * e : 6 * e + 12]
         K[np.ix_(dofs, dofs)] += frame_element(y[e + 1] - y[e], *props)

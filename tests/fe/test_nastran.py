@@ -188,6 +188,7 @@ def test_imported_file_loads_as_modal_data(tmp_path):
     [
         ("interface", "grid 999 is not in the deck"),
         ("singular", "singular stiffness"),
+        ("detached", "singular stiffness with grid"),
         ("size", "the matrices are not this deck's"),
         ("asymmetric", "is not symmetric"),
         ("name", "no matrix 'KXX'"),
@@ -200,9 +201,10 @@ def test_imported_file_loads_as_modal_data(tmp_path):
 )
 def test_bad_decks_are_refused_with_one_message(tmp_path, change, message):
     print(f"frame seed {SEED}")
-    K, M, xyz = frame(
-        4, elements=2 if change == "singular" else None
-    )  # singular: a grid hangs free
+    # singular: the last grid hangs free (no stiffness on its DOFs); detached: grids
+    # 2-4 form a free body (every diagonal stiffness > 0, six zero eigenvalues).
+    K, M, xyz = frame(4, elements=2 if change == "singular" else None,
+                      detached=change == "detached")  # fmt: skip
     ids = scrambled_ids(4)
     kwargs = {"interface": int(ids[0])}
     if change == "asymmetric":

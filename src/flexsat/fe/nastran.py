@@ -538,6 +538,7 @@ def import_nastran(bdf: str | Path, op4: str | Path, *, interface: int | None = 
     """
     bulk = read_bulk(bdf)
     k_name, m_name, K, M = read_op4_matrices(op4, stiffness, mass)
+    reference = None if op2 is None else read_op2_frequencies(op2)
     which = _SETS.get(k_name[-2:])
     if which is None:
         raise ConfigError(
@@ -609,7 +610,6 @@ def import_nastran(bdf: str | Path, op4: str | Path, *, interface: int | None = 
             f"{m_name}: the clamped eigenproblem failed ({shorten(str(exc), 80)}): a massless "
             "or unconstrained DOF; keep only DOFs with mass in the a-set (ASET1)"
         ) from None
-    reference = None if op2 is None else read_op2_frequencies(op2)
     return NastranModel(modal, dofs, grid, tip, k_name, m_name, reference)
 
 
