@@ -34,18 +34,36 @@ At every control instant the body-torque command is allocated by the
 pseudo-inverse, u_cmd = -A^+ tau_cmd - k_null (I - A^+ A)(h - I_s Omega_bias),
 A = [a_1 ... a_N] (3 x N): the null-space term drives the wheels towards their
 bias speed without torquing the hub; each u_cmd,i is clipped to the motor limit.
+
+Microvibration (``[actuator.microvibration]``, off by default): the empirical wheel
+model of Masterson, Miller and Grogan ("Development and validation of reaction wheel
+disturbance models: empirical model") and of Bialke ("High fidelity mathematical
+modeling of reaction wheel performance"). Each wheel, at rotor angle theta_i
+(integrated, theta_i_dot = Omega_i, zero at t = 0) exerts on the hub, for each
+harmonic k of a table (harmonic number h_k, coefficient C_k, random phase phi_ik)::
+
+    radial force   F = C_k Omega_i^2 (cos x e1_i + sin x e2_i)     x = h_k theta_i + phi_ik
+    axial force    F = C_k Omega_i^2 sin x a_i
+    radial torque  T = C_k Omega_i^2 (cos x e1_i + sin x e2_i)
+
+with (e1_i, e2_i, a_i) right-handed. The static imbalance U_s [kg m] is a radial
+force of h = 1, the dynamic imbalance U_d [kg m^2] a radial torque of h = 1. A force
+acts at the wheel's position r_i (hub frame, from the hub's reference point) and adds
+the torque r_i x F about it; the force itself is not applied to the hub's translation
+(the stage's wrench is a torque). The phases are drawn once from ``seed``
+(numpy's default generator), so a run is reproducible.
 """
 
 from __future__ import annotations
 
-from math import copysign, exp, pi, sin
+from math import copysign, cos, exp, pi, sin
 from typing import Annotated, Literal
 
 import numpy as np
 from numba import njit
 from pydantic import Field, model_validator
 
-from flexsat.config.models import Positive, Real
+from flexsat.config.models import Positive, Real, _Frozen
 from flexsat.control.registry import Channel
 from flexsat.control.stages.registry import (
     ActuatorStageConfig,
@@ -53,7 +71,18 @@ from flexsat.control.stages.registry import (
 )
 from flexsat.control.stages.static_actuator import PACKED as DISTURBANCES
 
-__all__ = ["MAX_WHEELS", "SATURATED_RATIO", "WHEELS", "WheelsConfig", "wheel_axes"]
+__all__ = [
+    "HARMONIC_KINDS",
+    "MAX_HARMONICS",
+    "MAX_WHEELS",
+    "SATURATED_RATIO",
+    "WHEELS",
+    "Harmonic",
+    "MicrovibrationConfig",
+    "WheelsConfig",
+    "radial_basis",
+    "wheel_axes",
+]
 
 MAX_WHEELS = 6
 """Most wheels in one cluster (the stage's state is sized for them)."""
@@ -71,10 +100,17 @@ _NULL = _PINV + 3 * MAX_WHEELS  # I - A^+ A, row-major (MAX_WHEELS, MAX_WHEELS)
 _INV_IS = _NULL + MAX_WHEELS * MAX_WHEELS
 _INV_TAU, _INV_WC, _HMAX, _H0 = _INV_IS + 1, _INV_IS + 2, _INV_IS + 3, _INV_IS + 4
 _SIZE = _INV_IS + 5
+# microvibration, packed only when configured (WheelsConfig._packed_vibration): the
+# number of terms at _SIZE, each wheel's e1, e2, r and on flag (10 per wheel slot), then each term's
+# kind, h, C and one phase per wheel slot
+_VIB_WHEELS = _SIZE + 1
+_VIB_TERMS = _VIB_WHEELS + 10 * MAX_WHEELS
+_VIB_STRIDE = 3 + MAX_WHEELS
 # state, packed for the N wheels of the cluster (the coupled RK4 step carries its first
-# 3 N + 2 entries, WheelsConfig.integrated_size): h_i - I_s Omega_0 at i, motor torque
-# u_i at N + i, command u_cmd,i at 2 N + i (held: zero rate), motor work at 3 N,
-# friction loss at 3 N + 1
+# 3 N + 2 entries, 4 N + 2 with microvibration, WheelsConfig.integrated_size):
+# h_i - I_s Omega_0 at i, motor torque u_i at N + i, command u_cmd,i at 2 N + i (held:
+# zero rate), motor work at 3 N, friction loss at 3 N + 1, rotor angle theta_i at
+# 3 N + 2 + i (with microvibration only)
 _RPM = 2.0 * np.pi / 60.0  # [rad/s per rpm]
 SATURATED_RATIO = 0.999
 """``abs(h_i) / (I_s Omega_max)`` at and above which a wheel is reported saturated."""
@@ -107,6 +143,90 @@ def wheel_axes(preset: str, pyramid_half_angle_deg: float = 54.7356) -> np.ndarr
                             np.full(4, np.cos(beta))])  # fmt: skip
 
 
+MAX_HARMONICS = 32
+"""Most harmonics of one microvibration table (radial force, axial force, radial torque)."""
+HARMONIC_KINDS = ("radial_force", "axial_force", "radial_torque")
+"""The microvibration tables, in the order the packed terms carry their kind (0, 1, 2)."""
+_HarmonicNumber = Annotated[float, Field(gt=0.0, le=1000.0, allow_inf_nan=False)]
+_Coefficient = Annotated[float, Field(ge=0.0, le=1.0, allow_inf_nan=False)]
+
+
+class Harmonic(_Frozen):
+    """One harmonic of the empirical wheel model: C Omega^2 at h Omega."""
+
+    number: _HarmonicNumber = Field(description="h, harmonic number of the wheel speed [-]")
+    coefficient: _Coefficient = Field(
+        description="C: amplitude C Omega^2 [kg m for a force, kg m^2 for a torque]"
+    )
+
+
+class MicrovibrationConfig(_Frozen):
+    """The wheels' imbalances and harmonic tables (module docstring, 'Microvibration')."""
+
+    static_imbalance_kg_m: _Coefficient = Field(0.0, description="U_s, static imbalance [kg m]")
+    dynamic_imbalance_kg_m2: _Coefficient = Field(
+        0.0, description="U_d, dynamic imbalance [kg m^2]"
+    )
+    radial_force: tuple[Harmonic, ...] = Field(
+        (), max_length=MAX_HARMONICS, description="radial force harmonics, C [kg m]"
+    )
+    axial_force: tuple[Harmonic, ...] = Field(
+        (), max_length=MAX_HARMONICS, description="axial force harmonics, C [kg m]"
+    )
+    radial_torque: tuple[Harmonic, ...] = Field(
+        (), max_length=MAX_HARMONICS, description="radial torque harmonics, C [kg m^2]"
+    )
+    positions_m: tuple[tuple[Real, Real, Real], ...] | None = Field(
+        None,
+        description="each wheel's position r_i from the hub's reference point, hub frame B "
+        "[m]; default: every wheel at the reference point (forces add no torque)",
+    )
+    wheels: tuple[Annotated[int, Field(ge=1, le=MAX_WHEELS)], ...] | None = Field(
+        None, min_length=1, description="the wheels (1-based) that vibrate; default: all"
+    )
+    seed: Annotated[int, Field(ge=0, lt=2**53)] = Field(1, description="phase stream")
+
+    def vibrating(self, n_wheels: int) -> np.ndarray:
+        """Whether each wheel vibrates, shape (n_wheels,)."""
+        on = np.ones(n_wheels, dtype=bool)
+        if self.wheels is not None:
+            on[:] = False
+            on[[w - 1 for w in self.wheels]] = True
+        return on
+
+    def terms(self) -> list[tuple[int, float, float]]:
+        """Every harmonic as (kind index in :data:`HARMONIC_KINDS`, h, C), the imbalances
+        first (a radial force and a radial torque of h = 1)."""
+        out = [(0, 1.0, self.static_imbalance_kg_m), (2, 1.0, self.dynamic_imbalance_kg_m2)]
+        for kind, name in enumerate(HARMONIC_KINDS):
+            out += [(kind, h.number, h.coefficient) for h in getattr(self, name)]
+        return [t for t in out if t[2] > 0.0]
+
+    def phases(self, n_wheels: int) -> np.ndarray:
+        """phi_ik, shape (n_terms, n_wheels), uniform in [0, 2 pi) from ``seed`` [rad]."""
+        rng = np.random.default_rng(self.seed)
+        return rng.uniform(0.0, 2.0 * np.pi, size=(len(self.terms()), n_wheels))
+
+
+def radial_basis(axes: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """e1_i, e2_i: unit vectors spanning each wheel's plane, (e1, e2, a) right-handed.
+
+    Parameters
+    ----------
+    axes : ndarray, shape (N, 3)
+        Unit spin axes a_i, hub frame B [-].
+
+    Returns
+    -------
+    e1, e2 : ndarray, shape (N, 3)
+        e1 the hub axis least aligned with a_i made perpendicular to it, e2 = a x e1 [-].
+    """
+    e1 = np.eye(3)[np.argmin(np.abs(axes), axis=1)]
+    e1 = e1 - np.sum(e1 * axes, axis=1)[:, None] * axes
+    e1 /= np.linalg.norm(e1, axis=1)[:, None]
+    return e1, np.cross(axes, e1)
+
+
 class WheelsConfig(ActuatorStageConfig):
     """A reaction-wheel cluster (module docstring); ``t_max_nm`` is the body-torque
     limit the law clips its command to."""
@@ -135,6 +255,9 @@ class WheelsConfig(ActuatorStageConfig):
     null_space_gain_1_s: NonNegative = Field(0.0, description="k_null [1/s]")
     bias_speed_rpm: Real = Field(0.0, description="Omega_bias, null-space target [rpm]")
     initial_speed_rpm: Real = Field(0.0, description="Omega_i at t = 0, hub at rest [rpm]")
+    microvibration: MicrovibrationConfig | None = Field(
+        None, description="imbalances and harmonic tables of the wheels (default: none)"
+    )
 
     @model_validator(mode="after")
     def _spanning(self) -> WheelsConfig:
@@ -143,6 +266,17 @@ class WheelsConfig(ActuatorStageConfig):
             raise ValueError(f"axes: at most {MAX_WHEELS} wheels, got {A.shape[1]}")
         if np.linalg.matrix_rank(A, tol=1e-6) < 3:
             raise ValueError("axes: the spin axes must span 3D (rank 3), they do not")
+        vib = self.microvibration
+        if vib is not None and vib.positions_m is not None and len(vib.positions_m) != A.shape[1]:
+            raise ValueError(
+                f"microvibration.positions_m: one position per wheel ({A.shape[1]}), "
+                f"got {len(vib.positions_m)}"
+            )
+        if vib is not None and vib.wheels is not None and max(vib.wheels) > A.shape[1]:
+            raise ValueError(
+                f"microvibration.wheels: wheel numbers from 1 to {A.shape[1]}, "
+                f"got {max(vib.wheels)}"
+            )
         return self
 
     def spin_axes(self) -> np.ndarray:
@@ -157,8 +291,13 @@ class WheelsConfig(ActuatorStageConfig):
 
     def integrated_size(self) -> int:
         """h, u and u_cmd of each wheel (u_cmd held: the motor's response reads it), the
-        motor work and the friction loss: 3 N + 2."""
-        return 3 * self.spin_axes().shape[0] + 2
+        motor work and the friction loss: 3 N + 2; with microvibration, each rotor's
+        angle too: 4 N + 2."""
+        n = self.spin_axes().shape[0]
+        return (4 if self._vibrating() else 3) * n + 2
+
+    def _vibrating(self) -> bool:
+        return self.microvibration is not None and bool(self.microvibration.terms())
 
     def check(self, scenario) -> None:
         if self.motor_time_constant_s < scenario.dt_s:
@@ -185,7 +324,26 @@ class WheelsConfig(ActuatorStageConfig):
                    self.spin_inertia_kg_m2 * head[10]]  # fmt: skip
         disturbances = scenario.disturbances.packed(self)  # gain 1: not read
         return np.concatenate([disturbances, head, A.ravel(), pinv.ravel(), null.ravel(),
-                               derived])  # fmt: skip
+                               derived, self._packed_vibration(axes)])  # fmt: skip
+
+    def _packed_vibration(self, axes: np.ndarray) -> np.ndarray:
+        """Empty without microvibration (the packed parameters end at ``_SIZE``); else
+        n_terms, then per wheel e1, e2, r and whether it vibrates (10 each, MAX_WHEELS
+        slots), then per term its
+        kind, h, C and one phase per wheel (3 + MAX_WHEELS each)."""
+        if not self._vibrating():
+            return np.zeros(0)
+        vib = self.microvibration
+        n = axes.shape[0]
+        e1, e2 = radial_basis(axes)
+        r = np.zeros((n, 3)) if vib.positions_m is None else np.array(vib.positions_m, float)
+        wheels = np.zeros((MAX_WHEELS, 10))
+        wheels[:n] = np.hstack([e1, e2, r, vib.vibrating(n)[:, None]])
+        terms = vib.terms()
+        rows = np.zeros((len(terms), 3 + MAX_WHEELS))
+        rows[:, :3] = terms
+        rows[:, 3 : 3 + n] = vib.phases(n)
+        return np.concatenate([[len(terms)], wheels.ravel(), rows.ravel()])
 
 
 @njit(cache=True, inline="always")
@@ -228,6 +386,44 @@ def _smooth_sign(z):
     return copysign((1.0 - e) / (1.0 + e), z)
 
 
+@njit(cache=True, inline="always")
+def _vibration(p, s, n, w0, w1, w2, state_dot):
+    """The microvibration torque on the hub, sum_i sum_k (r_i x F_ik + T_ik) [N m], hub
+    frame B; writes theta_i_dot = Omega_i (module docstring, 'Microvibration')."""
+    tx, ty, tz = 0.0, 0.0, 0.0
+    n_terms = int(p[_SIZE])
+    for i in range(n):
+        ax, ay, az = p[_A + i], p[_A + MAX_WHEELS + i], p[_A + 2 * MAX_WHEELS + i]
+        speed = (p[_H0] + s[i]) * p[_INV_IS] - (ax * w0 + ay * w1 + az * w2)
+        state_dot[3 * n + 2 + i] = speed
+        theta = s[3 * n + 2 + i]
+        w = _VIB_WHEELS + 10 * i
+        if p[w + 9] == 0.0:
+            continue  # a wheel without imbalance: only its angle is integrated
+        fx, fy, fz, mx, my, mz = 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
+        for k in range(n_terms):
+            t = _VIB_TERMS + _VIB_STRIDE * k
+            kind, amplitude = p[t], p[t + 2] * speed * speed
+            x = p[t + 1] * theta + p[t + 3 + i]
+            if kind == 1.0:  # axial force
+                a = amplitude * sin(x)
+                fx, fy, fz = fx + a * ax, fy + a * ay, fz + a * az
+                continue
+            c, d = amplitude * cos(x), amplitude * sin(x)
+            vx = c * p[w] + d * p[w + 3]
+            vy = c * p[w + 1] + d * p[w + 4]
+            vz = c * p[w + 2] + d * p[w + 5]
+            if kind == 0.0:  # radial force
+                fx, fy, fz = fx + vx, fy + vy, fz + vz
+            else:  # radial torque
+                mx, my, mz = mx + vx, my + vy, mz + vz
+        rx, ry, rz = p[w + 6], p[w + 7], p[w + 8]
+        tx += mx + ry * fz - rz * fy
+        ty += my + rz * fx - rx * fz
+        tz += mz + rx * fy - ry * fx
+    return tx, ty, tz
+
+
 @njit(cache=True, error_model="numpy")  # compiled with DERIVATIVE_SIGNATURE on first use
 def wheels_derivative(x, n_dof, t, omega, params, state, state_dot, wrench):
     """h_dot, u_dot, motor power, friction power; the wheels' wrench on the hub.
@@ -265,6 +461,9 @@ def wheels_derivative(x, n_dof, t, omega, params, state, state_dot, wrench):
         hz += az * h
     state_dot[3 * n] = work
     state_dot[3 * n + 1] = loss
+    if p.size > _SIZE:  # microvibration: packed only when configured
+        vx, vy, vz = _vibration(p, s, n, w0, w1, w2, state_dot)
+        tx, ty, tz = tx + vx, ty + vy, tz + vz
     # - omega x sum a_i h_i
     wrench[0] = tx - (w1 * hz - w2 * hy)
     wrench[1] = ty - (w2 * hx - w0 * hz)
@@ -315,7 +514,7 @@ def wheels_step(tau_cmd, t, dt, params, state, tau_applied, record):
 
 WHEELS = StageSpec(
     role="actuator", name="wheels", config=WheelsConfig, step=wheels_step,
-    derivative=wheels_derivative, state_size=3 * MAX_WHEELS + 2,
+    derivative=wheels_derivative, state_size=4 * MAX_WHEELS + 2,
     records=(
         Channel("wheel_momentum_B", "N m s", "sum a_i h_i, hub frame B", per_axis=True),
         Channel("wheel_kinetic_energy", "J", "sum h_i^2 / (2 I_s)"),
