@@ -29,6 +29,7 @@ LAYERS: tuple[tuple[str, tuple[str, ...]], ...] = (
     ("study", ("flexsat.study",)),
     ("figures", ("flexsat.plots",)),
     ("campaigns", ("flexsat.campaigns",)),
+    ("real time", ("flexsat.realtime",)),
     ("simulation", ("flexsat.simulate",)),
     ("linear analysis", ("flexsat.linear",)),
     ("control", ("flexsat.control",)),

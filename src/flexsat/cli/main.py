@@ -765,6 +765,114 @@ def study(
         raise typer.Exit(1)
 
 
+SensorEndpointOption = Annotated[
+    str,
+    typer.Option(help="Where the plant sends sensor packets: udp://HOST:PORT, or ZeroMQ "
+                 "tcp://HOST:PORT or ipc://PATH (extra 'realtime')."),
+]  # fmt: skip
+CommandEndpointOption = Annotated[
+    str, typer.Option(help="Where the plant listens for commands (same schemes).")
+]
+
+
+@app.command()
+def serve(
+    scenario: Annotated[Path, typer.Argument(help="Slew scenario (TOML): plant, stages, timing.")],
+    config: ConfigOption = None,
+    speed: Annotated[
+        float, typer.Option(help="Simulated seconds per wall second, in (0, 1000].")
+    ] = 1.0,
+    lockstep: Annotated[
+        bool, typer.Option(help="Wait for each command instead of holding a late one.")
+    ] = False,
+    sensor_endpoint: SensorEndpointOption = "udp://127.0.0.1:47101",
+    command_endpoint: CommandEndpointOption = "udp://127.0.0.1:47102",
+    client_timeout: Annotated[
+        float, typer.Option(help="A client silent this long ends the run [s], in (0, 3600].")
+    ] = 1.0,
+    start_timeout: Annotated[
+        float, typer.Option(help="Longest wait for the client's HELLO [s], in (0, 3600].")
+    ] = 60.0,
+    json_output: JsonOption = False,
+    out: RunOutOption = None,
+) -> None:
+    """Serve the plant in real time: sensor packets out, torque commands in (docs/realtime.md).
+
+    The slew's plant and sensing and actuation chains run paced to the wall clock;
+    a client (flexsat fsw, or your flight software) answers each sensor packet with
+    a body torque, applied at the next control instant. Prints R1-R3, deadline
+    overruns, pacing jitter and latency.
+    """
+    from flexsat.analysis.requirements import slew_metrics
+    from flexsat.config import load_config
+    from flexsat.dynamics.plant import Plant
+    from flexsat.realtime.server import serve as serve_plant
+    from flexsat.realtime.transport import plant_link
+    from flexsat.simulate import load_slew
+    from flexsat.study.outputs import prepare_output_dir, write_slew_outputs
+
+    cfg = load_config(config)
+    chosen = load_slew(scenario)
+    link = plant_link(sensor_endpoint, command_endpoint)
+    if out is not None:
+        prepare_output_dir(out)
+    _announce_compilation()
+    try:
+        result, stats = serve_plant(
+            Plant.from_config(cfg), chosen, link, speed=speed, lockstep=lockstep,
+            client_timeout_s=client_timeout, start_timeout_s=start_timeout,
+            log=lambda line: _errors.print(line, markup=False, highlight=False),
+        )  # fmt: skip
+    finally:
+        link.close()
+    metrics = {**slew_metrics(result.dataset), "realtime": stats.summary()}
+    if out is not None:
+        write_slew_outputs(result, metrics, out)
+    if json_output:
+        typer.echo(dumps(metrics))
+        return
+    _print_metrics({k: v for k, v in metrics.items() if k != "realtime"}, "Served slew")
+    print_table(_console, f"Real-time run (speed {speed:g}{', lock-step' if lockstep else ''})",
+                ("metric", "value"), list(stats.summary().items()))  # fmt: skip
+
+
+@app.command()
+def fsw(
+    scenario: Annotated[
+        Path, typer.Argument(help="The slew scenario the plant serves: its law and gains.")
+    ],
+    config: ConfigOption = None,
+    sensor_endpoint: SensorEndpointOption = "udp://127.0.0.1:47101",
+    command_endpoint: CommandEndpointOption = "udp://127.0.0.1:47102",
+    connect_timeout: Annotated[
+        float, typer.Option(help="Longest wait for the plant [s], in (0, 3600].")
+    ] = 60.0,
+    silence: Annotated[
+        float, typer.Option(help="A plant silent this long is gone [s], in (0, 3600].")
+    ] = 5.0,
+    json_output: JsonOption = False,
+) -> None:
+    """Reference flight software: the scenario's law answering a served plant (flexsat serve)."""
+    from flexsat.config import load_config
+    from flexsat.dynamics.plant import Plant
+    from flexsat.realtime.fsw import fly_remote
+    from flexsat.realtime.transport import client_link
+    from flexsat.simulate import load_slew
+
+    cfg = load_config(config)
+    chosen = load_slew(scenario)
+    link = client_link(sensor_endpoint, command_endpoint)
+    try:
+        summary = fly_remote(Plant.from_config(cfg), chosen, link,
+                             connect_timeout_s=connect_timeout, silence_s=silence)  # fmt: skip
+    finally:
+        link.close()
+    if json_output:
+        typer.echo(dumps(summary))
+    else:
+        _print_metrics(summary, "Flight software")
+
+
 def _options(given: dict) -> str:
     """The options the user gave, to name them in a validation message."""
     return ", ".join(option for option, value in given.items() if value is not None)

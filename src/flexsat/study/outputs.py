@@ -30,6 +30,7 @@ __all__ = [
     "prepare_output_dir",
     "write_json",
     "write_modal",
+    "write_slew_outputs",
 ]
 
 
@@ -219,7 +220,8 @@ def fly_slew(plant: Plant, scenario=None, out: Path | None = None, progress=None
     scenario : SlewScenario, optional
         Default: the thesis's 45/45/45 deg ASMC slew.
     out : Path, optional
-        Where the files go (records that do not fit in memory stream there).
+        Where the files go (records that do not fit in memory, and those of a run
+        along an orbit, stream there as the run goes).
     progress : bool or None
         Progress bar: None shows it on a terminal only.
     figures : bool
@@ -243,10 +245,16 @@ def fly_slew(plant: Plant, scenario=None, out: Path | None = None, progress=None
         return write_slew_figures(result.dataset, Path(out)) if figures else []
 
     scenario = scenario or SlewScenario()
-    check_run_size(plant.n_dof, scenario)
+    estimate = check_run_size(plant.n_dof, scenario, can_stream=True)
+    fits, record_path = estimate.fits_in_memory, None
     if out is not None:
         prepare_output_dir(out)
-    result = run_slew(plant, scenario, progress=progress)
+        # streamed into place: records that do not fit, and a run along an orbit (long
+        # by nature: docs/orbit.md, 'Long runs')
+        if not fits or scenario.orbit is not None:
+            record_path = Path(out) / "result.nc"
+    result = run_slew(plant, scenario, progress=progress, record_path=record_path,
+                      record_budget_bytes=None if fits else estimate.available_bytes)  # fmt: skip
     metrics = slew_metrics(result.dataset)  # the stored scenario's requirements
     J = result.dataset.attrs["design_inertia"]
     metrics["design_inertia_kg_m2"] = [list(J[3 * i : 3 * i + 3]) for i in range(3)]
@@ -266,6 +274,31 @@ def _write_run(result, metrics: dict, out: Path, figures: Callable[[], list[Path
         files += figures()
         metrics["files"] = [str(p) for p in [*files, out / "metrics.json"]]
         write_json(out / "metrics.json", metrics)
+
+
+def write_slew_outputs(result, metrics: dict, out: Path, figures: bool = True) -> None:
+    """A flown slew's files in ``out``, as :func:`fly_slew` writes them: result.nc,
+    metrics.json and (a finished run, ``figures``) the slew's figure set; the written
+    paths are added to ``metrics["files"]``.
+
+    Parameters
+    ----------
+    result : Result
+        The slew (a served one too: :func:`flexsat.realtime.server.serve`).
+    metrics : dict
+        Its metrics, written as metrics.json.
+    out : Path
+        The folder (created; :func:`prepare_output_dir` first to fail early).
+    figures : bool
+        Draw the figure set.
+    """
+
+    def draw() -> list[Path]:
+        from flexsat.plots.slew import write_slew_figures
+
+        return write_slew_figures(result.dataset, Path(out)) if figures else []
+
+    _write_run(result, metrics, Path(out), draw)
 
 
 def fly_campaign(definition, config, store: Path, *, progress: bool = True, **backend) -> dict:
