@@ -514,7 +514,8 @@ def speed_sweep(
         amplitude[s] = np.interp(line_hz[s], freqs, np.linalg.norm(Y, axis=1))
     rms = np.array(rms)
     total = np.sqrt(np.sum(rms**2, axis=1))
-    peaks = find_peaks(np.concatenate([[0.0], total, [0.0]]))[0] - 1
+    # an end of the range is a maximum when the total rises towards it
+    peaks = find_peaks(np.concatenate([total[1:2], total, total[-2:-1]]))[0] - 1
     worst_rpm, worst_rms = grid[peaks], total[peaks]
     for j, k in enumerate(peaks):  # refined between the neighbouring grid points
         if 0 < k < grid.size - 1:
