@@ -57,7 +57,12 @@ _MAX_NUMBERS = _MAX_OUTPUT_POINTS * _MAX_MODES * 3
 _DEFLATE_MAX_RATIO = 1032
 _NPZ_KEYS = ("format_version", "mass_kg", "center_of_mass_m", "inertia_interface_kg_m2",
              "frequencies_hz", "damping_ratios", "participation", "inertia_derivatives",
-             "output_names", "output_positions_m", "output_mode_shapes")  # fmt: skip
+             "output_names", "output_positions_m", "output_mode_shapes", "damping_matrix",
+             "first_moment_hessian", "coupling_gradient", "inertia_hessian")  # fmt: skip
+# The second-order (large-motion) invariants hold n^2 entries per mode pair: they are
+# accepted up to this many modes (9 n^2 = 810 000 numbers for the inertia's).
+_MAX_SECOND_ORDER_MODES = 300
+_SECOND_ORDER = ("first_moment_hessian", "coupling_gradient", "inertia_hessian")
 # Relative slack of the positive-semidefiniteness tests (round-off of the file's own
 # digits: a reduction written with 16 significant digits is exact to ~1e-15).
 _PSD_RTOL = 1e-9
@@ -112,6 +117,26 @@ class ModalData(_Frozen):
     output_points: Annotated[list[OutputPoint], Field(max_length=_MAX_OUTPUT_POINTS)] = Field(
         default_factory=list, description="points whose motion is reported (e.g. the tip)"
     )
+    damping_matrix: list[list[Real]] = Field(
+        default_factory=list,
+        description="optional: the full modal damping matrix phi^T C phi (n x n, symmetric, "
+        "positive semi-definite, its diagonal 2 zeta_k omega_k) [1/s]; none: diagonal",
+    )
+    first_moment_hessian: list[list[Vector3]] = Field(
+        default_factory=list,
+        description="optional, large motion: C_kl = d^2 c~/d eta_k d eta_l (n x n x 3, "
+        "symmetric in k, l), about the interface, frame M [1/m]",
+    )
+    coupling_gradient: list[list[Vector3]] = Field(
+        default_factory=list,
+        description="optional, large motion: E_kl = d h_k/d eta_l, the rotational coupling "
+        "of mode k, sum_p m_p x_p x dx_p/d eta_k, along mode l (n x n x 3), frame M [-]",
+    )
+    inertia_hessian: list[list[Matrix3]] = Field(
+        default_factory=list,
+        description="optional, large motion: J''_kl = d^2 J_I/d eta_k d eta_l (n x n x 3 x "
+        "3, symmetric in k, l and as matrices), about the interface, frame M [-]",
+    )
 
     @model_validator(mode="after")
     def _consistent(self) -> ModalData:
@@ -147,6 +172,8 @@ class ModalData(_Frozen):
         zeta = np.asarray(self.damping_ratios, dtype=float)
         if n and (zeta.min() < 0.0 or zeta.max() >= 1.0):
             raise ValueError("damping_ratios: each must be in [0, 1)")
+        self._check_damping_matrix(f, zeta)
+        self._check_second_order()
         J = np.asarray(self.inertia_interface_kg_m2, dtype=float)
         if np.max(np.abs(J - J.T)) > _PSD_RTOL * np.max(np.abs(J)):
             raise ValueError("inertia_interface_kg_m2: must be symmetric (J == J^T)")
@@ -178,6 +205,94 @@ class ModalData(_Frozen):
                 "(mass-normalized modes)"
             )
         return self
+
+    def _check_damping_matrix(self, f: np.ndarray, zeta: np.ndarray) -> None:
+        if not self.damping_matrix:
+            return
+        n = self.n_modes
+        rows = [len(r) for r in self.damping_matrix]
+        if len(rows) != n or any(r != n for r in rows):
+            raise ValueError(f"damping_matrix: expected {n} x {n} (one row and column per "
+                             f"mode), got {len(rows)} rows of lengths "
+                             f"{sorted(set(rows))}")  # fmt: skip
+        D = np.asarray(self.damping_matrix, dtype=float)
+        top = max(np.abs(D).max(initial=0.0), 1e-300)
+        if np.abs(D - D.T).max() > _PSD_RTOL * top:
+            raise ValueError("damping_matrix: must be symmetric")
+        if np.linalg.eigvalsh(D)[0] < -_PSD_RTOL * top:
+            raise ValueError("damping_matrix: must be positive semi-definite (no mode "
+                             "combination may gain energy from the dampers)")  # fmt: skip
+        diagonal = 4.0 * np.pi * zeta * f
+        worst = np.abs(np.diag(D) - diagonal).max()
+        if worst > _PSD_RTOL * max(top, np.abs(diagonal).max()):
+            raise ValueError("damping_matrix: its diagonal must be 2 zeta_k omega_k of "
+                             "damping_ratios and frequencies_hz (off by "
+                             f"{worst:.3g} 1/s)")  # fmt: skip
+
+    def _check_second_order(self) -> None:
+        given = [name for name in _SECOND_ORDER if getattr(self, name)]
+        if not given:
+            return
+        n = self.n_modes
+        if len(given) != len(_SECOND_ORDER):
+            missing = [name for name in _SECOND_ORDER if name not in given]
+            raise ValueError(f"{missing[0]}: the large-motion invariants come together "
+                             f"({', '.join(_SECOND_ORDER)}); {', '.join(given)} given "
+                             "without it")  # fmt: skip
+        if n > _MAX_SECOND_ORDER_MODES:
+            raise ValueError(f"{given[0]}: the large-motion invariants are accepted up to "
+                             f"{_MAX_SECOND_ORDER_MODES} modes, the data has {n}")  # fmt: skip
+        for name in _SECOND_ORDER:
+            rows = [len(r) for r in getattr(self, name)]
+            if len(rows) != n or any(r != n for r in rows):
+                raise ValueError(f"{name}: expected {n} x {n} entries (one per pair of "
+                                 f"modes), got {len(rows)} rows of lengths "
+                                 f"{sorted(set(rows))}")  # fmt: skip
+        C, H = self.first_moment_hessian_array(), self.inertia_hessian_array()
+        for name, x, swapped in (
+            ("first_moment_hessian", C, C.transpose(1, 0, 2)),
+            ("inertia_hessian", H, H.transpose(1, 0, 2, 3)),
+            ("inertia_hessian", H, H.transpose(0, 1, 3, 2)),
+        ):
+            if np.abs(x - swapped).max() > _PSD_RTOL * max(np.abs(x).max(), 1e-300):
+                raise ValueError(f"{name}: must be symmetric (in the mode pair k, l; the "
+                                 "inertia's 3 x 3 matrices too)")  # fmt: skip
+
+    @property
+    def second_order(self) -> bool:
+        """True when the data carries the large-motion invariants."""
+        return bool(self.first_moment_hessian)
+
+    def first_moment_hessian_array(self) -> np.ndarray:
+        """C_kl, shape (n, n, 3) [1/m] (zeros when the data gives none)."""
+        if not self.first_moment_hessian:
+            return np.zeros((self.n_modes, self.n_modes, 3))
+        return np.asarray(self.first_moment_hessian, dtype=float).reshape(
+            self.n_modes, self.n_modes, 3
+        )
+
+    def coupling_gradient_array(self) -> np.ndarray:
+        """E_kl, shape (n, n, 3) [-] (zeros when the data gives none)."""
+        if not self.coupling_gradient:
+            return np.zeros((self.n_modes, self.n_modes, 3))
+        return np.asarray(self.coupling_gradient, dtype=float).reshape(
+            self.n_modes, self.n_modes, 3
+        )
+
+    def inertia_hessian_array(self) -> np.ndarray:
+        """J''_kl, shape (n, n, 3, 3) [-] (zeros when the data gives none)."""
+        if not self.inertia_hessian:
+            return np.zeros((self.n_modes, self.n_modes, 3, 3))
+        return np.asarray(self.inertia_hessian, dtype=float).reshape(
+            self.n_modes, self.n_modes, 3, 3
+        )
+
+    def damping_matrix_array(self) -> np.ndarray:
+        """The modal damping matrix, shape (n, n) [1/s]: the file's, else diagonal."""
+        if self.damping_matrix:
+            return np.asarray(self.damping_matrix, dtype=float).reshape(self.n_modes, self.n_modes)
+        omega = 2.0 * np.pi * np.asarray(self.frequencies_hz, dtype=float)
+        return np.diag(2.0 * np.asarray(self.damping_ratios, dtype=float) * omega)
 
     @property
     def n_modes(self) -> int:
@@ -228,6 +343,11 @@ class ModalData(_Frozen):
                                            dtype=float).reshape(-1, 3),
             "output_mode_shapes": np.array([p.mode_shapes for p in self.output_points],
                                            dtype=float).reshape(-1, n, 3),
+            "damping_matrix": np.array(self.damping_matrix, dtype=float).reshape(
+                (n, n) if self.damping_matrix else (0,)),
+            **{name: np.array(getattr(self, name), dtype=float).reshape(
+                (n, n, *(3, 3)[: 2 if name == "inertia_hessian" else 1])
+                if self.second_order else (0,)) for name in _SECOND_ORDER},
         }  # fmt: skip
 
 

@@ -12,6 +12,7 @@ Z takes X into -Y).
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -19,7 +20,7 @@ import scipy.sparse as sp
 
 from flexsat.errors import ConfigError
 
-__all__ = ["BeamModel", "euler_bernoulli_hub_frequencies", "uniform_beam"]
+__all__ = ["BeamModel", "beam_invariants", "euler_bernoulli_hub_frequencies", "uniform_beam"]
 
 
 @dataclass(frozen=True)
@@ -39,6 +40,10 @@ class BeamModel:
         The tip's translation DOFs x, y, z (indices) [-].
     tip_position_m : tuple of float
         The tip's place from the interface, frame M [m].
+    large_motion : callable or None
+        ``large_motion(phi)``: the large-motion invariants of modes ``phi`` (n, k)
+        (:func:`beam_invariants`), the ``large_motion`` argument of
+        :func:`flexsat.fe.craig_bampton`.
     """
 
     M: sp.csr_matrix
@@ -47,6 +52,7 @@ class BeamModel:
     interface_map: np.ndarray
     tip_dofs: np.ndarray
     tip_position_m: tuple[float, float, float]
+    large_motion: Callable[[np.ndarray], dict] | None = None
 
 
 def uniform_beam(length_m: float, n_elements: int, *, mass_per_length_kg_m: float,
@@ -135,7 +141,105 @@ def uniform_beam(length_m: float, n_elements: int, *, mass_per_length_kg_m: floa
     T[5, 5] = -1.0
     tip_dofs = np.array([offsets[2] + value[tip], offsets[0] + lagrange.nodal_dofs[0][tip],
                          offsets[3] + value[tip]])  # fmt: skip
-    return BeamModel(M, K, dofs, T, tip_dofs, (0.0, float(length_m), 0.0))
+    fields = {"x": (offsets[2], n_h), "y": (offsets[0], n_l), "z": (offsets[3], n_h)}
+
+    def large_motion(phi: np.ndarray) -> dict:
+        return beam_invariants(mesh, fields, phi, length_m, mass_per_length_kg_m)
+
+    return BeamModel(M, K, dofs, T, tip_dofs, (0.0, float(length_m), 0.0), large_motion)
+
+
+def beam_invariants(mesh, fields: dict, phi: np.ndarray, length_m: float,
+                    mass_per_length_kg_m: float) -> dict:  # fmt: skip
+    """The large-motion invariants of a straight beam along Y_M's modes (frame M).
+
+    With Phi_k(s) = (w_x, u_y, w_z) the translation field of mode k along the span s
+    and the foreshortening of bending u_2,kl(s) = -int_0^s (w_k' . w_l') ds' (the
+    second-order displacement, along Y), sums over the beam's mass rho A ds:
+
+    - J'_k = sum m (2 x0.Phi_k I - x0 Phi_k^T - Phi_k x0^T), x0 = s e_y;
+    - C_kl = sum m u_2,kl e_y = -rho A int (L - s) w_k'.w_l' ds e_y: the geometric
+      stiffness of the tension a unit axial acceleration puts in the beam;
+    - E_kl = sum m Phi_l x Phi_k (x0 x e_y u_2 = 0 on the axis);
+    - J''_kl = 2 sum m (Phi_k.Phi_l I - sym(Phi_k Phi_l^T)) (the modes' second-order
+      inertia) - rho A int (L^2 - s^2) w_k'.w_l' ds diag(1, 0, 1) (the geometric
+      stiffness of the centrifugal tension).
+
+    Exact Gauss quadrature (order 6) of the cubic and linear shape functions. The
+    twist's polar inertia is left out of the second-order terms (its first-order
+    coupling is in the participation factors).
+
+    Parameters
+    ----------
+    mesh : skfem.MeshLine
+        The beam's mesh, s in [0, L] [m].
+    fields : dict
+        ``"x"``, ``"y"``, ``"z"`` -> (offset, size) of w_x, u_y, w_z in the DOFs [-].
+    phi : ndarray, shape (n, k)
+        The modes over every DOF, mass-normalized [1/sqrt(kg) by DOF unit].
+    length_m : float
+        L [m].
+    mass_per_length_kg_m : float
+        rho A [kg/m].
+
+    Returns
+    -------
+    dict
+        ``inertia_derivatives`` (k, 3, 3) [sqrt(kg) m], ``first_moment_hessian``
+        (k, k, 3) [1/m], ``coupling_gradient`` (k, k, 3) [-], ``inertia_hessian``
+        (k, k, 3, 3) [-], frame M: the fields of :class:`flexsat.config.ModalData`.
+    """
+    from skfem import Basis, BilinearForm, ElementLineHermite, ElementLineP1, LinearForm
+    from skfem.helpers import grad
+
+    bases = {"x": Basis(mesh, ElementLineHermite(), intorder=6),
+             "y": Basis(mesh, ElementLineP1(), intorder=6)}  # fmt: skip
+    bases["z"] = bases["x"]
+    rho_a, L = mass_per_length_kg_m, length_m
+
+    @BilinearForm
+    def mass(u, v, w):
+        return rho_a * u * v
+
+    @BilinearForm
+    def tension_axial(u, v, w):  # the tension of a unit axial load, per rho A
+        return (L - w.x[0]) * grad(u)[0] * grad(v)[0]
+
+    @BilinearForm
+    def tension_spin(u, v, w):  # twice the tension of a unit spin, per rho A
+        return (L**2 - w.x[0] ** 2) * grad(u)[0] * grad(v)[0]
+
+    @LinearForm
+    def moment(v, w):
+        return rho_a * w.x[0] * v
+
+    k = phi.shape[1]
+    shapes = {a: phi[o : o + size] for a, (o, size) in fields.items()}
+    axes = "xyz"
+    S = np.zeros((k, k, 3, 3))  # S[k, l, a, b] = sum m Phi_k,a Phi_l,b
+    for i, a in enumerate(axes):
+        for j, b in enumerate(axes):
+            S[:, :, i, j] = shapes[a].T @ (mass.assemble(bases[b], bases[a]) @ shapes[b])
+    first = np.stack([moment.assemble(bases[a]) @ shapes[a] for a in axes], axis=1)  # (k, 3)
+    J1 = np.zeros((k, 3, 3))
+    J1 += 2.0 * first[:, 1, None, None] * np.eye(3)
+    J1[:, 1, :] -= first
+    J1[:, :, 1] -= first
+    bend_axial = sum(shapes[a].T @ tension_axial.assemble(bases[a]) @ shapes[a] for a in "xz")
+    bend_spin = sum(shapes[a].T @ tension_spin.assemble(bases[a]) @ shapes[a] for a in "xz")
+    C = np.zeros((k, k, 3))
+    C[:, :, 1] = -rho_a * bend_axial
+    levi = np.zeros((3, 3, 3))
+    levi[0, 1, 2] = levi[1, 2, 0] = levi[2, 0, 1] = 1.0
+    levi[0, 2, 1] = levi[2, 1, 0] = levi[1, 0, 2] = -1.0
+    E = np.einsum("cab,lkab->klc", levi, S)  # E_kl = sum m Phi_l x Phi_k
+    sym = 0.5 * (S + S.transpose(0, 1, 3, 2))
+    trace = np.einsum("klaa->kl", S)
+    J2 = 2.0 * (trace[:, :, None, None] * np.eye(3) - sym)
+    J2 -= rho_a * bend_spin[:, :, None, None] * np.diag([1.0, 0.0, 1.0])
+    J2 = 0.5 * (J2 + J2.transpose(1, 0, 2, 3))
+    return {"inertia_derivatives": J1.tolist(), "first_moment_hessian": C.tolist(),
+            "coupling_gradient": E.tolist(), "inertia_hessian": J2.tolist()}  # fmt: skip
 
 
 def euler_bernoulli_hub_frequencies(hub_inertia_kg_m2: float, root_radius_m: float,

@@ -18,7 +18,7 @@ node (the static response to a rigid interface motion is that rigid motion), so
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 
 import numpy as np
 import scipy.sparse as sp
@@ -42,6 +42,7 @@ def craig_bampton(
     interface_map: np.ndarray | None = None, rigid_modes: np.ndarray | None = None,
     damping_ratio: float | Sequence[float] = 0.0,
     outputs: Mapping[str, tuple[Sequence[int], Sequence[float]]] | None = None,
+    large_motion: Callable[[np.ndarray], dict] | None = None,
 ) -> ModalData:  # fmt: skip
     """Reduce FE matrices clamped at an interface to the modal data format.
 
@@ -69,6 +70,12 @@ def craig_bampton(
     outputs : mapping, optional
         name -> (three DOF indices of the point's translation x, y, z in frame M, its
         undeformed position from the interface in frame M [m]).
+    large_motion : callable, optional
+        ``large_motion(phi)`` -> the large-motion invariants of the clamped modes
+        ``phi`` (n, n_modes), zero on the interface DOFs, as modal data fields
+        (``inertia_derivatives``, ``first_moment_hessian``, ``coupling_gradient``,
+        ``inertia_hessian``; e.g. :attr:`flexsat.fe.BeamModel.large_motion`). Default:
+        none, the first-order model.
 
     Returns
     -------
@@ -135,7 +142,13 @@ def craig_bampton(
             rows[:, a] = phi[where[0]] if where.size else 0.0  # an interface DOF does not move
         points.append({"name": name, "position_m": list(map(float, position)),
                        "mode_shapes": rows.tolist()})  # fmt: skip
+    extra = {}
+    if large_motion is not None:
+        full = np.zeros((n, n_modes))
+        full[i] = phi
+        extra = large_motion(full)
     return modal_data_from_dict({
+        **extra,
         "format_version": FORMAT_VERSION,
         "mass_kg": mass,
         "center_of_mass_m": com.tolist(),

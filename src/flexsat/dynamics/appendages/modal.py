@@ -65,6 +65,8 @@ from flexsat.compiled.linalg3 import (
     rot_zyx,
     scale,
     skew,
+    sub,
+    transpose,
 )
 from flexsat.compiled.status import STATUS_OK
 from flexsat.config.modal_data import ModalData, load_modal_data
@@ -100,7 +102,9 @@ P_FIRST = 13  # (3) m c, first moment about the interface [kg m]
 P_J_I = 16  # (9) J_I, inertia about the interface point [kg m^2]
 P_RES = 25  # (36) M_rr - L^T L at eta = 0, about the interface, row-major 6 x 6
 P_N = 61  # (1) number of modes n
-P_MODES = 62  # n blocks of MODE_SIZE
+P_DAMP_AT = 62  # (1) offset of the n x n modal damping matrix [1/s]; 0: diagonal (MODE_C)
+P_SECOND_AT = 63  # (1) offset of the n x n blocks of SO_SIZE (large motion); 0: none
+P_MODES = 64  # n blocks of MODE_SIZE
 MODE_K = 0  # omega_k^2 [1/s^2]
 MODE_C = 1  # 2 zeta_k omega_k [1/s]
 MODE_LT = 2  # (3) l_t,k [sqrt(kg)]
@@ -108,6 +112,13 @@ MODE_LR = 5  # (3) l_r,k [sqrt(kg) m]
 MODE_TIP = 8  # (3) tip mode-shape row, frame M [m / (sqrt(kg) m)]
 MODE_DJ = 11  # (9) J'_k = dJ_I / d eta_k, B, row-major [sqrt(kg) m]
 MODE_SIZE = 20
+# The large-motion invariants of mode pair (k, l), block (k n + l) of SO_SIZE, frame B.
+SO_C = 0  # (3) C_kl = d^2 c~ / d eta_k d eta_l [1/m]
+SO_E = 3  # (3) E_kl = d h_k / d eta_l [-]
+SO_ET = 6  # (3) E_lk [-]
+SO_J = 9  # (9) J''_kl = d^2 J_I / d eta_k d eta_l [-]
+SO_SIZE = 18
+WORK_MODE = 7  # per mode in pass 1's scratch: L_t,k(eta) (3), h_k(eta) (3), its force (1)
 
 Scale = Annotated[float, Strict(), AllowInfNan(False), Field(gt=0.0, le=1e3)]
 
@@ -166,11 +177,14 @@ class ModalAppendageConfig(BaseModel):
         if unscaled == (1.0, 1.0, 1.0):
             return d
         p = self.participation_scale
+        # A full damping matrix (2 zeta omega off the diagonal too) follows both factors.
+        c = self.damping_scale * self.frequency_scale
         return ModalData.model_validate({
             **d.model_dump(),
             "frequencies_hz": [f * self.frequency_scale for f in d.frequencies_hz],
             "damping_ratios": [z * self.damping_scale for z in d.damping_ratios],
             "participation": [[p * x for x in row] for row in d.participation],
+            "damping_matrix": [[c * x for x in row] for row in d.damping_matrix],
         })  # fmt: skip
 
     def mount_rotation(self) -> np.ndarray:
@@ -208,6 +222,12 @@ def _madd(a, b, s):
 
 
 @njit(cache=True, error_model="numpy")
+def _outer(a, b):
+    """a b^T for 3-vectors."""
+    return (scale(a[0], b), scale(a[1], b), scale(a[2], b))
+
+
+@njit(cache=True, error_model="numpy")
 def _add_inertia(hub, r0, c0, A):
     for a in range(3):
         for b in range(3):
@@ -232,6 +252,99 @@ def _centrifugal(p, k, omega):
 
 
 @njit(cache=True, error_model="numpy")
+def _mode_rows(q, qd, o, p, k):
+    """Mode k's rows at eta (large motion): L_t,k(eta) = l_t,k + sum_l C_kl eta_l,
+    h_k(eta) = l_r,k + sum_l E_kl eta_l, J_k(eta) = J'_k + sum_l J''_kl eta_l, and
+    sum_l C_kl eta_dot_l, sum_l E_kl eta_dot_l, sum_l E_lk eta_dot_l (B)."""
+    n = int(p[P_N])
+    b = P_MODES + MODE_SIZE * k
+    l_t, h, J_k = load_seg(p, b + MODE_LT), load_seg(p, b + MODE_LR), load_m33_at(p, b + MODE_DJ)
+    c_d, e_d, et_d = (0.0, 0.0, 0.0), (0.0, 0.0, 0.0), (0.0, 0.0, 0.0)
+    base = int(p[P_SECOND_AT]) + SO_SIZE * n * k
+    for m in range(n):
+        c = base + SO_SIZE * m
+        e, e_dot = q[o + m], qd[o + m]
+        C, E = load_seg(p, c + SO_C), load_seg(p, c + SO_E)
+        l_t = add(l_t, scale(e, C))
+        h = add(h, scale(e, E))
+        c_d = add(c_d, scale(e_dot, C))
+        e_d = add(e_d, scale(e_dot, E))
+        et_d = add(et_d, scale(e_dot, load_seg(p, c + SO_ET)))
+        J_k = _madd(J_k, load_m33_at(p, c + SO_J), e)
+    return l_t, h, J_k, c_d, e_d, et_d
+
+
+@njit(cache=True, error_model="numpy")
+def _second_sums(q, qd, o, p, omega, work, j, store):
+    """The sums of the large-motion model (docs/model.md, eqs. M.8-M.10), B:
+    s = c~ - m c = sum_k eta_k (l_t,k + L_t,k(eta)) / 2, s_dot = sum_k eta_dot_k
+    L_t,k(eta), h_r = sum_k eta_dot_k h_k(eta), J(eta) = J_I + sum_k eta_k (J'_k +
+    J_k(eta)) / 2, J_dot = sum_k eta_dot_k J_k(eta), and the velocity-quadratic terms
+    eta_dot^T C eta_dot and eta_dot^T E eta_dot. With ``store``, row ``j`` of ``work``
+    keeps each mode's L_t,k(eta), h_k(eta) and its inertia force
+    1/2 omega^T J_k(eta) omega - sum_l (E_kl - E_lk) . omega eta_dot_l."""
+    z = (0.0, 0.0, 0.0)
+    s, s_dot, h_r, quad_t, quad_r = z, z, z, z, z
+    J, J_dot = load_m33_at(p, P_J_I), (z, z, z)
+    for k in range(int(p[P_N])):
+        b = P_MODES + MODE_SIZE * k
+        l_t, h, J_k, c_d, e_d, et_d = _mode_rows(q, qd, o, p, k)
+        e, e_dot = q[o + k], qd[o + k]
+        s = add(s, scale(0.5 * e, add(load_seg(p, b + MODE_LT), l_t)))
+        J = _madd(_madd(J, load_m33_at(p, b + MODE_DJ), 0.5 * e), J_k, 0.5 * e)
+        s_dot = add(s_dot, scale(e_dot, l_t))
+        h_r = add(h_r, scale(e_dot, h))
+        J_dot = _madd(J_dot, J_k, e_dot)
+        quad_t = add(quad_t, scale(e_dot, c_d))
+        quad_r = add(quad_r, scale(e_dot, e_d))
+        if store:
+            w = WORK_MODE * k
+            for a in range(3):
+                work[j, w + a] = l_t[a]
+                work[j, w + 3 + a] = h[a]
+            work[j, w + 6] = 0.5 * dot(omega, mv(J_k, omega)) - dot(sub(e_d, et_d), omega)
+    return s, s_dot, h_r, J, J_dot, quad_t, quad_r
+
+
+@njit(cache=True, error_model="numpy")
+def _sums(q, qd, o, p, omega, work, j, store):
+    """s, s_dot, h_r, J(eta), J_dot and the velocity-quadratic terms (zero for the
+    first-order model, whose sums are :func:`_modal_sums` and :func:`_inertia`)."""
+    if p[P_SECOND_AT] > 0.0:
+        return _second_sums(q, qd, o, p, omega, work, j, store)
+    s, s_dot, h_r = _modal_sums(q, qd, o, p)
+    J, J_dot = _inertia(q, qd, o, p)
+    z = (0.0, 0.0, 0.0)
+    return s, s_dot, h_r, J, J_dot, z, z
+
+
+@njit(cache=True, error_model="numpy")
+def _mode(q, qd, o, p, k, omega):
+    """Mode k's L_t,k(eta), h_k(eta) and its inertia force beyond -L_t,k . a_I -
+    h_k . alpha: 1/2 omega^T J'_k omega (first order), with the large-motion terms
+    1/2 omega^T J_k(eta) omega - sum_l (E_kl - E_lk) . omega eta_dot_l."""
+    b = P_MODES + MODE_SIZE * k
+    if p[P_SECOND_AT] > 0.0:
+        l_t, h, J_k, _, e_d, et_d = _mode_rows(q, qd, o, p, k)
+        return l_t, h, 0.5 * dot(omega, mv(J_k, omega)) - dot(sub(e_d, et_d), omega)
+    return load_seg(p, b + MODE_LT), load_seg(p, b + MODE_LR), _centrifugal(p, k, omega)
+
+
+@njit(cache=True, error_model="numpy")
+def _damping(qd, o, p, k):
+    """Mode k's damping force: 2 zeta_k omega_k eta_dot_k, or row k of the full modal
+    damping matrix times eta_dot."""
+    at = int(p[P_DAMP_AT])
+    if at == 0:
+        return p[P_MODES + MODE_SIZE * k + MODE_C] * qd[o + k]
+    n = int(p[P_N])
+    f = 0.0
+    for m in range(n):
+        f += p[at + n * k + m] * qd[o + m]
+    return f
+
+
+@njit(cache=True, error_model="numpy")
 def _inertia_about_hub(p, J, r, c1):
     """Inertia about the hub centre of mass (at -r from the interface) of a body with
     inertia J about the interface and first moment c1 there:
@@ -248,33 +361,53 @@ def pass1(q, qd, Q, members, params, work, hub, qdd):
     Leaves the modal forces f_k in the member's rows of ``qdd`` for :func:`pass2`.
     """
     omega = load_seg(hub, HUB_OMEGA)
+    z3 = (0.0, 0.0, 0.0)
     for j in range(members.shape[0]):
         o, p = members[j, 1], params[j]
         r = load_seg(p, P_MOUNT)
-        s, s_dot, h_r = _modal_sums(q, qd, o, p)
-        J, J_dot = _inertia(q, qd, o, p)
-        g_t, g_r = (0.0, 0.0, 0.0), (0.0, 0.0, 0.0)
+        second, full_damping = p[P_SECOND_AT] > 0.0, p[P_DAMP_AT] > 0.0
+        s, s_dot, h_r, J, J_dot, quad_t, quad_r = _sums(q, qd, o, p, omega, work, j, True)
+        g_t, g_r = z3, z3
+        d_tt, d_tr, d_rr = (z3, z3, z3), (z3, z3, z3), (z3, z3, z3)  # L(eta)^T L(eta) - L^T L
         for k in range(int(p[P_N])):
             b = P_MODES + MODE_SIZE * k
-            f = Q[o + k] - p[b + MODE_K] * q[o + k] - p[b + MODE_C] * qd[o + k]
-            f += _centrifugal(p, k, omega)
+            damping = _damping(qd, o, p, k)
+            f = Q[o + k] - p[b + MODE_K] * q[o + k] - damping
+            if second:
+                w = WORK_MODE * k
+                l_t = (work[j, w], work[j, w + 1], work[j, w + 2])
+                l_r = (work[j, w + 3], work[j, w + 4], work[j, w + 5])
+                f += work[j, w + 6]
+                t0, r0 = load_seg(p, b + MODE_LT), load_seg(p, b + MODE_LR)
+                d_tt = _madd(_madd(d_tt, _outer(l_t, l_t), 1.0), _outer(t0, t0), -1.0)
+                d_tr = _madd(_madd(d_tr, _outer(l_t, l_r), 1.0), _outer(t0, r0), -1.0)
+                d_rr = _madd(_madd(d_rr, _outer(l_r, l_r), 1.0), _outer(r0, r0), -1.0)
+            else:
+                l_t, l_r = load_seg(p, b + MODE_LT), load_seg(p, b + MODE_LR)
+                f += _centrifugal(p, k, omega)
             qdd[o + k] = f
-            g_t = add(g_t, scale(f, load_seg(p, b + MODE_LT)))
-            g_r = add(g_r, scale(f, load_seg(p, b + MODE_LR)))
-            hub[HUB_DISSIPATION] += p[b + MODE_C] * qd[o + k] ** 2  # eq. 2.36
-        c1 = add(load_seg(p, P_FIRST), s)  # c~ = m c + L_t^T eta
+            g_t = add(g_t, scale(f, l_t))
+            g_r = add(g_r, scale(f, l_r))
+            if full_damping:
+                hub[HUB_DISSIPATION] += damping * qd[o + k]
+            else:
+                hub[HUB_DISSIPATION] += p[b + MODE_C] * qd[o + k] ** 2  # eq. 2.36
+        c1 = add(load_seg(p, P_FIRST), s)  # c~ = m c + L_t^T eta (+ 1/2 eta^T C eta)
         # M_I = [[A, B], [C, D]] = M_res + [[0, -[s]x], [[s]x, J(eta) - J_I]], about I.
         S = skew(s)
         A = load_block33(p, P_RES, 0, 0)
         D = _madd(_madd(load_block33(p, P_RES, 3, 3), J, 1.0), load_m33_at(p, P_J_I), -1.0)
         B = _madd(load_block33(p, P_RES, 0, 3), S, -1.0)
         C = _madd(load_block33(p, P_RES, 3, 0), S, 1.0)
+        if second:  # the modes' rows follow eta: M_res - (L(eta)^T L(eta) - L^T L)
+            A, B, D = _madd(A, d_tt, -1.0), _madd(B, d_tr, -1.0), _madd(D, d_rr, -1.0)
+            C = _madd(C, transpose(d_tr), -1.0)
         # Wrench on the appendage at a_hub = 0, alpha = 0: M_I [w x (w x r); 0] + b_a.
         w2r = cross(omega, cross(omega, r))
         F = add(add(cross(omega, cross(omega, c1)), scale(2.0, cross(omega, s_dot))), g_t)
-        F = add(F, mv(A, w2r))
+        F = add(add(F, mv(A, w2r)), quad_t)
         N = add(add(cross(omega, mv(J, omega)), cross(omega, h_r)), g_r)
-        N = add(add(N, mv(C, w2r)), mv(J_dot, omega))
+        N = add(add(add(N, mv(C, w2r)), mv(J_dot, omega)), quad_r)
         T = add(N, cross(r, F))
         for a in range(3):
             hub[HUB_FORCE + a] -= F[a]
@@ -300,6 +433,13 @@ def pass2(q, qd, members, params, work, hub, qdd):
         o, p = members[j, 1], params[j]
         r = load_seg(p, P_MOUNT)
         a_I = add(add(a_hub, cross(alpha, r)), cross(omega, cross(omega, r)))
+        if p[P_SECOND_AT] > 0.0:  # the rows at eta, left by pass 1
+            for k in range(int(p[P_N])):
+                w = WORK_MODE * k
+                qdd[o + k] -= dot((work[j, w], work[j, w + 1], work[j, w + 2]), a_I) + dot(
+                    (work[j, w + 3], work[j, w + 4], work[j, w + 5]), alpha
+                )
+            continue
         for k in range(int(p[P_N])):
             b = P_MODES + MODE_SIZE * k
             qdd[o + k] -= dot(load_seg(p, b + MODE_LT), a_I) + dot(load_seg(p, b + MODE_LR), alpha)
@@ -316,16 +456,14 @@ def mass_matrix(q, members, params, M):
     for j in range(members.shape[0]):
         o, p = members[j, 1], params[j]
         m, r = p[P_MASS], load_seg(p, P_MOUNT)
-        s, _, _ = _modal_sums(q, q, o, p)
+        s, _, _, J, _, _, _ = _sums(q, q, o, p, identity[0], params, j, False)
         c1 = add(load_seg(p, P_FIRST), s)
         first_hub = add(scale(m, r), c1)  # first moment about the hub centre of mass
         add_block(M, 0, 0, identity, m)
         add_block(M, 0, 3, mm(R_NB, mm(skew(first_hub), S)), -1.0)
-        J, _ = _inertia(q, q, o, p)
         add_block(M, 3, 3, mtm(S, mm(_inertia_about_hub(p, J, r, c1), S)), 1.0)
         for k in range(int(p[P_N])):
-            b = P_MODES + MODE_SIZE * k
-            l_t, l_r = load_seg(p, b + MODE_LT), load_seg(p, b + MODE_LR)
+            l_t, l_r, _ = _mode(q, q, o, p, k, identity[0])
             row_r = mv(R_NB, l_t)
             row_theta = mtv(S, add(cross(r, l_t), l_r))
             for a in range(3):
@@ -346,9 +484,8 @@ def bias_forces(q, qd, members, params, hub, h):
     for j in range(members.shape[0]):
         o, p = members[j, 1], params[j]
         m, r = p[P_MASS], load_seg(p, P_MOUNT)
-        s, s_dot, h_r = _modal_sums(q, qd, o, p)
+        s, s_dot, h_r, J, J_dot, quad_t, quad_r = _sums(q, qd, o, p, omega, params, j, False)
         c1 = add(load_seg(p, P_FIRST), s)
-        J, J_dot = _inertia(q, qd, o, p)
         a_I = add(cross(alpha, r), cross(omega, cross(omega, r)))
         F = add(
             add(scale(m, a_I), cross(alpha, c1)),
@@ -356,18 +493,19 @@ def bias_forces(q, qd, members, params, hub, h):
         )
         N = add(add(add(cross(c1, a_I), mv(J, alpha)), mv(J_dot, omega)),
                 add(cross(omega, mv(J, omega)), cross(omega, h_r)))  # fmt: skip
+        F, N = add(F, quad_t), add(N, quad_r)
         F_N = mv(R_NB, F)
         T = add(N, cross(r, F))
         for a in range(3):
             hub[HUB_FORCE + a] += F_N[a]
             hub[HUB_TORQUE + a] += T[a]
+        full_damping = p[P_DAMP_AT] > 0.0
         for k in range(int(p[P_N])):
             b = P_MODES + MODE_SIZE * k
-            h[o + k] = (
-                dot(load_seg(p, b + MODE_LT), a_I)
-                + dot(load_seg(p, b + MODE_LR), alpha)
-                - _centrifugal(p, k, omega)
-            )
+            l_t, l_r, force = _mode(q, qd, o, p, k, omega)
+            h[o + k] = dot(l_t, a_I) + dot(l_r, alpha) - force
+            if full_damping:  # the diagonal is in C_damp; the rest is held here
+                h[o + k] += _damping(qd, o, p, k) - p[b + MODE_C] * qd[o + k]
 
 
 @njit(cache=True, error_model="numpy")  # compiled with OBSERVE_SIGNATURE on first use
@@ -380,9 +518,8 @@ def observe(q, qd, members, params, out):
     for j in range(members.shape[0]):
         o, p = members[j, 1], params[j]
         m, r = p[P_MASS], load_seg(p, P_MOUNT)
-        s, s_dot, h_r = _modal_sums(q, qd, o, p)
+        s, s_dot, h_r, J, _, _, _ = _sums(q, qd, o, p, omega, params, j, False)
         c1 = add(load_seg(p, P_FIRST), s)
-        J, _ = _inertia(q, qd, o, p)
         v = add(v_hub, cross(omega, r))
         kinetic = 0.5 * m * dot(v, v) + dot(v, cross(omega, c1)) + 0.5 * dot(omega, mv(J, omega))
         kinetic += dot(v, s_dot) + dot(omega, h_r)
@@ -390,7 +527,10 @@ def observe(q, qd, members, params, out):
             b = P_MODES + MODE_SIZE * k
             kinetic += 0.5 * qd[o + k] ** 2
             out[OBS_ELASTIC] += 0.5 * p[b + MODE_K] * q[o + k] ** 2
-            out[OBS_DISSIPATION] += p[b + MODE_C] * qd[o + k] ** 2
+            if p[P_DAMP_AT] > 0.0:
+                out[OBS_DISSIPATION] += _damping(qd, o, p, k) * qd[o + k]
+            else:
+                out[OBS_DISSIPATION] += p[b + MODE_C] * qd[o + k] ** 2
         out[OBS_KINETIC] += kinetic
         # Momentum at the interface: P = m v + omega x c~ + s_dot, H_I = c~ x v + J_I omega
         # + h_r; about the inertial origin: p_I x P + H_I (frame N).
@@ -455,19 +595,18 @@ def joint_wrench(q, qd, qdd, Q, members, params, out):
     for j in range(members.shape[0]):
         o, p = members[j, 1], params[j]
         r = load_seg(p, P_MOUNT)
-        s, s_dot, h_r = _modal_sums(q, qd, o, p)
-        J, J_dot = _inertia(q, qd, o, p)
-        c1 = add(load_seg(p, P_FIRST), s)  # c~ = m c + L_t^T eta
+        s, s_dot, h_r, J, J_dot, quad_t, quad_r = _sums(q, qd, o, p, omega, params, j, False)
+        c1 = add(load_seg(p, P_FIRST), s)  # c~ = m c + L_t^T eta (+ 1/2 eta^T C eta)
         a_I = add(add(a_hub, cross(alpha, r)), cross(omega, cross(omega, r)))
         g_t, g_r = (0.0, 0.0, 0.0), (0.0, 0.0, 0.0)  # L_t^T eta_ddot, L_r^T eta_ddot
         for k in range(int(p[P_N])):
-            b = P_MODES + MODE_SIZE * k
-            g_t = add(g_t, scale(qdd[o + k], load_seg(p, b + MODE_LT)))
-            g_r = add(g_r, scale(qdd[o + k], load_seg(p, b + MODE_LR)))
+            l_t, l_r, _ = _mode(q, qd, o, p, k, omega)
+            g_t = add(g_t, scale(qdd[o + k], l_t))
+            g_r = add(g_r, scale(qdd[o + k], l_r))
         F = add(add(scale(p[P_MASS], a_I), cross(alpha, c1)), cross(omega, cross(omega, c1)))
-        F = add(add(F, scale(2.0, cross(omega, s_dot))), g_t)
+        F = add(add(add(F, scale(2.0, cross(omega, s_dot))), g_t), quad_t)
         N = add(add(cross(c1, a_I), mv(J, alpha)), mv(J_dot, omega))
-        N = add(add(N, cross(omega, mv(J, omega))), add(cross(omega, h_r), g_r))
+        N = add(add(add(N, cross(omega, mv(J, omega))), add(cross(omega, h_r), g_r)), quad_r)
         T = add(N, cross(r, F))
         for a in range(3):
             out[a] -= F[a]
@@ -491,10 +630,11 @@ def _set_damping_ratio(table: dict, ratio: float) -> None:
     """Campaign path ``appendages[*].damping_ratio`` on a modal appendage: the damping
     ratio of every mode (``damping_scale`` back to 1), as the plate's ``damping_ratio``
     sets its joints'. The data is in the table once the config is validated (a file's
-    content is read into ``data``)."""
+    content is read into ``data``); a full damping matrix gives way to the diagonal."""
     if table.get("data") is None:
         raise KeyError("damping_ratio: the modal data is not in the config (validate it first)")
     table["data"]["damping_ratios"] = [ratio] * len(table["data"]["damping_ratios"])
+    table["data"]["damping_matrix"] = []  # every mode that ratio: diagonal damping
     table["damping_scale"] = 1.0
 
 
@@ -537,7 +677,28 @@ class ModalModel(AppendageModel):
         if tip is not None:
             modes[:, MODE_TIP : MODE_TIP + 3] = data.output_points[tip].mode_shapes
         modes[:, MODE_DJ : MODE_DJ + 9] = (R @ data.inertia_derivative_array() @ R.T).reshape(n, 9)
-        return row
+        blocks = [row]
+        at = row.size
+        if data.damping_matrix:
+            row[P_DAMP_AT] = at
+            blocks.append(data.damping_matrix_array().ravel())
+            at += n * n
+        if data.second_order:
+            row[P_SECOND_AT] = at
+            pairs = np.zeros((n, n, SO_SIZE))
+            C, E = data.first_moment_hessian_array(), data.coupling_gradient_array()
+            pairs[:, :, SO_C : SO_C + 3] = C @ R.T
+            pairs[:, :, SO_E : SO_E + 3] = E @ R.T
+            pairs[:, :, SO_ET : SO_ET + 3] = (E @ R.T).transpose(1, 0, 2)
+            J2 = R @ data.inertia_hessian_array() @ R.T
+            pairs[:, :, SO_J : SO_J + 9] = J2.reshape(n, n, 9)
+            blocks.append(pairs.ravel())
+        return np.concatenate(blocks) if len(blocks) > 1 else row
+
+    def work_columns(self, params: np.ndarray) -> int:
+        # Pass 1 leaves each mode's rows at eta for pass 2 when the large-motion terms
+        # are on.
+        return WORK_MODE * int(params[P_N]) if params[P_SECOND_AT] > 0.0 else 0
 
     @staticmethod
     def _modes(params: np.ndarray) -> np.ndarray:
