@@ -503,7 +503,25 @@ ORBIT = [
     _scenario("nadir pointing without an orbit", '[reference]\nkind = "nadir"\n', "reference.kind = 'nadir' points at a target along the orbit: add an [orbit] table", command="slew"),
 ]  # fmt: skip
 
-TABLE = CONFIGS + SCENARIOS + PATHS + SPECIAL_FILES + ROBUSTNESS + CAMPAIGNS + BUDGET + NASTRAN + ORBIT
+# The real-time plant and its flight software: options refused before a port is bound.
+_SERVE = ["serve", "{tmp}/s.toml"]
+_FSW = ["fsw", "{tmp}/s.toml"]
+_SLEW_FILE = {"s.toml": 'name = "served"\n'}
+REALTIME = [
+    Bad("serve speed zero", [*_SERVE, "--speed", "0"], "--speed: must be in (0, 1000], got 0", _SLEW_FILE),
+    Bad("serve speed too fast", [*_SERVE, "--speed", "5000"], "--speed: must be in (0, 1000], got 5000", _SLEW_FILE),
+    Bad("serve client timeout negative", [*_SERVE, "--client-timeout", "-1"], "--client-timeout: must be in (0, 3600] s, got -1", _SLEW_FILE),
+    Bad("serve endpoint scheme", [*_SERVE, "--sensor-endpoint", "http://127.0.0.1:80"], "--sensor-endpoint: expected udp://HOST:PORT, tcp://HOST:PORT (ZeroMQ) or ipc://PATH (ZeroMQ), got 'http://127.0.0.1:80'", _SLEW_FILE),
+    Bad("serve port out of range", [*_SERVE, "--command-endpoint", "udp://127.0.0.1:70000"], "--command-endpoint: expected a host and a port in 1-65535", _SLEW_FILE),
+    Bad("serve endpoint without port", [*_SERVE, "--command-endpoint", "udp://127.0.0.1"], "--command-endpoint: expected a host and a port in 1-65535", _SLEW_FILE),
+    Bad("serve mixed transports", [*_SERVE, "--sensor-endpoint", "tcp://127.0.0.1:47901"], "--sensor-endpoint and --command-endpoint: both udp://, or both ZeroMQ", _SLEW_FILE),
+    Bad("serve scenario missing", ["serve", "{tmp}/absent.toml"], "absent.toml"),
+    Bad("fsw silence zero", [*_FSW, "--silence", "0"], "--silence: must be in (0, 3600] s, got 0", _SLEW_FILE),
+    Bad("fsw connect timeout too long", [*_FSW, "--connect-timeout", "1e5"], "--connect-timeout: must be in (0, 3600] s, got 100000", _SLEW_FILE),
+]  # fmt: skip
+
+TABLE = (CONFIGS + SCENARIOS + PATHS + SPECIAL_FILES + ROBUSTNESS + CAMPAIGNS + BUDGET + NASTRAN
+         + ORBIT + REALTIME)  # fmt: skip
 
 
 def test_the_table_is_at_least_sixty_rows():

@@ -806,11 +806,13 @@ def serve(
     from flexsat.analysis.requirements import slew_metrics
     from flexsat.config import load_config
     from flexsat.dynamics.plant import Plant
+    from flexsat.realtime.server import check_options
     from flexsat.realtime.server import serve as serve_plant
     from flexsat.realtime.transport import plant_link
     from flexsat.simulate import load_slew
     from flexsat.study.outputs import prepare_output_dir, write_slew_outputs
 
+    check_options(speed, client_timeout, start_timeout)
     cfg = load_config(config)
     chosen = load_slew(scenario)
     link = plant_link(sensor_endpoint, command_endpoint)
@@ -856,9 +858,11 @@ def fsw(
     from flexsat.config import load_config
     from flexsat.dynamics.plant import Plant
     from flexsat.realtime.fsw import fly_remote
-    from flexsat.realtime.transport import client_link
+    from flexsat.realtime.transport import check_seconds, client_link
     from flexsat.simulate import load_slew
 
+    check_seconds("--connect-timeout", connect_timeout)
+    check_seconds("--silence", silence)
     cfg = load_config(config)
     chosen = load_slew(scenario)
     link = client_link(sensor_endpoint, command_endpoint)

@@ -14,10 +14,10 @@ import numpy as np
 from flexsat.control.laws import get_law
 from flexsat.control.quaternion import target_quaternion
 from flexsat.dynamics.plant import Plant
-from flexsat.errors import ConfigError, SimulationError
+from flexsat.errors import SimulationError
 from flexsat.realtime import packets
 from flexsat.realtime.client import PlantClient
-from flexsat.realtime.transport import Link
+from flexsat.realtime.transport import Link, check_seconds
 from flexsat.simulate.closedloop import slew_design_inertia
 from flexsat.simulate.scenario import SlewScenario
 
@@ -55,9 +55,8 @@ def fly_remote(plant: Plant, scenario: SlewScenario, link: Link, *,
     SimulationError
         No plant within ``connect_timeout_s``, or the law's step failed.
     """
-    for name, value in (("--connect-timeout", connect_timeout_s), ("--silence", silence_s)):
-        if not 0.0 < value <= 3600.0:
-            raise ConfigError(f"{name}: must be in (0, 3600] s, got {value:g}")
+    check_seconds("--connect-timeout", connect_timeout_s)
+    check_seconds("--silence", silence_s)
     law = get_law(scenario.controller.kind)
     gains = np.ascontiguousarray(scenario.controller.gains(scenario.actuator), dtype=float)
     J = np.ascontiguousarray(slew_design_inertia(plant, scenario), dtype=float)

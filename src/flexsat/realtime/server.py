@@ -26,13 +26,13 @@ from flexsat.control.stages import JOINT_ACTUATORS, REFERENCES
 from flexsat.dynamics.plant import Plant
 from flexsat.errors import ConfigError, SimulationError
 from flexsat.realtime import packets
-from flexsat.realtime.transport import Link
+from flexsat.realtime.transport import Link, check_seconds
 from flexsat.simulate.closedloop import finish_slew, prepare_slew
 from flexsat.simulate.python_loop import python_loop
 from flexsat.simulate.result import Result
 from flexsat.simulate.scenario import SlewScenario
 
-__all__ = ["MAX_SPEED", "SPIN_S", "ServeStats", "serve"]
+__all__ = ["MAX_SPEED", "SPIN_S", "ServeStats", "check_options", "serve"]
 
 SPIN_S = 1e-3
 """The pacing spins on the clock for the last this long before an instant [s]; before
@@ -191,6 +191,27 @@ class _RemoteLaw:
         return self.held
 
 
+def check_options(speed: float, client_timeout_s: float, start_timeout_s: float) -> None:
+    """Refuse a speed outside (0, :data:`MAX_SPEED`] or a timeout outside (0, 3600] s.
+
+    Parameters
+    ----------
+    speed : float
+        Simulated seconds per wall second [-].
+    client_timeout_s, start_timeout_s : float
+        The timeouts of :func:`serve` [s].
+
+    Raises
+    ------
+    ConfigError
+        Naming the option (``--speed``, ``--client-timeout``, ``--start-timeout``).
+    """
+    if not 0.0 < speed <= MAX_SPEED:
+        raise ConfigError(f"--speed: must be in (0, {MAX_SPEED:g}], got {speed:g}")
+    check_seconds("--client-timeout", client_timeout_s)
+    check_seconds("--start-timeout", start_timeout_s)
+
+
 def _compile(plant: Plant, scenario: SlewScenario) -> None:
     """Fly one control period of ``scenario`` under zero torque: the python loop's
     compiled pieces are compiled (or loaded from the disk cache) before the paced run."""
@@ -245,12 +266,7 @@ def serve(plant: Plant, scenario: SlewScenario, link: Link, *, speed: float = 1.
     SimulationError
         No client said HELLO within ``start_timeout_s``.
     """
-    if not 0.0 < speed <= MAX_SPEED:
-        raise ConfigError(f"--speed: must be in (0, {MAX_SPEED:g}], got {speed:g}")
-    for name, value in (("--client-timeout", client_timeout_s),
-                        ("--start-timeout", start_timeout_s)):  # fmt: skip
-        if not 0.0 < value <= 3600.0:
-            raise ConfigError(f"{name}: must be in (0, 3600] s, got {value:g}")
+    check_options(speed, client_timeout_s, start_timeout_s)
     run = prepare_slew(plant, scenario)
     layout = run.layout
     if (layout.reference.name != REFERENCES.default

@@ -22,6 +22,7 @@ __all__ = [
     "DEFAULT_COMMAND_ENDPOINT",
     "DEFAULT_SENSOR_ENDPOINT",
     "Link",
+    "check_seconds",
     "client_link",
     "parse_endpoint",
     "plant_link",
@@ -45,6 +46,28 @@ class Link(Protocol):
 
     def close(self) -> None:
         """Release the sockets."""
+
+
+def check_seconds(option: str, value: float, limit_s: float = 3600.0) -> float:
+    """``value`` [s] if it is in (0, ``limit_s``], else a :class:`ConfigError` naming ``option``.
+
+    Parameters
+    ----------
+    option : str
+        The option, for the message.
+    value : float
+        A duration [s].
+    limit_s : float
+        Largest allowed [s].
+
+    Returns
+    -------
+    float
+        ``value``.
+    """
+    if not 0.0 < value <= limit_s:
+        raise ConfigError(f"{option}: must be in (0, {limit_s:g}] s, got {value:g}")
+    return value
 
 
 def parse_endpoint(text: str, option: str) -> tuple[str, str, int | None]:
