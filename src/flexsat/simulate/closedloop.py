@@ -2,10 +2,14 @@
 
 from __future__ import annotations
 
+import os
+import tempfile
 import time
+from pathlib import Path
 from typing import NamedTuple, Protocol
 
 import numpy as np
+import xarray as xr
 
 from flexsat.config import nominal
 from flexsat.config.models import SatelliteConfig
@@ -22,9 +26,16 @@ from flexsat.simulate.loops import LoopData, LoopStages
 from flexsat.simulate.openloop import initial_state
 from flexsat.simulate.python_loop import python_loop
 from flexsat.simulate.result import Result, build_dataset
-from flexsat.simulate.run_setup import PROGRESS_MIN_STEPS, progress_bar, run_attributes
+from flexsat.simulate.run_setup import (
+    PROGRESS_MIN_STEPS,
+    check_run_size,
+    chunk_steps,
+    progress_bar,
+    run_attributes,
+)
 from flexsat.simulate.scenario import SlewScenario
 from flexsat.simulate.stage_chain import loop_data, loop_layout, loop_stages
+from flexsat.simulate.stream import RecordStream, check_disk_space
 from flexsat.simulate.targets import reference_track, tracking_errors
 
 __all__ = [
@@ -103,6 +114,9 @@ def run_slew(
     design_J: np.ndarray | None = None,
     progress: bool | None = None,
     controller: Controller | None = None,
+    *,
+    record_path: str | Path | None = None,
+    record_budget_bytes: float | None = None,
 ) -> Result:
     """Simulate a closed-loop slew of the flexible plant.
 
@@ -120,6 +134,13 @@ def run_slew(
         A plain-Python law used instead of ``scenario.controller`` (whose compiled
         form runs inside the RK4 loop). The sensor and actuator stages of the
         scenario still run; the law's diagnostics are recorded as NaN.
+    record_path : str or Path, optional
+        Stream the records to this NetCDF file while the run goes, block by block
+        (:mod:`flexsat.simulate.stream`; the compiled law only); by default only a run
+        whose records do not fit in memory is streamed, to a temporary file.
+    record_budget_bytes : float, optional
+        Memory the records may use before they are streamed [bytes]; default: half the
+        machine's memory (:func:`flexsat.simulate.run_setup.check_run_size`).
 
     Returns
     -------
@@ -127,10 +148,32 @@ def run_slew(
         As :func:`flexsat.simulate.run_openloop`, plus the pointing and rate errors,
         the law's declared diagnostics and the stages' records (each a variable with
         its units) and, in the attributes, what the law's plots need. A diverging
-        run stops cleanly with its history and ``status = "failed"``.
+        run stops cleanly with its history and ``status = "failed"``. A streamed
+        run's dataset reads its file lazily (``result.path``).
+
+    Raises
+    ------
+    ConfigError
+        Records that fit neither in memory nor on the disk they would be streamed
+        to; streaming asked of a Python controller's run.
     """
     scenario = scenario or SlewScenario()
-    run = prepare_slew(plant, scenario, design_J)
+    stream, block_rows = None, None
+    if record_path is not None or record_budget_bytes is not None:
+        estimate = check_run_size(plant.n_dof, scenario, record_budget_bytes, can_stream=True)
+        if record_path is not None or not estimate.fits_in_memory:
+            if controller is not None:
+                raise ConfigError("record_path: a Python controller's run keeps its records "
+                                  "in memory; run it without record_path")  # fmt: skip
+            path = Path(record_path) if record_path is not None else _temporary_record_file()
+            check_disk_space(path.parent, estimate.record_bytes * estimate.records)
+            stream = RecordStream(path)
+            # a quarter of the budget per block, at least two chunks of records
+            per_chunk = chunk_steps(scenario.record_every, scenario.control_every)
+            per_chunk //= scenario.record_every
+            budget = int(0.25 * estimate.available_bytes / estimate.record_bytes)
+            block_rows = max(2 * per_chunk, budget) + 2
+    run = prepare_slew(plant, scenario, design_J, block_rows)
     layout = run.layout
     if controller is not None and (
         layout.reference.name != REFERENCES.default
@@ -145,13 +188,20 @@ def run_slew(
     start = time.perf_counter()
     with progress_bar(show, scenario.duration_s) as (bar, task):
         if controller is None:
-            status, done, rows = _compiled_loop(run, bar, task)
+            status, done, rows = _compiled_loop(run, bar, task, stream)
         else:
             status, done, rows = python_loop(plant, scenario, run.x, run.frame, run.stages,
                                              run.data, run.rec_t, run.rec_x, run.rec_ctrl,
                                              run.rec_frame, bar, task, controller,
                                              layout.continuous)  # fmt: skip
-    return finish_slew(run, status, done, rows, time.perf_counter() - start, controller is None)
+    return finish_slew(run, status, done, rows, time.perf_counter() - start, controller is None,
+                       stream)  # fmt: skip
+
+
+def _temporary_record_file() -> Path:
+    handle, name = tempfile.mkstemp(prefix="flexsat-slew-", suffix=".nc")
+    os.close(handle)
+    return Path(name)
 
 
 class PreparedSlew(NamedTuple):
@@ -215,8 +265,8 @@ class PreparedSlew(NamedTuple):
     rec_solved: np.ndarray  # (m, 2, n_dof), NaN where the loop has not written it
 
 
-def prepare_slew(plant: Plant, scenario: SlewScenario,
-                 design_J: np.ndarray | None = None) -> PreparedSlew:  # fmt: skip
+def prepare_slew(plant: Plant, scenario: SlewScenario, design_J: np.ndarray | None = None,
+                 record_rows: int | None = None) -> PreparedSlew:  # fmt: skip
     """Everything a slew's compiled loop reads and writes, allocated once.
 
     Parameters
@@ -227,12 +277,16 @@ def prepare_slew(plant: Plant, scenario: SlewScenario,
         The slew.
     design_J : ndarray, shape (3, 3), optional
         The controller's inertia [kg m^2]; default :func:`slew_design_inertia`.
+    record_rows : int, optional
+        Rows of the record buffers when the run streams its records in blocks
+        (at most the whole run's).
 
     Returns
     -------
     PreparedSlew
         Initial state, loop data, stages and record buffers sized for the whole run
-        (``n_steps // record_every + 2`` rows: the last good state of a failed run too).
+        (``n_steps // record_every + 2`` rows: the last good state of a failed run too),
+        or for one streamed block.
     """
     J = np.ascontiguousarray(
         slew_design_inertia(plant, scenario) if design_J is None else design_J, dtype=float
@@ -241,6 +295,8 @@ def prepare_slew(plant: Plant, scenario: SlewScenario,
     layout = loop_layout(plant, scenario)
     q0, qd0 = initial_state(plant, scenario)
     n_records = scenario.n_steps // scenario.record_every + 2  # + the last good state
+    if record_rows is not None:
+        n_records = min(n_records, record_rows)
     data = loop_data(layout, scenario, J, plant)
     stages = loop_stages(scenario)
     return PreparedSlew(
@@ -255,7 +311,8 @@ def prepare_slew(plant: Plant, scenario: SlewScenario,
 
 
 def finish_slew(run: PreparedSlew, status: int, done: int, rows: int, wall: float,
-                compiled_law: bool = True) -> Result:  # fmt: skip
+                compiled_law: bool = True,
+                stream: RecordStream | None = None) -> Result:  # fmt: skip
     """The :class:`~flexsat.simulate.result.Result` of a slew the loop has flown.
 
     Parameters
@@ -272,12 +329,15 @@ def finish_slew(run: PreparedSlew, status: int, done: int, rows: int, wall: floa
         Wall time of the loop [s] (an attribute of the result).
     compiled_law : bool
         The scenario's compiled law flew it (False: a Python controller).
+    stream : RecordStream, optional
+        Where the run's earlier blocks of records went: the buffers' ``rows`` are
+        its last block.
 
     Returns
     -------
     Result
     """
-    plant, scenario, law, layout, J, x, frame, data = run[:8]
+    scenario, x, frame, data = run.scenario, run.x, run.frame, run.data
     records = run.rec_t, run.rec_x, run.rec_ctrl, run.rec_frame, run.rec_Q, run.rec_solved
     rec_t, rec_x, rec_ctrl, rec_frame, rec_Q, _ = records
     t_fail = done * scenario.dt_s if status else -1.0
@@ -285,7 +345,18 @@ def finish_slew(run: PreparedSlew, status: int, done: int, rows: int, wall: floa
         rec_t[rows], rec_x[rows], rec_ctrl[rows], rec_frame[rows] = t_fail, x, data.held, frame
         rec_Q[rows, :6], rec_Q[rows, 6:] = 0.0, data.Q[6:]  # as the loop records them
         rows += 1
-    rec_t, rec_x, rec_ctrl, rec_frame, rec_Q, rec_solved = (a[:rows] for a in records)
+    attrs = _slew_attributes(run, status, t_fail, wall, done, compiled_law)
+    if stream is None:
+        return Result(_slew_block(run, rows, attrs))
+    if rows:
+        stream.append(_slew_block(run, rows, attrs, stream.energy0))
+    return Result(stream.finish(attrs), stream.path)
+
+
+def _slew_attributes(run: PreparedSlew, status: int, t_fail: float, wall: float, done: int,
+                     compiled_law: bool = True) -> dict:  # fmt: skip
+    """The dataset attributes of a slew (its configs, status, law, stages, target)."""
+    plant, scenario, law, layout, J = run[:5]
     attrs = run_attributes(plant, scenario, "closed-loop", status, t_fail, wall, done)
     attrs["controller"] = law.name if compiled_law else "python"
     attrs["controller_label"] = law.label if compiled_law else "Python law"
@@ -301,6 +372,17 @@ def finish_slew(run: PreparedSlew, status: int, done: int, rows: int, wall: floa
     attrs["target_quaternion"] = target.tolist()
     # gain (3), environment (3), sloshing ratio and Hz, residual (3), T_max
     attrs["realised_disturbances"] = scenario.disturbances.packed(scenario.actuator).tolist()
+    return attrs
+
+
+def _slew_block(run: PreparedSlew, rows: int, attrs: dict,
+                energy0: float | None = None) -> xr.Dataset:  # fmt: skip
+    """The dataset of the first ``rows`` records of the buffers (a run's, or a block)."""
+    plant, scenario, _, layout = run[:4]
+    data = run.data
+    records = run.rec_t, run.rec_x, run.rec_ctrl, run.rec_frame, run.rec_Q, run.rec_solved
+    rec_t, rec_x, rec_ctrl, rec_frame, rec_Q, rec_solved = (a[:rows] for a in records)
+    target = np.asarray(attrs["target_quaternion"], dtype=float)
     at = layout.plant  # where each piece of the plant state lives
     ta = ("time", "axis")
 
@@ -337,24 +419,36 @@ def finish_slew(run: PreparedSlew, status: int, done: int, rows: int, wall: floa
         )  # fmt: skip
         return more
 
-    ds = build_dataset(
+    return build_dataset(
         plant, rec_t, rec_x[:, at.q], rec_x[:, at.qd], rec_x[:, at.work_in],
         rec_x[:, at.dissipated], rec_ctrl[:, layout.tau_cmd], rec_ctrl[:, layout.tau_applied],
-        attrs, frames=rec_frame, joint_force=rec_Q, solved=rec_solved, more=added,
+        dict(attrs), energy0, frames=rec_frame, joint_force=rec_Q, solved=rec_solved,
+        more=added,
     )  # fmt: skip
-    return Result(ds)
 
 
-def _compiled_loop(run: PreparedSlew, bar, task) -> tuple[int, int, int]:
-    """The whole loop, stages and law included, in compiled chunks (one call without a bar)."""
-    per_call = 1 if bar is not None else run.scenario.n_steps + 1
+def _compiled_loop(run: PreparedSlew, bar, task,
+                   stream: RecordStream | None = None) -> tuple[int, int, int]:  # fmt: skip
+    """The whole loop, stages and law included, in compiled chunks (one call without a bar
+    or a stream); a streamed run hands each full buffer of records to ``stream``."""
+    scenario = run.scenario
+    per_call = 1 if (bar is not None or stream is not None) else scenario.n_steps + 1
+    # records of one chunk, plus the final step's and a failed run's last good state
+    per_chunk = chunk_steps(scenario.record_every, scenario.control_every)
+    room = per_chunk // scenario.record_every + 2
     status, done, rows = 0, 0, 0
+    attrs = None
     while True:
         status, done, rows = fly(*_fly_arguments(run, done, rows, per_call))
         if bar is not None:
-            bar.update(task, completed=done * run.scenario.dt_s)
-        if status != 0 or done == run.scenario.n_steps:
+            bar.update(task, completed=done * scenario.dt_s)
+        if status != 0 or done == scenario.n_steps:
             return status, done, rows
+        if stream is not None and rows + room > run.rec_t.size:
+            attrs = attrs or _slew_attributes(run, 0, -1.0, 0.0, 0)
+            stream.append(_slew_block(run, rows, attrs, stream.energy0))
+            run.rec_solved[:] = np.nan  # written only where the loop has it: no stale rows
+            rows = 0
 
 
 def _fly_arguments(run: PreparedSlew, done: int, rows: int, max_chunks: int) -> tuple:
