@@ -459,7 +459,6 @@ BUDGET = [
 ]  # fmt: skip
 
 
-
 def _nastran(id: str, change: str, extra: list[str], fragment: str) -> Bad:
     """``flexsat fe import`` of the frame deck of tests/fe/nastran_decks.py, changed."""
     from tests.fe.nastran_decks import deck_files
