@@ -232,16 +232,22 @@ def test_wheel_speeds_are_recorded_per_wheel_in_rpm(nominal_plant):
     assert np.all(np.abs(speed[-1, :4] - 100.0) > 1.0)
 
 
-def test_r3_fails_when_a_motor_is_asked_more_than_its_limit(nominal_plant):
+def test_the_min_max_allocation_keeps_every_motor_inside_its_limit(nominal_plant):
     # The ASMC's 45/45/45 command starts clipped to RF T_max = 0.95 x 2 = 1.9 N m on
     # every axis; the pseudo-inverse of the pyramid (A A^T = 4/3 I, so A^+ = 3/4 A^T)
-    # asks the wheel on (1, 1, 1)/sqrt(3) for 3/4 x sqrt(3) x 1.9 = 2.468 N m, 123.4 %
-    # of its 2 N m motor: clipped, the cluster does not deliver the command, and R3
-    # fails with no wheel saturated and the hub torque inside T_max (measured 1.75 N m).
+    # would ask the wheel on (1, 1, 1)/sqrt(3) for 3/4 x sqrt(3) x 1.9 = 2.468 N m,
+    # 123.4 % of its 2 N m motor. Along the null direction (-1, 1, -1, 1)/2 the
+    # min-max allocation asks every motor for sqrt(3) x 1.9 / 2 = 1.645 N m, 82.3 % of
+    # its limit, at t = 0, and delivers the whole command. Later commands leave the
+    # diagonal; the allocation engages whenever the pseudo-inverse would ask more than
+    # the limit and keeps the demand at most at the limit (measured 99.6 %): R3 holds,
+    # no wheel saturated. 1e-6: the preset's half-angle is the magic angle to 1.7e-7
+    # rad (test_allocation.py).
     scenario = SlewScenario.model_validate({"duration_s": 2.0, "actuator": {"kind": "wheels"}})
     ds = run_slew(nominal_plant, scenario).dataset
     metrics = slew_metrics(ds)
-    expected = 0.75 * math.sqrt(3.0) * 0.95 * 2.0 / 2.0
-    assert ds["actuator_torque_ratio"].values.max() == pytest.approx(expected, rel=1e-9)
+    ratio = ds["actuator_torque_ratio"].values
+    assert ratio[0] == pytest.approx(math.sqrt(3.0) * 0.95 * 2.0 / 2.0 / 2.0, rel=1e-6)
+    assert ratio.max() <= 1.0
     assert metrics["actuator_saturation_s"] == {} and max(metrics["max_abs_torque_nm"]) < 2.0
-    assert not metrics["r3_pass"]
+    assert metrics["r3_pass"]

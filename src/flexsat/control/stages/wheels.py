@@ -33,7 +33,11 @@ actuator's output).
 At every control instant the body-torque command is allocated by the
 pseudo-inverse, u_cmd = -A^+ tau_cmd - k_null (I - A^+ A)(h - I_s Omega_bias),
 A = [a_1 ... a_N] (3 x N): the null-space term drives the wheels towards their
-bias speed without torquing the hub; each u_cmd,i is clipped to the motor limit.
+bias speed without torquing the hub. When that asks a motor for more than its
+limit, u_cmd moves along a null direction of A to the smallest largest motor
+torque (:mod:`flexsat.control.stages._allocation`: the exact min-max allocation of
+four wheels on three axes), the hub torque unchanged; each u_cmd,i is then clipped
+to the motor limit.
 
 Microvibration (``[actuator.microvibration]``, off by default): the empirical wheel
 model of Masterson, Miller and Grogan ("Development and validation of reaction wheel
@@ -65,6 +69,7 @@ from pydantic import Field, model_validator
 
 from flexsat.config.models import Positive, Real, _Frozen
 from flexsat.control.registry import Channel
+from flexsat.control.stages._allocation import minmax_shift
 from flexsat.control.stages.registry import (
     ActuatorStageConfig,
     StageSpec,
@@ -479,15 +484,29 @@ def wheels_step(tau_cmd, t, dt, params, state, tau_applied, record):
     n = int(p[_N])
     bias = p[_IS] * p[_WBIAS]
     hx, hy, hz, h2, h_abs, saturated, asked = 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
+    u = s[2 * n : 3 * n]  # the motor commands, written here
     for i in range(n):
-        u = 0.0
+        u[i] = 0.0
         for a in range(3):
-            u -= p[_PINV + 3 * i + a] * tau_cmd[a]
+            u[i] -= p[_PINV + 3 * i + a] * tau_cmd[a]
         if p[_KNULL] != 0.0:  # null-space momentum management, off by default
             for j in range(n):
-                u -= p[_KNULL] * p[_NULL + MAX_WHEELS * i + j] * (_momentum(p, s, j) - bias)
-        asked = max(asked, abs(u))
-        s[2 * n + i] = min(p[_UMAX], max(-p[_UMAX], u))
+                u[i] -= p[_KNULL] * p[_NULL + MAX_WHEELS * i + j] * (_momentum(p, s, j) - bias)
+        asked = max(asked, abs(u[i]))
+    if asked > p[_UMAX]:  # beyond a motor's limit: the min-max allocation (_allocation)
+        j = 0
+        for i in range(n):
+            if p[_NULL + (MAX_WHEELS + 1) * i] > p[_NULL + (MAX_WHEELS + 1) * j]:
+                j = i
+        if p[_NULL + (MAX_WHEELS + 1) * j] > 1e-12:  # column j of I - A^+ A: a null direction
+            d = p[_NULL + j : _NULL + MAX_WHEELS * n : MAX_WHEELS]
+            step = minmax_shift(u, d, n)
+            asked = 0.0
+            for i in range(n):
+                u[i] += step * d[i]
+                asked = max(asked, abs(u[i]))
+    for i in range(n):
+        u[i] = min(p[_UMAX], max(-p[_UMAX], u[i]))
         h = _momentum(p, s, i)
         record[8 + i] = h * p[_INV_IS] / _RPM  # the axial spin rate [rpm]
         hx += p[_A + i] * h
