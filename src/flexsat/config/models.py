@@ -221,7 +221,19 @@ def appendage_config_class(model: str) -> type[BaseModel]:
 
 
 def table_model(value: Any) -> str:
-    """The ``model`` key of an appendage table, the default model when it names none."""
+    """The ``model`` key of an appendage table, the default model when it names none.
+
+    Parameters
+    ----------
+    value : Any
+        An appendage table as read from a file (a dict), or anything else.
+
+    Returns
+    -------
+    str
+        The model's registered name [-]; ``DEFAULT_APPENDAGE_MODEL`` when ``value``
+        is not a table or names no model.
+    """
     if isinstance(value, dict):
         return value.get("model", DEFAULT_APPENDAGE_MODEL)
     return DEFAULT_APPENDAGE_MODEL
