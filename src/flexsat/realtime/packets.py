@@ -72,7 +72,17 @@ class PacketError(ValueError):
 
 
 class Header(NamedTuple):
-    """A packet's header: its type, sequence number and simulated time [ns]."""
+    """A packet's header: its type, sequence number and simulated time.
+
+    Attributes
+    ----------
+    type : int
+        Packet type: :data:`HELLO`, :data:`SENSOR`, :data:`COMMAND` or :data:`END` [-].
+    sequence : int
+        Control instant index k (a command: the k it answers) [-].
+    sim_time_ns : int
+        Simulated time of the sample [ns].
+    """
 
     type: int
     sequence: int
@@ -186,7 +196,19 @@ def encode_hello() -> bytes:
 
 
 def encode_end(sequence: int, sim_time_ns: int) -> bytes:
-    """The plant's END packet (a header alone): the run is over at ``sim_time_ns`` [ns]."""
+    """The plant's END packet (a header alone): the run is over.
+
+    Parameters
+    ----------
+    sequence : int
+        The last control instant index [-].
+    sim_time_ns : int
+        Simulated time the run ended at [ns].
+
+    Returns
+    -------
+    bytes
+    """
     return _HEADER.pack(*_header(END, sequence, sim_time_ns))
 
 

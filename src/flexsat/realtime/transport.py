@@ -63,7 +63,7 @@ def check_seconds(option: str, value: float, limit_s: float = 3600.0) -> float:
     Returns
     -------
     float
-        ``value``.
+        ``value`` [s].
     """
     if not 0.0 < value <= limit_s:
         raise ConfigError(f"{option}: must be in (0, {limit_s:g}] s, got {value:g}")
