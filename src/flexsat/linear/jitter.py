@@ -261,7 +261,9 @@ class StepperConfig(_Frozen):
     step_angle_deg: Annotated[float, Field(gt=0.0, le=90.0, allow_inf_nan=False)] = Field(
         description="s, the output angle of one (micro)step [deg]"
     )
-    harmonics: tuple[StepperHarmonic, ...] = Field(min_length=1, max_length=64)
+    harmonics: tuple[StepperHarmonic, ...] = Field(
+        min_length=1, max_length=64, description="the ripple's harmonics h_k, T_k [-, N m]"
+    )
     seed: Annotated[int, Field(ge=0, lt=2**53)] = Field(1, description="phase stream")
 
     @property
@@ -314,7 +316,7 @@ def line_response(
         The disturbance.
     rows : ndarray, shape (n_y, n_model_outputs), optional
         A map of the model's outputs (:func:`los_rows` for a line of sight); default
-        the outputs themselves.
+        the outputs themselves [rad per rad].
 
     Returns
     -------
@@ -362,8 +364,12 @@ def jitter_rms(
 
     Parameters
     ----------
-    model, lines, rows
-        As for :func:`line_response`.
+    model : LinearModel
+        The closed loop (:func:`closed_loop`).
+    lines : Lines
+        The disturbance.
+    rows : ndarray, shape (n_y, n_model_outputs), optional
+        Output map, as for :func:`line_response` [rad per rad].
     window_s : float, optional
         The RPE's window Δt [s]; default none (the whole error's RMS).
 
@@ -389,10 +395,14 @@ def jitter_psd(
 
     Parameters
     ----------
-    model, lines, rows
-        As for :func:`line_response`.
+    model : LinearModel
+        The closed loop (:func:`closed_loop`).
+    lines : Lines
+        The disturbance.
     frequency_hz : ndarray, shape (n_f,)
         Bin centres, uniformly spaced, ascending [Hz].
+    rows : ndarray, shape (n_y, n_model_outputs), optional
+        Output map, as for :func:`line_response` [rad per rad].
 
     Returns
     -------
@@ -473,7 +483,7 @@ def speed_sweep(
     speeds_rpm : ndarray
         Speeds to sweep [rpm], every wheel at the same speed (> 0).
     rows : ndarray, optional
-        Output map, as for :func:`line_response`.
+        Output map, as for :func:`line_response` [rad per rad].
     window_s : float, optional
         RPE window [s].
     n_worst : int
