@@ -8,6 +8,8 @@ A slew opts in with::
     density = "exponential"
     [environment.models.magnetic]
     residual_dipole_a_m2 = [0.1, 0.0, 0.0]
+    [environment.magnetorquers]       # dump the wheels' momentum
+    dipole_max_a_m2 = 10.0
     [environment.surfaces.front]      # also hub, back
     specular = 0.1
     diffuse = 0.1
@@ -25,6 +27,7 @@ from typing import Annotated, Any
 from pydantic import Field, field_validator, model_validator
 
 from flexsat.config.models import _Frozen
+from flexsat.environment.magnetorquers import MagnetorquerConfig
 from flexsat.environment.registry import (
     EnvironmentModelConfig,
     environment_model,
@@ -89,6 +92,9 @@ class EnvironmentConfig(_Frozen):
     hub_facets: Annotated[int, Field(ge=3, le=64)] = Field(
         8, description="flat faces around the hub cylinder's side [-]"
     )
+    magnetorquers: MagnetorquerConfig | None = Field(
+        None, description="magnetorquers dumping the reaction wheels' momentum; default: none"
+    )
 
     @field_validator("models", mode="before")
     @classmethod
@@ -103,6 +109,13 @@ class EnvironmentConfig(_Frozen):
             model = environment_model(name).config
             out[name] = table if isinstance(table, model) else model.model_validate(table or {})
         return out
+
+    @model_validator(mode="after")
+    def _field_for_the_magnetorquers(self) -> EnvironmentConfig:
+        if self.magnetorquers is not None and "magnetic" not in self.active():
+            raise ValueError("magnetorquers: they act on the geomagnetic field: add the "
+                             "magnetic model ([environment.models.magnetic])")  # fmt: skip
+        return self
 
     def active(self) -> dict[str, EnvironmentModelConfig]:
         """The enabled models, by name, in the table's order."""

@@ -99,7 +99,8 @@ def nrlmsis_density(eph: np.ndarray, epoch: str, f107: float, ap: float) -> np.n
     Parameters
     ----------
     eph : ndarray, shape (n, 13)
-        The ephemeris (:data:`~flexsat.environment.registry.EPHEMERIS_COLUMNS`).
+        The ephemeris (:data:`~flexsat.environment.registry.EPHEMERIS_COLUMNS`)
+        [s, m, m/s, -, m, -, rad].
     epoch : str
         Its epoch, ISO 8601 UTC.
     f107 : float
@@ -133,7 +134,21 @@ def nrlmsis_density(eph: np.ndarray, epoch: str, f107: float, ap: float) -> np.n
 
 @njit(cache=True)
 def exponential_density(params, altitude):
-    """rho [kg/m^3] at ``altitude`` [m] from the packed bands of Vallado's table."""
+    """The density of Vallado's exponential atmosphere at an altitude (E.6).
+
+    Parameters
+    ----------
+    params : ndarray
+        The drag model's packed parameters, its bands of Vallado's table from slot 3
+        (h_0 [m], rho_0 [kg/m^3], H [m] each).
+    altitude : float
+        Height above the equatorial radius [m].
+
+    Returns
+    -------
+    float
+        rho [kg/m^3], of the band whose base is the highest at or below ``altitude``.
+    """
     band = 0
     for b in range(_BANDS):
         if altitude >= params[_TABLE + 3 * b]:
@@ -154,7 +169,31 @@ def _tabulated(params, t):
 
 @njit(cache=True)  # compiled with LOAD_SIGNATURE on first use
 def drag_load(eph, C_BN, points, surfaces, params, force, torque):
-    """The drag force on each surface's centre facing the flow, frame B (module docstring)."""
+    """The drag force on each surface's centre facing the flow, frame B (module docstring).
+
+    Parameters
+    ----------
+    eph : ndarray, shape (13,)
+        The ephemeris row at the instant (``EPHEMERIS_COLUMNS``, ECI)
+        [s, m, m/s, -, m, -, rad].
+    C_BN : ndarray, shape (3, 3)
+        Rotation from ECI to hub frame B [-].
+    points : ndarray, shape (k, 4)
+        Mass elements: position from the hub centre of mass, frame B [m], mass [kg].
+    surfaces : ndarray, shape (s, SURFACE_SIZE)
+        Surfaces (``SURF_*`` slots of :mod:`flexsat.environment.registry`) [m, -, m^2, -].
+    params : ndarray, shape (p,)
+        The model's packed parameters (its config's ``packed``) [SI].
+    force : ndarray, shape (k + s, 3)
+        Force on each mass element, then each surface's centre, frame B [N], added to.
+    torque : ndarray, shape (3,)
+        Torque on the hub acting on no point, frame B [N m], added to.
+
+    Returns
+    -------
+    int
+        0 (the load cannot fail).
+    """
     rx, ry, rz = eph[EPH_R], eph[EPH_R + 1], eph[EPH_R + 2]
     w = params[_OMEGA]
     vx, vy, vz = eph[EPH_V] + w * ry, eph[EPH_V + 1] - w * rx, eph[EPH_V + 2]

@@ -53,18 +53,19 @@ class LoadGeometry:
     points : ndarray, shape (k, 4)
         Mass elements: position from the hub centre of mass [m], mass [kg].
     surfaces : ndarray, shape (s, SURFACE_SIZE)
-        Surfaces (``SURF_*`` slots of :mod:`flexsat.environment.registry`).
+        Surfaces (``SURF_*`` slots of :mod:`flexsat.environment.registry`): centre [m],
+        unit normal [-], area [m^2], optical fractions and drag coefficient [-].
     positions : ndarray, shape (k + s, 3)
         Where each load acts: the mass elements, then the surfaces' centres [m].
     owner : ndarray, shape (k + s, 2), int64
         Per load point, the offset in q of its appendage's first coordinate and their
-        count; (-1, 0) for a point carried by the hub.
+        count; (-1, 0) for a point carried by the hub [-].
     jacobian : ndarray, shape (k + s, 3, c)
         G_k, c the largest coordinate count [m per coordinate unit].
     hub_inertia : ndarray, shape (3, 3)
         The hub's inertia about its centre of mass, frame B [kg m^2].
     appendage : ndarray, shape (k + s,), int64
-        The appendage index of each load point, -1 for the hub.
+        The appendage index of each load point, -1 for the hub [-].
     """
 
     points: np.ndarray

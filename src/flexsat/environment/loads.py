@@ -4,13 +4,14 @@ torque and each appendage's generalized forces (numba, allocation-free).
 At a control instant the loop interpolates the ephemeris at t
 (:func:`ephemeris_row`), takes C_BN from the hub attitude (:func:`attitude_cbn`)
 and calls :func:`environment_loads`: each registered model's kernel adds its forces
-on the load points and its torque on the hub; a point the hub carries adds
-r_k x F_k to the hub torque, a point of an appendage adds G_k^T F_k to that
-appendage's generalized forces (:mod:`flexsat.environment.geometry`). The loads are
-held until the next control instant, like the actuators' torque: they change at the
-orbit's rate and the attitude's (a hold of one control period moves them by
-dt |d tau/dt|, under 1e-4 of their size at a 0.1 s period in low Earth orbit: docs/
-environment.md, 'When the loads are evaluated').
+on the load points and its torque on the hub; every point adds r_k x F_k to the hub
+torque (the virtual work of a rotation of the hub, which carries the appendages), and
+a point of an appendage also adds G_k^T F_k to that appendage's generalized forces
+(:mod:`flexsat.environment.geometry`; docs/environment.md, 'Appendage loads').
+The loads are held until the next control instant, like the actuators' torque: they
+turn at the orbit's rate n and the attitude's |omega|, so a hold of one control period
+dt moves them by about (n + |omega|) dt of their size, 1e-4 for n dt at 0.1 s in low
+Earth orbit (docs/environment.md, 'When the loads are evaluated').
 """
 
 from __future__ import annotations
@@ -25,6 +26,7 @@ from numba import njit
 from flexsat.compiled.first_class import first_class
 from flexsat.compiled.linalg3 import load_m33_at, mm, rot_zyx
 from flexsat.environment.geometry import LoadGeometry, load_geometry
+from flexsat.environment.magnetorquers import DUMP_SIZE, dump_momentum
 from flexsat.environment.registry import (
     EPH_LIT,
     EPH_R,
@@ -34,6 +36,7 @@ from flexsat.environment.registry import (
     LOAD_SIGNATURE,
     environment_model,
 )
+from flexsat.errors import ConfigError
 
 __all__ = [
     "MODEL_SLOTS",
@@ -61,7 +64,7 @@ class LoadContext:
     plant : flexsat.dynamics.plant.Plant
         The satellite.
     ephemeris : ndarray, shape (n, 13)
-        The run's ephemeris table (ECI, SI).
+        The run's ephemeris table (ECI) [s, m, m/s, -, m, -, rad].
     epoch : str
         Its epoch, ISO 8601 UTC.
     hub_inertia : ndarray, shape (3, 3)
@@ -82,18 +85,19 @@ class EnvironmentData(NamedTuple):
     active : bool
         Whether any model acts (False: the loop never calls the environment).
     ephemeris : ndarray, shape (n, 13)
-        The ephemeris table.
+        The ephemeris table (ECI) [s, m, m/s, -, m, -, rad].
     row : ndarray, shape (13,)
-        The ephemeris at the current instant.
+        The ephemeris at the current instant [s, m, m/s, -, m, -, rad].
     C_BN : ndarray, shape (3, 3)
-        ECI to hub frame B at the current instant.
+        ECI to hub frame B at the current instant [-].
     points, surfaces, positions, owner, jacobian : ndarray
-        The load geometry (:class:`~flexsat.environment.geometry.LoadGeometry`).
+        The load geometry (:class:`~flexsat.environment.geometry.LoadGeometry`, its
+        units) [m, kg, m^2, -].
     kernels : tuple
         The models' load kernels (first-class, :data:`LOAD_SIGNATURE`), padded to
         :data:`MODEL_SLOTS`.
     params : tuple of ndarray
-        Each model's packed parameters, padded.
+        Each model's packed parameters, padded [SI].
     n_models : int
         Models that act.
     force : ndarray, shape (k + s, 3)
@@ -106,6 +110,14 @@ class EnvironmentData(NamedTuple):
     applied : ndarray, shape (n_dof,)
         What the plant steps under: the joint actuator's generalized forces plus
         ``Q`` (:func:`applied_forces`) [N, N m per coordinate].
+    dumping : bool
+        Magnetorquers dump the wheels' momentum
+        (:mod:`flexsat.environment.magnetorquers`).
+    dump : ndarray, shape (5,)
+        Their packed parameters (:func:`~flexsat.environment.magnetorquers.dump_momentum`)
+        [1/s, A m^2, A m^2, -, -].
+    dipole : ndarray, shape (3,)
+        Their dipole, held between instants, hub frame B [A m^2].
     """
 
     active: bool
@@ -124,6 +136,9 @@ class EnvironmentData(NamedTuple):
     torque: np.ndarray
     Q: np.ndarray
     applied: np.ndarray
+    dumping: bool
+    dump: np.ndarray
+    dipole: np.ndarray
 
 
 @njit(cache=True)
@@ -138,7 +153,8 @@ def _padded(entries: tuple, filler) -> tuple:
                                   - len(entries))  # fmt: skip
 
 
-def environment_data(plant, config, ephemeris: np.ndarray, epoch: str) -> EnvironmentData:
+def environment_data(plant, config, ephemeris: np.ndarray, epoch: str,
+                     momentum_column: int | None = None) -> EnvironmentData:  # fmt: skip
     """The environment of a run, packed for the loop.
 
     Parameters
@@ -148,9 +164,13 @@ def environment_data(plant, config, ephemeris: np.ndarray, epoch: str) -> Enviro
     config : flexsat.environment.config.EnvironmentConfig
         The ``[environment]`` table.
     ephemeris : ndarray, shape (n, 13)
-        The run's ephemeris (ECI, SI, uniform in time from t = 0, n >= 2).
+        The run's ephemeris (ECI, uniform in time from t = 0, n >= 2)
+        [s, m, m/s, -, m, -, rad].
     epoch : str
         Its epoch, ISO 8601 UTC.
+    momentum_column : int, optional
+        Where the loop's record row holds the wheels' ``wheel_momentum_B`` (3): needed
+        by the magnetorquers.
 
     Returns
     -------
@@ -165,6 +185,14 @@ def environment_data(plant, config, ephemeris: np.ndarray, epoch: str) -> Enviro
     params = tuple(np.ascontiguousarray(c.packed(context), dtype=float) for c in models.values())
     filler = first_class(_no_load, LOAD_SIGNATURE)
     rows = geometry.positions.shape[0]
+    dump = np.zeros(DUMP_SIZE)
+    if config.magnetorquers is not None:
+        if momentum_column is None:
+            raise ConfigError("environment.magnetorquers: they dump the reaction wheels' "
+                              "momentum: the [actuator] must be kind = 'wheels'")  # fmt: skip
+        mt = config.magnetorquers
+        dump[:] = (mt.gain_1_s, mt.dipole_max_a_m2, mt.quantum_a_m2, momentum_column,
+                   list(models).index("magnetic"))  # fmt: skip
     return EnvironmentData(
         active=bool(models), ephemeris=eph, row=eph[0].copy(), C_BN=np.eye(3),
         points=geometry.points, surfaces=geometry.surfaces, positions=geometry.positions,
@@ -172,6 +200,7 @@ def environment_data(plant, config, ephemeris: np.ndarray, epoch: str) -> Enviro
         kernels=_padded(kernels, filler), params=_padded(params, np.zeros(0)),
         n_models=len(models), force=np.zeros((rows, 3)), torque=np.zeros(3),
         Q=np.zeros(plant.n_dof), applied=np.zeros(plant.n_dof),
+        dumping=config.magnetorquers is not None, dump=dump, dipole=np.zeros(3),
     )  # fmt: skip
 
 
@@ -196,7 +225,7 @@ def idle_environment(n_dof: int) -> EnvironmentData:
         owner=np.zeros((0, 2), dtype=np.int64), jacobian=np.zeros((0, 3, 1)),
         kernels=(filler,) * MODEL_SLOTS, params=(np.zeros(0),) * MODEL_SLOTS, n_models=0,
         force=np.zeros((0, 3)), torque=np.zeros(3), Q=np.zeros(n_dof),
-        applied=np.zeros(n_dof),
+        applied=np.zeros(n_dof), dumping=False, dump=np.zeros(DUMP_SIZE), dipole=np.zeros(3),
     )  # fmt: skip
 
 
@@ -239,8 +268,17 @@ def ephemeris_row(eph, t, out):
 
 @njit(cache=True)
 def attitude_cbn(x, frame, C_BN):
-    """C_BN = (R_NF R_FB(Theta))^T from the plant state ``x`` (Theta = x[3:6]) and the
-    attitude reference ``frame`` (R_NF, row-major (9,)) into ``C_BN`` (3, 3)."""
+    """C_BN = (R_NF R_FB(Theta))^T from the plant state and the attitude reference frame.
+
+    Parameters
+    ----------
+    x : ndarray, shape (2 n_dof,)
+        The plant state, its ZYX Euler angles Theta = x[3:6] relative to F [m, rad, ...].
+    frame : ndarray, shape (9,)
+        R_NF, the attitude reference frame F in ECI, row-major [-].
+    C_BN : ndarray, shape (3, 3)
+        ECI to hub frame B [-], written.
+    """
     R = mm(load_m33_at(frame, 0), rot_zyx(x[3], x[4], x[5]))
     for i in range(3):
         for j in range(3):
@@ -248,14 +286,16 @@ def attitude_cbn(x, frame, C_BN):
 
 
 @njit(cache=True)
-def environment_loads(env):
+def environment_loads(env, held):
     """Every model's loads at ``env.row`` and ``env.C_BN``, into ``env.torque`` and
-    ``env.Q`` (module docstring).
+    ``env.Q`` (module docstring), and the magnetorquers' torque when they act.
 
     Parameters
     ----------
     env : EnvironmentData
-        Its ``force``, ``torque`` and ``Q`` are overwritten.
+        Its ``force``, ``torque``, ``Q`` and ``dipole`` are overwritten.
+    held : ndarray
+        The loop's record row, where the wheels' momentum is read [per channel].
 
     Returns
     -------
@@ -275,14 +315,17 @@ def environment_loads(env):
     pos, G = env.positions, env.jacobian
     for i in range(force.shape[0]):
         fx, fy, fz = force[i, 0], force[i, 1], force[i, 2]
+        # every point's moment reaches the hub's attitude (Q_Theta = S^T sum r_k x F_k):
+        # an appendage's coordinates are relative to the hub, which carries it
+        torque[0] += pos[i, 1] * fz - pos[i, 2] * fy
+        torque[1] += pos[i, 2] * fx - pos[i, 0] * fz
+        torque[2] += pos[i, 0] * fy - pos[i, 1] * fx
         offset, count = env.owner[i, 0], env.owner[i, 1]
-        if offset < 0:
-            torque[0] += pos[i, 1] * fz - pos[i, 2] * fy
-            torque[1] += pos[i, 2] * fx - pos[i, 0] * fz
-            torque[2] += pos[i, 0] * fy - pos[i, 1] * fx
-        else:
-            for c in range(count):
-                Q[offset + c] += G[i, 0, c] * fx + G[i, 1, c] * fy + G[i, 2, c] * fz
+        for c in range(count if offset >= 0 else 0):
+            Q[offset + c] += G[i, 0, c] * fx + G[i, 1, c] * fy + G[i, 2, c] * fz
+    if env.dumping:
+        dump_momentum(env.dump, env.row, env.C_BN, env.params[int(env.dump[4])], held, torque,
+                      env.dipole)  # fmt: skip
     return status
 
 

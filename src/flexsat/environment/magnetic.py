@@ -75,7 +75,8 @@ def igrf_field(eph: np.ndarray, epoch: str, max_degree: int = 13) -> np.ndarray:
     Parameters
     ----------
     eph : ndarray, shape (n, 13)
-        The ephemeris (:data:`~flexsat.environment.registry.EPHEMERIS_COLUMNS`).
+        The ephemeris (:data:`~flexsat.environment.registry.EPHEMERIS_COLUMNS`)
+        [s, m, m/s, -, m, -, rad].
     epoch : str
         Its epoch, ISO 8601 UTC: the date of the coefficients.
     max_degree : int
@@ -110,7 +111,20 @@ def igrf_field(eph: np.ndarray, epoch: str, max_degree: int = 13) -> np.ndarray:
 
 @njit(cache=True)
 def field_at(eph, params):
-    """B at the ephemeris row ``eph``, ECI [T], from the packed parameters (a 3-tuple)."""
+    """The geomagnetic field at an ephemeris row (module docstring).
+
+    Parameters
+    ----------
+    eph : ndarray, shape (13,)
+        The ephemeris row (``EPHEMERIS_COLUMNS``, ECI) [s, m, m/s, -, m, -, rad].
+    params : ndarray
+        The magnetic model's packed parameters (``MagneticConfig.packed``) [SI].
+
+    Returns
+    -------
+    tuple of 3 float
+        B, ECI [T]: the tilted dipole, or the tabulated IGRF interpolated in time.
+    """
     if params[_MODE] != 0.0:
         step, n = params[_TABLE], int(params[_TABLE + 1])
         u = max(0.0, eph[EPH_T] / step)
@@ -135,7 +149,31 @@ def field_at(eph, params):
 
 @njit(cache=True)  # compiled with LOAD_SIGNATURE on first use
 def magnetic_load(eph, C_BN, points, surfaces, params, force, torque):
-    """tau = m_res x B_B on the hub (module docstring)."""
+    """tau = m_res x B_B on the hub (module docstring).
+
+    Parameters
+    ----------
+    eph : ndarray, shape (13,)
+        The ephemeris row at the instant (``EPHEMERIS_COLUMNS``, ECI)
+        [s, m, m/s, -, m, -, rad].
+    C_BN : ndarray, shape (3, 3)
+        Rotation from ECI to hub frame B [-].
+    points : ndarray, shape (k, 4)
+        Mass elements: position from the hub centre of mass, frame B [m], mass [kg].
+    surfaces : ndarray, shape (s, SURFACE_SIZE)
+        Surfaces (``SURF_*`` slots of :mod:`flexsat.environment.registry`) [m, -, m^2, -].
+    params : ndarray, shape (p,)
+        The model's packed parameters (its config's ``packed``) [SI].
+    force : ndarray, shape (k + s, 3)
+        Force on each mass element, then each surface's centre, frame B [N], added to.
+    torque : ndarray, shape (3,)
+        Torque on the hub acting on no point, frame B [N m], added to.
+
+    Returns
+    -------
+    int
+        0 (the load cannot fail).
+    """
     bx, by, bz = field_at(eph, params)
     b0 = C_BN[0, 0] * bx + C_BN[0, 1] * by + C_BN[0, 2] * bz
     b1 = C_BN[1, 0] * bx + C_BN[1, 1] * by + C_BN[1, 2] * bz

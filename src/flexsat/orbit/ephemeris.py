@@ -61,7 +61,8 @@ class Ephemeris:
     Parameters
     ----------
     table : ndarray, shape (n, 13)
-        float64, C-contiguous; columns :data:`EPHEMERIS_COLUMNS`, row k at t = k step_s.
+        float64, C-contiguous; columns :data:`EPHEMERIS_COLUMNS`, row k at t = k step_s
+        [s, m, m/s, -, m, -, rad].
     epoch : str
         The UTC time of t = 0, ISO 8601.
     step_s : float
@@ -187,7 +188,7 @@ def ephemeris_at(eph, t, out):
     Parameters
     ----------
     eph : ndarray, shape (n, 13)
-        The table (module docstring), n >= 2.
+        The table (module docstring), n >= 2 [s, m, m/s, -, m, -, rad].
     t : float
         Time since the epoch [s].
     out : ndarray, shape (13,)

@@ -42,7 +42,7 @@ def true_anomaly(mean_anomaly: float, e: float) -> float:
     mean_anomaly : float
         M [rad].
     e : float
-        Eccentricity, in [0, 1).
+        Eccentricity, in [0, 1) [-].
 
     Returns
     -------
@@ -105,7 +105,7 @@ def j2_acceleration(r: np.ndarray, j2: float = EARTH_J2) -> np.ndarray:
     r : ndarray, shape (3,)
         Position [m].
     j2 : float
-        The zonal coefficient (0: two-body).
+        The zonal coefficient (0: two-body) [-].
 
     Returns
     -------
@@ -169,7 +169,18 @@ def _satrec(orbit: OrbitConfig):
 
 
 def tle_epoch_jd(orbit: OrbitConfig) -> tuple[float, float]:
-    """The TLE's epoch as a two-part Julian date (UTC) [d]."""
+    """The TLE's epoch as a two-part Julian date (UTC).
+
+    Parameters
+    ----------
+    orbit : OrbitConfig
+        An orbit given by its TLE (the ``orbit`` extra's sgp4 reads it).
+
+    Returns
+    -------
+    tuple of float
+        The whole and fractional parts of the Julian date [d].
+    """
     satellite = _satrec(orbit)
     return float(satellite.jdsatepoch), float(satellite.jdsatepochF)
 

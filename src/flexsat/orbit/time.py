@@ -94,7 +94,7 @@ def precession_angles(t_centuries):
     Parameters
     ----------
     t_centuries : float
-        Julian centuries of TT since J2000.
+        Julian centuries of TT since J2000 [cy].
 
     Returns
     -------
@@ -116,7 +116,7 @@ def precession_matrix(t_centuries):
     Parameters
     ----------
     t_centuries : float
-        Julian centuries of TT since J2000.
+        Julian centuries of TT since J2000 [cy].
 
     Returns
     -------

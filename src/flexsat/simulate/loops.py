@@ -426,7 +426,7 @@ def rk4_closed_loop(x, clock, stages, d, records, plant, frame):
                 env = d.env
                 ephemeris_row(env.ephemeris, t, env.row)
                 attitude_cbn(x, frame, env.C_BN)
-                status |= environment_loads(env)
+                status |= environment_loads(env, d.held)
                 applied_forces(env, d.Q, d.flow.held, clock.continuous)
             if status != 0:
                 return STATUS_CONTROL_FAILED, k, row - records.start

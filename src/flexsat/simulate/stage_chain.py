@@ -240,11 +240,12 @@ def loop_data(layout: LoopLayout, scenario: SlewScenario, J: np.ndarray,
         joint_state=state[layout.joint_state],
         joint_record=held[layout.joint_record],
         Q=np.zeros(layout.plant.n_dof),
-        env=slew_environment(scenario, plant),
+        env=slew_environment(scenario, plant, layout),
     )
 
 
-def slew_environment(scenario: SlewScenario, plant: Plant) -> EnvironmentData:
+def slew_environment(scenario: SlewScenario, plant: Plant,
+                     layout: LoopLayout | None = None) -> EnvironmentData:  # fmt: skip
     """The environment a slew flies in: its ``[environment]`` models along the orbit its
     ``[orbit]`` table gives (the ephemeris built over the run), or none.
 
@@ -254,6 +255,8 @@ def slew_environment(scenario: SlewScenario, plant: Plant) -> EnvironmentData:
         The slew (its ``environment`` and ``orbit`` tables, both optional).
     plant : Plant
         The plant flown (its geometry and mass elements).
+    layout : LoopLayout, optional
+        The loop's layout: where the magnetorquers read the wheels' momentum.
 
     Returns
     -------
@@ -271,4 +274,8 @@ def slew_environment(scenario: SlewScenario, plant: Plant) -> EnvironmentData:
 
     step = EPHEMERIS_STEP_S
     ephemeris = build_ephemeris(orbit, scenario.duration_s + step, step)
-    return environment_data(plant, config, ephemeris.table, ephemeris.epoch)
+    column = None
+    for channel, columns in layout.channels() if layout is not None else ():
+        if channel.name == "wheel_momentum_B":
+            column = columns.start
+    return environment_data(plant, config, ephemeris.table, ephemeris.epoch, column)

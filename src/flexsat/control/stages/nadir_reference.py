@@ -56,7 +56,25 @@ class NadirReferenceConfig(PlantStageConfig):
 
 @njit(cache=True, error_model="numpy")
 def lvlh_target(row, params, q_d, omega_d, omega_dot_d):
-    """The nadir target from one ephemeris row (13,): q_d, omega_d, omega_dot_d (frame D)."""
+    """The nadir target from one ephemeris row: q_d, omega_d, omega_dot_d (frame D).
+
+    The LVLH frame: z to nadir, y against the orbit normal; its rate |h|/r^2 and
+    acceleration -2 |h| (r . v)/r^4 about -y (docs/orbit.md, 'Pointing targets').
+
+    Parameters
+    ----------
+    row : ndarray, shape (13,)
+        The ephemeris at the instant (``EPHEMERIS_COLUMNS``) [s, m, m/s, -, m, -, rad].
+    params : ndarray
+        The stage's packed parameters: q_off (4), the rows, the table
+        (:func:`~flexsat.control.stages._targets.packed_target`) [-, -, SI].
+    q_d : ndarray, shape (4,)
+        The target attitude, quaternion of D in ECI, scalar first [-], written.
+    omega_d : ndarray, shape (3,)
+        The target's angular rate, frame D [rad/s], written.
+    omega_dot_d : ndarray, shape (3,)
+        The target's angular acceleration, frame D [rad/s^2], written.
+    """
     rx, ry, rz, vx, vy, vz = row[1], row[2], row[3], row[4], row[5], row[6]
     r2 = rx * rx + ry * ry + rz * rz
     r = sqrt(r2)

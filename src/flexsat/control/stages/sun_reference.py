@@ -56,7 +56,24 @@ class SunReferenceConfig(PlantStageConfig):
 
 @njit(cache=True, error_model="numpy")
 def sun_target(s0, s1, s2, d0, d1, d2, params, q_d, omega_d, omega_dot_d):
-    """The Sun target from the unit Sun direction s and its rate s' (ECI) [1, 1/s]."""
+    """The Sun target from the unit Sun direction s and its rate s' (ECI).
+
+    Parameters
+    ----------
+    s0, s1, s2 : float
+        The unit Sun direction s, ECI [-].
+    d0, d1, d2 : float
+        Its rate s', ECI [1/s].
+    params : ndarray
+        The stage's packed parameters: q_off (4), the rows, the table
+        (:func:`~flexsat.control.stages._targets.packed_target`) [-, -, SI].
+    q_d : ndarray, shape (4,)
+        The target attitude, quaternion of D in ECI, scalar first [-], written.
+    omega_d : ndarray, shape (3,)
+        The target's angular rate, frame D [rad/s], written.
+    omega_dot_d : ndarray, shape (3,)
+        The target's angular acceleration, frame D [rad/s^2], written.
+    """
     rho = sqrt(s0 * s0 + s1 * s1)  # |Z x s|
     x0, x1, x2 = -s1 / rho, s0 / rho, 0.0
     y0, y1, y2 = s1 * x2 - s2 * x1, s2 * x0 - s0 * x2, s0 * x1 - s1 * x0
