@@ -85,3 +85,49 @@ def test_chain_and_craig_bampton_responses_agree(analytic):
     modal = run_openloop(_satellite(32, 16), scenario).dataset
     w_chain, w_modal = chain["omega"].values[:, 2], modal["omega"].values[:, 2]
     assert np.abs(w_chain - w_modal).max() <= 1e-2 * np.abs(w_modal).max()
+
+
+def _hub_row_in_root_loads(omega: float) -> float:
+    """det of (M.12) with the hub row in the beams' root loads, J omega^2 Theta +
+    2 EI beta^2 ((a - c) - R beta (b - d)) = 0 (docs/model.md, 'Hub and beam: the
+    analytic reference'), scaled by 1 / cosh^2 (beta L)."""
+    beta = (RHO_A * omega**2 / EI_Z) ** 0.25
+    x, k = beta * L, 2.0 * EI_Z * beta**2
+    A = np.array([
+        [1.0, 0.0, 1.0, 0.0, -ROOT],
+        [0.0, beta, 0.0, beta, -1.0],
+        [np.cosh(x), np.sinh(x), -np.cos(x), -np.sin(x), 0.0],
+        [np.sinh(x), np.cosh(x), np.sin(x), -np.cos(x), 0.0],
+        [k, -k * ROOT * beta, -k, k * ROOT * beta, HUB_J * omega**2],
+    ])  # fmt: skip
+    return float(np.linalg.det(A) / np.cosh(x) ** 2)
+
+
+def test_both_forms_of_the_hub_equation_have_the_same_roots(analytic):
+    # The reference solves (M.12) with the hub row in angular momentum (a quadrature);
+    # the root-load form is its integration by parts, closed form. Brent's method on
+    # the second, bracketed 1 % around each root of the first, finds them within 1e-12
+    # relative (both converged to 1e-14; the quadrature is exact to round-off).
+    from scipy.optimize import brentq
+
+    for f in analytic:
+        w = 2.0 * np.pi * f
+        root = brentq(_hub_row_in_root_loads, 0.99 * w, 1.01 * w, xtol=1e-14, rtol=1e-14)
+        assert root / w == pytest.approx(1.0, abs=1e-12)
+
+
+def test_three_formulations_agree_on_the_first_three_frequencies(analytic):
+    # The chain's error is O(1/N^2) (the test above): Richardson's (4 f_64 - f_32) / 3
+    # removes it, leaving the O(1/N^4) term (measured -1.6e-6, -8.4e-6, -2.1e-5 from the
+    # analytic ones; from N = 16 and 32, -1.0e-6, -1.2e-5, -3.2e-5). The Craig-Bampton
+    # beam (32 elements, 16 modes) is within 3.2e-6. Required: each pair within 1e-4.
+    f32, f64 = (coupled_yaw_frequencies(chain_satellite(n), 3) for n in (32, 64))
+    formulations = {
+        "chain (Richardson, N = 32, 64)": (4.0 * f64 - f32) / 3.0,
+        "Craig-Bampton (32 elements, 16 modes)": coupled_yaw_frequencies(_satellite(32, 16), 3),
+        "analytic (M.12)": analytic,
+    }
+    for name, f in formulations.items():
+        print(f"{name}: {np.array2string(f, precision=6)} Hz")
+    for (a, fa), (b, fb) in itertools.combinations(formulations.items(), 2):
+        assert np.all(np.abs(fa / fb - 1.0) <= 1e-4), (a, b)
