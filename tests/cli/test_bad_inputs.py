@@ -445,6 +445,45 @@ def _budget(id: str, pointing: str, fragment: str) -> Bad:
     return Bad(id, argv, fragment, files)
 
 
+def _jitter(
+    id: str,
+    options: list[str],
+    fragment: str,
+    stepper: str | None = None,
+    microvibration: str | None = None,
+) -> Bad:
+    """``flexsat jitter`` with ``options``, a [stepper] file and a scenario's microvibration."""
+    argv, files = ["jitter", "--speeds", "100:6000:20", *options], {}
+    if stepper is not None:
+        argv += ["--stepper", "{tmp}/st.toml"]
+        files["st.toml"] = stepper
+    if microvibration is not None:
+        argv += ["--scenario", "{tmp}/s.toml"]
+        files["s.toml"] = f'[actuator]\nkind = "wheels"\n{microvibration}'
+    return Bad(id, argv, fragment, files)
+
+
+_STEP = '[stepper]\ncoordinate = "panel_1.eta_ry"\nrate_deg_s = 0.06\n'
+_ONE = "harmonics = [{number = 1.0, amplitude_nm = 0.01}]\n"
+_VIB = "[actuator.microvibration]\n"
+JITTER = [
+    _jitter("jitter speeds of two numbers", ["--speeds", "100:6000"], "--speeds: expected LOW:HIGH:COUNT, e.g. 100:6000:400, got '100:6000'"),
+    _jitter("jitter speeds descending", ["--speeds", "6000:100:10"], "--speeds: need 0 < LOW < HIGH <= 1e6 rpm and 2 <= COUNT <= 100000, got '6000:100:10'"),
+    _jitter("jitter speeds of one speed", ["--speeds", "100:6000:1"], "2 <= COUNT <= 100000, got '100:6000:1'"),
+    _jitter("jitter window zero", ["--window", "0"], "--window: the RPE window must be > 0 s, got 0"),
+    _jitter("jitter window negative", ["--window", "-2"], "--window: the RPE window must be > 0 s, got -2"),
+    _jitter("jitter boresight zero", ["--boresight", "0,0,0"], "boresight: three finite numbers, not all zero"),
+    _jitter("jitter boresight of two numbers", ["--boresight", "1,2"], "--boresight: expected three comma-separated numbers, got '1,2'"),
+    _jitter("jitter stepper step angle zero", [], "{tmp}/st.toml: stepper: step_angle_deg: Input should be greater than 0", stepper=_STEP + "step_angle_deg = 0.0\n" + _ONE),
+    _jitter("jitter stepper harmonic number zero", [], "stepper: harmonics[0].number: Input should be greater than 0", stepper=_STEP + "step_angle_deg = 0.01\nharmonics = [{number = 0.0, amplitude_nm = 0.01}]\n"),
+    _jitter("jitter stepper on an unknown coordinate", [], "actuated: unknown coordinate 'panel_1.alpha'", stepper=_STEP.replace("eta_ry", "alpha") + "step_angle_deg = 0.01\n" + _ONE),
+    _jitter("jitter stepper file without its table", [], "{tmp}/st.toml: a [stepper] table is needed", stepper="rate_deg_s = 0.06\n"),
+    _jitter("jitter negative imbalance", [], "actuator.microvibration.static_imbalance_kg_m: Input should be greater than or equal to 0", microvibration=_VIB + "static_imbalance_kg_m = -1e-5\n"),
+    _jitter("jitter harmonic number zero", [], "actuator.microvibration.radial_force[0].number: Input should be greater than 0", microvibration=_VIB + "radial_force = [{number = 0.0, coefficient = 1e-6}]\n"),
+    _jitter("jitter wheels without microvibration", [], 'actuator.microvibration: the jitter needs [actuator] kind = "wheels"', microvibration=""),
+    Bad("jitter stepper file missing", ["jitter", "--stepper", "{tmp}/none.toml"], "stepper file not found"),
+]  # fmt: skip
+
 _RPE = "[pointing.indices.RPE]\nbound_deg = 0.01\n"
 BUDGET = [
     _budget("budget window longer than the run", _RPE + "window_s = 50.0", "pointing.indices.RPE.window_s: 50 s is longer than the record: at most 1.1 s"),
@@ -457,6 +496,7 @@ BUDGET = [
     _budget("budget ensemble of one run", 'interpretation = "ensemble"\n[pointing.indices.APE]\nbound_deg = 0.01', "pointing.interpretation: 'ensemble' needs a campaign"),
     Bad("budget of a missing result", ["budget", "{tmp}/none.nc", "--requirements", "{tmp}/req.toml"], "RESULT_OR_CAMPAIGN {tmp}/none.nc: no such file or folder", {"req.toml": "[pointing]\n"}),
 ]  # fmt: skip
+BUDGET += JITTER  # the microvibration part of the pointing budget
 
 
 def _nastran(id: str, change: str, extra: list[str], fragment: str) -> Bad:
