@@ -593,6 +593,9 @@ def test_bad_input_gives_one_message_and_exit_code_2(row: Bad, tmp_path, capsys,
         created
     )
 
+    Bad("fmu export suffix", ["fmu", "export", "-o", "{tmp}/plant.zip"], "--output: the suffix must be .fmu, got 'plant.zip'"),
+    Bad("fmu export dt too long", ["fmu", "export", "-o", "{tmp}/plant.fmu", "--dt", "0.5"], "--dt: must be in (0, 0.1] s, got 0.5"),
+    Bad("fmu export config missing", ["fmu", "export", "{tmp}/absent.toml", "-o", "{tmp}/plant.fmu"], "absent.toml"),
 
 def test_an_unreachable_scheduler_is_refused_before_the_store_exists(tmp_path, capsys):
     outcome = flexsat(["campaign", "sensitivity", "--scheduler", "tcp://127.0.0.1:1",
