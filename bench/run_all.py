@@ -51,6 +51,7 @@ ORDER = (
     "bench_campaign_start",
     "bench_figures",
     "bench_modal",
+    "bench_modal_large_motion",
     "bench_demo",
     "bench_basilisk",
     "bench_basilisk_chain",
