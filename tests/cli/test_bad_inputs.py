@@ -549,6 +549,9 @@ _SLEW_FILE = {"s.toml": 'name = "served"\n'}
 REALTIME = [
     Bad("serve speed zero", [*_SERVE, "--speed", "0"], "--speed: must be in (0, 1000], got 0", _SLEW_FILE),
     Bad("serve speed too fast", [*_SERVE, "--speed", "5000"], "--speed: must be in (0, 1000], got 5000", _SLEW_FILE),
+    Bad("fmu export suffix", ["fmu", "export", "-o", "{tmp}/plant.zip"], "--output: the suffix must be .fmu, got 'plant.zip'"),
+    Bad("fmu export dt too long", ["fmu", "export", "-o", "{tmp}/plant.fmu", "--dt", "0.5"], "--dt: must be in (0, 0.1] s, got 0.5"),
+    Bad("fmu export config missing", ["fmu", "export", "{tmp}/absent.toml", "-o", "{tmp}/plant.fmu"], "absent.toml"),
     Bad("serve client timeout negative", [*_SERVE, "--client-timeout", "-1"], "--client-timeout: must be in (0, 3600] s, got -1", _SLEW_FILE),
     Bad("serve endpoint scheme", [*_SERVE, "--sensor-endpoint", "http://127.0.0.1:80"], "--sensor-endpoint: expected udp://HOST:PORT, tcp://HOST:PORT (ZeroMQ) or ipc://PATH (ZeroMQ), got 'http://127.0.0.1:80'", _SLEW_FILE),
     Bad("serve port out of range", [*_SERVE, "--command-endpoint", "udp://127.0.0.1:70000"], "--command-endpoint: expected a host and a port in 1-65535", _SLEW_FILE),
@@ -593,9 +596,6 @@ def test_bad_input_gives_one_message_and_exit_code_2(row: Bad, tmp_path, capsys,
         created
     )
 
-    Bad("fmu export suffix", ["fmu", "export", "-o", "{tmp}/plant.zip"], "--output: the suffix must be .fmu, got 'plant.zip'"),
-    Bad("fmu export dt too long", ["fmu", "export", "-o", "{tmp}/plant.fmu", "--dt", "0.5"], "--dt: must be in (0, 0.1] s, got 0.5"),
-    Bad("fmu export config missing", ["fmu", "export", "{tmp}/absent.toml", "-o", "{tmp}/plant.fmu"], "absent.toml"),
 
 def test_an_unreachable_scheduler_is_refused_before_the_store_exists(tmp_path, capsys):
     outcome = flexsat(["campaign", "sensitivity", "--scheduler", "tcp://127.0.0.1:1",
