@@ -13,6 +13,7 @@ checks only the bookkeeping.
 from __future__ import annotations
 
 import json
+import os
 import socket
 import subprocess
 import sys
@@ -25,9 +26,10 @@ import pytest
 from flexsat.analysis.requirements import slew_metrics
 from flexsat.config import nominal
 from flexsat.dynamics.plant import Plant
+from flexsat.errors import ConfigError
 from flexsat.realtime import packets
 from flexsat.realtime.client import PlantClient
-from flexsat.realtime.server import serve
+from flexsat.realtime.server import fifo_priority, serve
 from flexsat.realtime.transport import client_link, plant_link
 from flexsat.simulate import SlewScenario, load_slew, run_slew
 from tests.cli.harness import flexsat
@@ -221,3 +223,25 @@ def test_paced_serve_and_fsw_commands_write_a_slew_s_records(tmp_path, scenario_
     assert {"r1_pass", "r2_pass", "r3_pass"} <= metrics.keys()
     assert (tmp_path / "run" / "result.nc").is_file()
     assert (tmp_path / "run" / "metrics.json").is_file()
+
+
+def test_fifo_priority_runs_the_block_under_sched_fifo_and_restores_the_policy():
+    if not hasattr(os, "sched_setscheduler"):
+        with pytest.raises(ConfigError, match="--priority: SCHED_FIFO is not available"):
+            with fifo_priority(10):
+                pass
+        return
+    before = os.sched_getscheduler(0)
+    try:
+        with fifo_priority(10):
+            inside = os.sched_getscheduler(0), os.sched_getparam(0).sched_priority
+    except ConfigError as error:  # not permitted here: one message, the policy unchanged
+        assert "--priority: SCHED_FIFO needs the CAP_SYS_NICE capability" in str(error)
+    else:
+        assert inside == (os.SCHED_FIFO, 10)
+    assert os.sched_getscheduler(0) == before
+    with fifo_priority(None):  # the normal scheduler, left alone
+        assert os.sched_getscheduler(0) == before
+    with pytest.raises(ConfigError, match=r"--priority: must be in 1..99 \(SCHED_FIFO\), got 0"):
+        with fifo_priority(0):
+            pass

@@ -17,6 +17,7 @@ from flexsat.dynamics.plant import Plant
 from flexsat.errors import SimulationError
 from flexsat.realtime import packets
 from flexsat.realtime.client import PlantClient
+from flexsat.realtime.server import check_priority, fifo_priority
 from flexsat.realtime.transport import Link, check_seconds
 from flexsat.simulate.closedloop import slew_design_inertia
 from flexsat.simulate.scenario import SlewScenario
@@ -25,7 +26,8 @@ __all__ = ["fly_remote"]
 
 
 def fly_remote(plant: Plant, scenario: SlewScenario, link: Link, *,
-               connect_timeout_s: float = 60.0, silence_s: float = 5.0) -> dict:  # fmt: skip
+               connect_timeout_s: float = 60.0, silence_s: float = 5.0,
+               priority: int | None = None) -> dict:  # fmt: skip
     """Answer the plant's sensor packets with ``scenario.controller``'s law until END.
 
     Parameters
@@ -41,6 +43,9 @@ def fly_remote(plant: Plant, scenario: SlewScenario, link: Link, *,
         Longest wait for the plant's first sensor packet [s].
     silence_s : float
         A plant silent this long [s] is gone: the client stops.
+    priority : int, optional
+        Answer under SCHED_FIFO at this priority, 1-99
+        (:func:`flexsat.realtime.server.fifo_priority`); default: the normal scheduler.
 
     Returns
     -------
@@ -51,12 +56,13 @@ def fly_remote(plant: Plant, scenario: SlewScenario, link: Link, *,
     Raises
     ------
     ConfigError
-        A timeout out of (0, 3600] s.
+        A timeout out of (0, 3600] s, a priority out of 1-99, or SCHED_FIFO refused.
     SimulationError
         No plant within ``connect_timeout_s``, or the law's step failed.
     """
     check_seconds("--connect-timeout", connect_timeout_s)
     check_seconds("--silence", silence_s)
+    check_priority(priority)
     law = get_law(scenario.controller.kind)
     gains = np.ascontiguousarray(scenario.controller.gains(scenario.actuator), dtype=float)
     J = np.ascontiguousarray(slew_design_inertia(plant, scenario), dtype=float)
@@ -64,11 +70,20 @@ def fly_remote(plant: Plant, scenario: SlewScenario, link: Link, *,
     omega_d, omega_dot_d = np.zeros(3), np.zeros(3)
     state, diag, tau = np.zeros(law.state_size), np.zeros(law.diag_size), np.zeros(3)
     dt = scenario.control_dt_s
-    every, step = scenario.control_every, scenario.dt_s  # t as the loop computes it
     # compile (or load) the step before saying HELLO: the plant's clock starts then
     law.step(q_d, omega_d, omega_dot_d, q_d.copy(), omega_d.copy(), J, gains, state, 0.0, dt,
              tau, diag)  # fmt: skip
     state[:] = 0.0
+    with fifo_priority(priority):
+        return _answer(law, gains, J, q_d, state, diag, tau, scenario, link, connect_timeout_s,
+                       silence_s)  # fmt: skip
+
+
+def _answer(law, gains, J, q_d, state, diag, tau, scenario, link, connect_timeout_s, silence_s):
+    """The loop of :func:`fly_remote`: HELLO, then one command per sensor packet."""
+    omega_d, omega_dot_d = np.zeros(3), np.zeros(3)
+    dt = scenario.control_dt_s
+    every, step = scenario.control_every, scenario.dt_s  # t as the loop computes it
     client = PlantClient(link)
     packet: packets.Sensor | packets.Header | None = client.connect(connect_timeout_s)
     ended = "silence"

@@ -15,9 +15,11 @@ control period, the ``delay`` stage with ``periods = 1`` (``docs/realtime.md``,
 
 from __future__ import annotations
 
+import os
 import sys
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -32,7 +34,8 @@ from flexsat.simulate.python_loop import python_loop
 from flexsat.simulate.result import Result
 from flexsat.simulate.scenario import SlewScenario
 
-__all__ = ["MAX_SPEED", "SPIN_S", "ServeStats", "check_options", "serve"]
+__all__ = ["MAX_SPEED", "SPIN_S", "ServeStats", "check_options", "check_priority",
+           "fifo_priority", "serve"]  # fmt: skip
 
 SPIN_S = 1e-3
 """The pacing spins on the clock for the last this long before an instant [s]; before
@@ -212,6 +215,61 @@ def check_options(speed: float, client_timeout_s: float, start_timeout_s: float)
     check_seconds("--start-timeout", start_timeout_s)
 
 
+def check_priority(priority: int | None) -> None:
+    """Refuse a SCHED_FIFO priority outside 1-99 (None: the normal scheduler).
+
+    Parameters
+    ----------
+    priority : int or None
+        Real-time priority [-].
+
+    Raises
+    ------
+    ConfigError
+        Naming ``--priority``.
+    """
+    if priority is not None and not 1 <= priority <= 99:
+        raise ConfigError(f"--priority: must be in 1..99 (SCHED_FIFO), got {priority}")
+
+
+@contextmanager
+def fifo_priority(priority: int | None) -> Iterator[None]:
+    """Run the block under Linux's SCHED_FIFO at ``priority``, then restore the policy.
+
+    A process of this policy runs as soon as it is runnable, ahead of every normal
+    process: the pacing's sleep wakes on time on a loaded machine. It never spins
+    for long (the pacing spins the last :data:`SPIN_S` before each instant, the rest
+    is sleeping), so the other processes keep the processor between instants.
+
+    Parameters
+    ----------
+    priority : int or None
+        1 (lowest) to 99 [-]; None: leave the scheduler alone.
+
+    Raises
+    ------
+    ConfigError
+        A priority outside 1-99, a system without SCHED_FIFO, or no permission
+        (CAP_SYS_NICE, or root).
+    """
+    check_priority(priority)
+    if priority is None:
+        yield
+        return
+    if not hasattr(os, "sched_setscheduler"):
+        raise ConfigError("--priority: SCHED_FIFO is not available on this system (Linux only)")
+    policy, param = os.sched_getscheduler(0), os.sched_getparam(0)
+    try:
+        os.sched_setscheduler(0, os.SCHED_FIFO, os.sched_param(priority))
+    except PermissionError:
+        raise ConfigError("--priority: SCHED_FIFO needs the CAP_SYS_NICE capability (or root); "
+                          "run without --priority") from None  # fmt: skip
+    try:
+        yield
+    finally:
+        os.sched_setscheduler(0, policy, param)
+
+
 def _compile(plant: Plant, scenario: SlewScenario) -> None:
     """Fly one control period of ``scenario`` under zero torque: the python loop's
     compiled pieces are compiled (or loaded from the disk cache) before the paced run."""
@@ -224,7 +282,8 @@ def _compile(plant: Plant, scenario: SlewScenario) -> None:
 
 def serve(plant: Plant, scenario: SlewScenario, link: Link, *, speed: float = 1.0,
           lockstep: bool = False, client_timeout_s: float = 1.0, start_timeout_s: float = 60.0,
-          log: Callable[[str], None] | None = None) -> tuple[Result, ServeStats]:  # fmt: skip
+          log: Callable[[str], None] | None = None,
+          priority: int | None = None) -> tuple[Result, ServeStats]:  # fmt: skip
     """Fly ``scenario`` with the law outside: a client over ``link`` sends the torques.
 
     Parameters
@@ -249,6 +308,9 @@ def serve(plant: Plant, scenario: SlewScenario, link: Link, *, speed: float = 1.
         How long to wait for the client's HELLO [s, wall].
     log : callable, optional
         Takes one line per event (malformed packets); default: stderr.
+    priority : int, optional
+        Run the paced loop under SCHED_FIFO at this priority, 1-99
+        (:func:`fifo_priority`); default: the normal scheduler.
 
     Returns
     -------
@@ -261,12 +323,14 @@ def serve(plant: Plant, scenario: SlewScenario, link: Link, *, speed: float = 1.
     Raises
     ------
     ConfigError
-        A speed or timeout out of range, or a scenario with a reference or joint
-        actuator (the remote law flies the step reference alone).
+        A speed, timeout or priority out of range, SCHED_FIFO refused, or a scenario
+        with a reference or joint actuator (the remote law flies the step reference
+        alone).
     SimulationError
         No client said HELLO within ``start_timeout_s``.
     """
     check_options(speed, client_timeout_s, start_timeout_s)
+    check_priority(priority)
     run = prepare_slew(plant, scenario)
     layout = run.layout
     if (layout.reference.name != REFERENCES.default
@@ -276,17 +340,18 @@ def serve(plant: Plant, scenario: SlewScenario, link: Link, *, speed: float = 1.
     _compile(plant, scenario)  # before the client starts the clock
     law = _RemoteLaw(link, scenario, speed, lockstep, client_timeout_s,
                      log or (lambda line: print(line, file=sys.stderr)))  # fmt: skip
-    law.wait_for_client(start_timeout_s)
-    start = time.perf_counter()
-    try:
-        status, done, rows = python_loop(plant, scenario, run.x, run.frame, run.stages,
-                                         run.data, run.rec_t, run.rec_x, run.rec_ctrl,
-                                         run.rec_frame, None, None, law,
-                                         layout.continuous)  # fmt: skip
-    except _Stop:
-        status, done = 0, law.k * scenario.control_every
-        rows = -(-done // scenario.record_every)
-    wall = time.perf_counter() - start
+    with fifo_priority(priority):
+        law.wait_for_client(start_timeout_s)
+        start = time.perf_counter()
+        try:
+            status, done, rows = python_loop(plant, scenario, run.x, run.frame, run.stages,
+                                             run.data, run.rec_t, run.rec_x, run.rec_ctrl,
+                                             run.rec_frame, None, None, law,
+                                             layout.continuous)  # fmt: skip
+        except _Stop:
+            status, done = 0, law.k * scenario.control_every
+            rows = -(-done // scenario.record_every)
+        wall = time.perf_counter() - start
     end = packets.encode_end(law.k, round(done * scenario.dt_s * 1e9))
     for _ in range(3):  # a datagram may be lost: the client needs one
         link.send(end)
