@@ -604,6 +604,8 @@ def test_an_unreachable_scheduler_is_refused_before_the_store_exists(tmp_path, c
     assert "cannot connect to the Dask scheduler tcp://127.0.0.1:1" in outcome.stderr
     assert not (tmp_path / "store").exists()
 
+    Bad("serve priority zero", [*_SERVE, "--priority", "0"], "--priority: must be in 1..99 (SCHED_FIFO), got 0", _SLEW_FILE),
+    Bad("fsw priority above 99", [*_FSW, "--priority", "100"], "--priority: must be in 1..99 (SCHED_FIFO), got 100", _SLEW_FILE),
 
 def test_a_5_mb_name_gives_a_short_message(tmp_path, capsys):
     path = tmp_path / "c.toml"

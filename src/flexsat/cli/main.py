@@ -779,6 +779,10 @@ SensorEndpointOption = Annotated[
 CommandEndpointOption = Annotated[
     str, typer.Option(help="Where the plant listens for commands (same schemes).")
 ]
+PriorityOption = Annotated[
+    int | None,
+    typer.Option(help="Run under SCHED_FIFO at this priority, 1..99 (Linux; CAP_SYS_NICE)."),
+]
 
 
 @app.command()
@@ -799,6 +803,7 @@ def serve(
     start_timeout: Annotated[
         float, typer.Option(help="Longest wait for the client's HELLO [s], in (0, 3600].")
     ] = 60.0,
+    priority: PriorityOption = None,
     json_output: JsonOption = False,
     out: RunOutOption = None,
 ) -> None:
@@ -812,13 +817,14 @@ def serve(
     from flexsat.analysis.requirements import slew_metrics
     from flexsat.config import load_config
     from flexsat.dynamics.plant import Plant
-    from flexsat.realtime.server import check_options
+    from flexsat.realtime.server import check_options, check_priority
     from flexsat.realtime.server import serve as serve_plant
     from flexsat.realtime.transport import plant_link
     from flexsat.simulate import load_slew
     from flexsat.study.outputs import prepare_output_dir, write_slew_outputs
 
     check_options(speed, client_timeout, start_timeout)
+    check_priority(priority)
     cfg = load_config(config)
     chosen = load_slew(scenario)
     link = plant_link(sensor_endpoint, command_endpoint)
@@ -830,6 +836,7 @@ def serve(
             Plant.from_config(cfg), chosen, link, speed=speed, lockstep=lockstep,
             client_timeout_s=client_timeout, start_timeout_s=start_timeout,
             log=lambda line: _errors.print(line, markup=False, highlight=False),
+            priority=priority,
         )  # fmt: skip
     finally:
         link.close()
@@ -858,23 +865,27 @@ def fsw(
     silence: Annotated[
         float, typer.Option(help="A plant silent this long is gone [s], in (0, 3600].")
     ] = 5.0,
+    priority: PriorityOption = None,
     json_output: JsonOption = False,
 ) -> None:
     """Reference flight software: the scenario's law answering a served plant (flexsat serve)."""
     from flexsat.config import load_config
     from flexsat.dynamics.plant import Plant
     from flexsat.realtime.fsw import fly_remote
+    from flexsat.realtime.server import check_priority
     from flexsat.realtime.transport import check_seconds, client_link
     from flexsat.simulate import load_slew
 
     check_seconds("--connect-timeout", connect_timeout)
     check_seconds("--silence", silence)
+    check_priority(priority)
     cfg = load_config(config)
     chosen = load_slew(scenario)
     link = client_link(sensor_endpoint, command_endpoint)
     try:
         summary = fly_remote(Plant.from_config(cfg), chosen, link,
-                             connect_timeout_s=connect_timeout, silence_s=silence)  # fmt: skip
+                             connect_timeout_s=connect_timeout, silence_s=silence,
+                             priority=priority)  # fmt: skip
     finally:
         link.close()
     if json_output:
