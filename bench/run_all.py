@@ -52,6 +52,7 @@ ORDER = (
     "bench_figures",
     "bench_modal",
     "bench_modal_large_motion",
+    "bench_environment",
     "bench_demo",
     "bench_basilisk",
     "bench_basilisk_chain",

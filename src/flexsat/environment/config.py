@@ -92,6 +92,10 @@ class EnvironmentConfig(_Frozen):
     hub_facets: Annotated[int, Field(ge=3, le=64)] = Field(
         8, description="flat faces around the hub cylinder's side [-]"
     )
+    period_s: Annotated[float, Field(gt=0.0, le=60.0, allow_inf_nan=False)] = Field(
+        0.1, description="interval between evaluations of the loads, rounded to a whole "
+        "number of control periods (at least one) [s]"
+    )  # fmt: skip
     magnetorquers: MagnetorquerConfig | None = Field(
         None, description="magnetorquers dumping the reaction wheels' momentum; default: none"
     )

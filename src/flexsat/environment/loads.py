@@ -8,10 +8,11 @@ on the load points and its torque on the hub; every point adds r_k x F_k to the 
 torque (the virtual work of a rotation of the hub, which carries the appendages), and
 a point of an appendage also adds G_k^T F_k to that appendage's generalized forces
 (:mod:`flexsat.environment.geometry`; docs/environment.md, 'Appendage loads').
-The loads are held until the next control instant, like the actuators' torque: they
-turn at the orbit's rate n and the attitude's |omega|, so a hold of one control period
-dt moves them by about (n + |omega|) dt of their size, 1e-4 for n dt at 0.1 s in low
-Earth orbit (docs/environment.md, 'When the loads are evaluated').
+They are evaluated every ``period_s`` of the ``[environment]`` table (a whole number of
+control periods) and held in between, like the actuators' torque: they turn at the
+orbit's rate n and the attitude's |omega|, so a hold of T moves them by about
+(n + |omega|) T of their size, 1e-4 for n T at 0.1 s in low Earth orbit
+(docs/environment.md, 'When the loads are evaluated').
 """
 
 from __future__ import annotations
@@ -118,6 +119,9 @@ class EnvironmentData(NamedTuple):
         [1/s, A m^2, A m^2, -, -].
     dipole : ndarray, shape (3,)
         Their dipole, held between instants, hub frame B [A m^2].
+    every : int
+        Loop steps between two evaluations, a whole number of control periods (the
+        ``[environment]`` table's ``period_s``; 1 outside a loop).
     """
 
     active: bool
@@ -139,6 +143,7 @@ class EnvironmentData(NamedTuple):
     dumping: bool
     dump: np.ndarray
     dipole: np.ndarray
+    every: int
 
 
 @njit(cache=True)
@@ -153,8 +158,14 @@ def _padded(entries: tuple, filler) -> tuple:
                                   - len(entries))  # fmt: skip
 
 
-def environment_data(plant, config, ephemeris: np.ndarray, epoch: str,
-                     momentum_column: int | None = None) -> EnvironmentData:  # fmt: skip
+def environment_data(
+    plant,
+    config,
+    ephemeris: np.ndarray,
+    epoch: str,
+    momentum_column: int | None = None,
+    every: int = 1,
+) -> EnvironmentData:
     """The environment of a run, packed for the loop.
 
     Parameters
@@ -171,6 +182,9 @@ def environment_data(plant, config, ephemeris: np.ndarray, epoch: str,
     momentum_column : int, optional
         Where the loop's record row holds the wheels' ``wheel_momentum_B`` (3): needed
         by the magnetorquers.
+    every : int, optional
+        Loop steps between two evaluations of the loads (a whole number of control
+        periods) [-].
 
     Returns
     -------
@@ -201,6 +215,7 @@ def environment_data(plant, config, ephemeris: np.ndarray, epoch: str,
         n_models=len(models), force=np.zeros((rows, 3)), torque=np.zeros(3),
         Q=np.zeros(plant.n_dof), applied=np.zeros(plant.n_dof),
         dumping=config.magnetorquers is not None, dump=dump, dipole=np.zeros(3),
+        every=max(1, int(every)),
     )  # fmt: skip
 
 
@@ -226,6 +241,7 @@ def idle_environment(n_dof: int) -> EnvironmentData:
         kernels=(filler,) * MODEL_SLOTS, params=(np.zeros(0),) * MODEL_SLOTS, n_models=0,
         force=np.zeros((0, 3)), torque=np.zeros(3), Q=np.zeros(n_dof),
         applied=np.zeros(n_dof), dumping=False, dump=np.zeros(DUMP_SIZE), dipole=np.zeros(3),
+        every=1,
     )  # fmt: skip
 
 

@@ -15,7 +15,7 @@ tau = m x B_B. Its component across the field is -k h_w,perp: the wheels, which 
 the attitude against it, lose the momentum they carry across the field at the rate
 k; the component along the field cannot be dumped at that instant, but the field
 turns along the orbit, so every component is dumped over an orbit.
-The dipole is held over the control period, like the loads.
+The dipole is held until the loads' next evaluation, like them.
 """
 
 from __future__ import annotations

@@ -168,9 +168,10 @@ class LoopData(NamedTuple):
     Q : ndarray, shape (n_dof,)
         Generalized forces on the appendage coordinates, ``Q[6:]``, held [N or N m].
     env : EnvironmentData
-        The environment's loads (:mod:`flexsat.environment.loads`): evaluated at each
-        control instant when ``env.active``, held like the torque; inactive without an
-        ``[environment]`` table (the loop then never reads it).
+        The environment's loads (:mod:`flexsat.environment.loads`): evaluated every
+        ``env.every`` steps (a control instant) when ``env.active``, held like the
+        torque; inactive without an ``[environment]`` table (the loop then never reads
+        it).
     """
 
     J_design: np.ndarray  # (3, 3) [kg m^2]
@@ -422,11 +423,12 @@ def rk4_closed_loop(x, clock, stages, d, records, plant, frame):
                 d.law_gains, d.law_state, t, control_dt, d.tau_cmd, d.law_diag,
             )  # fmt: skip
             status |= run_actuators(x, n, t, control_dt, clock.continuous, stages, d)
-            if d.env.active:  # held until the next instant, like the torque
+            if d.env.active:  # held until the next evaluation, like the torque
                 env = d.env
-                ephemeris_row(env.ephemeris, t, env.row)
-                attitude_cbn(x, frame, env.C_BN)
-                status |= environment_loads(env, d.held)
+                if (int(clock.t0 / clock.dt + 0.5) + k) % env.every == 0:  # the run's step
+                    ephemeris_row(env.ephemeris, t, env.row)
+                    attitude_cbn(x, frame, env.C_BN)
+                    status |= environment_loads(env, d.held)
                 applied_forces(env, d.Q, d.flow.held, clock.continuous)
             if status != 0:
                 return STATUS_CONTROL_FAILED, k, row - records.start

@@ -278,4 +278,6 @@ def slew_environment(scenario: SlewScenario, plant: Plant,
     for channel, columns in layout.channels() if layout is not None else ():
         if channel.name == "wheel_momentum_B":
             column = columns.start
-    return environment_data(plant, config, ephemeris.table, ephemeris.epoch, column)
+    periods = max(1, round(config.period_s / scenario.control_dt_s))
+    return environment_data(plant, config, ephemeris.table, ephemeris.epoch, column,
+                            periods * scenario.control_every)  # fmt: skip
