@@ -559,6 +559,8 @@ REALTIME = [
     Bad("serve mixed transports", [*_SERVE, "--sensor-endpoint", "tcp://127.0.0.1:47901"], "--sensor-endpoint and --command-endpoint: both udp://, or both ZeroMQ", _SLEW_FILE),
     Bad("serve scenario missing", ["serve", "{tmp}/absent.toml"], "absent.toml"),
     Bad("fsw silence zero", [*_FSW, "--silence", "0"], "--silence: must be in (0, 3600] s, got 0", _SLEW_FILE),
+    Bad("serve priority zero", [*_SERVE, "--priority", "0"], "--priority: must be in 1..99 (SCHED_FIFO), got 0", _SLEW_FILE),
+    Bad("fsw priority above 99", [*_FSW, "--priority", "100"], "--priority: must be in 1..99 (SCHED_FIFO), got 100", _SLEW_FILE),
     Bad("fsw connect timeout too long", [*_FSW, "--connect-timeout", "1e5"], "--connect-timeout: must be in (0, 3600] s, got 100000", _SLEW_FILE),
 ]  # fmt: skip
 
@@ -615,8 +617,6 @@ def test_an_unreachable_scheduler_is_refused_before_the_store_exists(tmp_path, c
     assert "cannot connect to the Dask scheduler tcp://127.0.0.1:1" in outcome.stderr
     assert not (tmp_path / "store").exists()
 
-    Bad("serve priority zero", [*_SERVE, "--priority", "0"], "--priority: must be in 1..99 (SCHED_FIFO), got 0", _SLEW_FILE),
-    Bad("fsw priority above 99", [*_FSW, "--priority", "100"], "--priority: must be in 1..99 (SCHED_FIFO), got 100", _SLEW_FILE),
 
 def test_a_5_mb_name_gives_a_short_message(tmp_path, capsys):
     path = tmp_path / "c.toml"
