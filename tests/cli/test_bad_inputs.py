@@ -540,6 +540,17 @@ ORBIT = [
     _scenario("epoch not a time", '[orbit]\nepoch = "yesterday"\n', "orbit.epoch: 'yesterday' is not an ISO 8601 UTC time", command="slew"),
     _scenario("epoch not in UTC", '[orbit]\nepoch = "2026-03-20T12:00:00+02:00"\n', "is not in UTC", command="slew"),
     _scenario("nadir pointing without an orbit", '[reference]\nkind = "nadir"\n', "reference.kind = 'nadir' points at a target along the orbit: add an [orbit] table", command="slew"),
+    # the [environment] table (docs/environment.md, 'The environment table')
+    _scenario("surface coefficient above 1", "[orbit]\naltitude_m = 500e3\n[environment.models.srp]\n[environment.surfaces.front]\nspecular = 1.2\ndiffuse = 0.0\nabsorbed = 0.0\n", "environment.surfaces.front.specular: Input should be less than or equal to 1 (got 1.2)", command="slew"),
+    _scenario("surface coefficient negative", "[orbit]\naltitude_m = 500e3\n[environment.models.srp]\n[environment.surfaces.hub]\nspecular = -0.1\ndiffuse = 0.3\nabsorbed = 0.8\n", "environment.surfaces.hub.specular: Input should be greater than or equal to 0 (got -0.1)", command="slew"),
+    _scenario("surface coefficients summing to 0.9", "[orbit]\naltitude_m = 500e3\n[environment.models.srp]\n[environment.surfaces.back]\nspecular = 0.3\ndiffuse = 0.3\nabsorbed = 0.3\n", "environment.surfaces.back: specular + diffuse + absorbed must sum to 1 (within 1e-06), got 0.3 + 0.3 + 0.3 = 0.9", command="slew"),
+    _scenario("unknown environment model", "[orbit]\naltitude_m = 500e3\n[environment.models.albedo]\n", "unknown environment model 'albedo': must be one of gravity_gradient, srp, drag, magnetic", command="slew"),
+    _scenario("environment without an orbit", "[environment.models.magnetic]\n", "environment: the environment models need the orbit: add an [orbit] table", command="slew"),
+    _scenario("magnetorquers without the field", "[orbit]\naltitude_m = 500e3\n[environment.models.drag]\n[environment.magnetorquers]\n", "magnetorquers: they act on the geomagnetic field: add the magnetic model ([environment.models.magnetic])", command="slew"),
+    _scenario("magnetorquer limit negative", "[orbit]\naltitude_m = 500e3\n[environment.models.magnetic]\n[environment.magnetorquers]\ndipole_max_a_m2 = -1.0\n", "environment.magnetorquers.dipole_max_a_m2: Input should be greater than 0 (got -1.0)", command="slew"),
+    _scenario("magnetorquer gain above 1/s", "[orbit]\naltitude_m = 500e3\n[environment.models.magnetic]\n[environment.magnetorquers]\ngain_1_s = 5.0\n", "environment.magnetorquers.gain_1_s: Input should be less than or equal to 1 (got 5.0)", command="slew"),
+    _scenario("environment period zero", "[orbit]\naltitude_m = 500e3\n[environment]\nperiod_s = 0.0\n[environment.models.drag]\n", "environment.period_s: Input should be greater than 0 (got 0.0)", command="slew"),
+    _scenario("magnetorquers without wheels", "[orbit]\naltitude_m = 500e3\n[environment.models.magnetic]\n[environment.magnetorquers]\n", "environment.magnetorquers: they dump the reaction wheels' momentum: the [actuator] must be kind = 'wheels'", command="slew"),
 ]  # fmt: skip
 
 # The real-time plant and its flight software: options refused before a port is bound.
@@ -576,17 +587,6 @@ def test_the_table_is_at_least_sixty_rows():
 @pytest.mark.parametrize("row", TABLE, ids=[row.id for row in TABLE])
 def test_bad_input_gives_one_message_and_exit_code_2(row: Bad, tmp_path, capsys, monkeypatch):
     monkeypatch.chdir(tmp_path)  # default output folders land in the test's folder
-    # the [environment] table (docs/environment.md, 'The environment table')
-    _scenario("surface coefficient above 1", "[orbit]\naltitude_m = 500e3\n[environment.models.srp]\n[environment.surfaces.front]\nspecular = 1.2\ndiffuse = 0.0\nabsorbed = 0.0\n", "environment.surfaces.front.specular: Input should be less than or equal to 1 (got 1.2)", command="slew"),
-    _scenario("surface coefficient negative", "[orbit]\naltitude_m = 500e3\n[environment.models.srp]\n[environment.surfaces.hub]\nspecular = -0.1\ndiffuse = 0.3\nabsorbed = 0.8\n", "environment.surfaces.hub.specular: Input should be greater than or equal to 0 (got -0.1)", command="slew"),
-    _scenario("surface coefficients summing to 0.9", "[orbit]\naltitude_m = 500e3\n[environment.models.srp]\n[environment.surfaces.back]\nspecular = 0.3\ndiffuse = 0.3\nabsorbed = 0.3\n", "environment.surfaces.back: specular + diffuse + absorbed must sum to 1 (within 1e-06), got 0.3 + 0.3 + 0.3 = 0.9", command="slew"),
-    _scenario("unknown environment model", "[orbit]\naltitude_m = 500e3\n[environment.models.albedo]\n", "unknown environment model 'albedo': must be one of gravity_gradient, srp, drag, magnetic", command="slew"),
-    _scenario("environment without an orbit", "[environment.models.magnetic]\n", "environment: the environment models need the orbit: add an [orbit] table", command="slew"),
-    _scenario("magnetorquers without the field", "[orbit]\naltitude_m = 500e3\n[environment.models.drag]\n[environment.magnetorquers]\n", "magnetorquers: they act on the geomagnetic field: add the magnetic model ([environment.models.magnetic])", command="slew"),
-    _scenario("magnetorquer limit negative", "[orbit]\naltitude_m = 500e3\n[environment.models.magnetic]\n[environment.magnetorquers]\ndipole_max_a_m2 = -1.0\n", "environment.magnetorquers.dipole_max_a_m2: Input should be greater than 0 (got -1.0)", command="slew"),
-    _scenario("magnetorquer gain above 1/s", "[orbit]\naltitude_m = 500e3\n[environment.models.magnetic]\n[environment.magnetorquers]\ngain_1_s = 5.0\n", "environment.magnetorquers.gain_1_s: Input should be less than or equal to 1 (got 5.0)", command="slew"),
-    _scenario("environment period zero", "[orbit]\naltitude_m = 500e3\n[environment]\nperiod_s = 0.0\n[environment.models.drag]\n", "environment.period_s: Input should be greater than 0 (got 0.0)", command="slew"),
-    _scenario("magnetorquers without wheels", "[orbit]\naltitude_m = 500e3\n[environment.models.magnetic]\n[environment.magnetorquers]\n", "environment.magnetorquers: they dump the reaction wheels' momentum: the [actuator] must be kind = 'wheels'", command="slew"),
     for name, content in row.files.items():
         path = tmp_path / name
         path.parent.mkdir(parents=True, exist_ok=True)
@@ -625,13 +625,3 @@ def test_a_5_mb_name_gives_a_short_message(tmp_path, capsys):
     assert outcome.code == 2
     assert "name: String should have at most 64 characters" in outcome.stderr
     assert len(outcome.stderr) < 1000
-    # the [environment] table (docs/environment.md, 'The environment table')
-    _scenario("surface coefficient above 1", "[orbit]\naltitude_m = 500e3\n[environment.models.srp]\n[environment.surfaces.front]\nspecular = 1.2\ndiffuse = 0.0\nabsorbed = 0.0\n", "environment.surfaces.front.specular: Input should be less than or equal to 1 (got 1.2)", command="slew"),
-    _scenario("surface coefficient negative", "[orbit]\naltitude_m = 500e3\n[environment.models.srp]\n[environment.surfaces.hub]\nspecular = -0.1\ndiffuse = 0.3\nabsorbed = 0.8\n", "environment.surfaces.hub.specular: Input should be greater than or equal to 0 (got -0.1)", command="slew"),
-    _scenario("surface coefficients summing to 0.9", "[orbit]\naltitude_m = 500e3\n[environment.models.srp]\n[environment.surfaces.back]\nspecular = 0.3\ndiffuse = 0.3\nabsorbed = 0.3\n", "environment.surfaces.back: specular + diffuse + absorbed must sum to 1 (within 1e-06), got 0.3 + 0.3 + 0.3 = 0.9", command="slew"),
-    _scenario("unknown environment model", "[orbit]\naltitude_m = 500e3\n[environment.models.albedo]\n", "unknown environment model 'albedo': must be one of gravity_gradient, srp, drag, magnetic", command="slew"),
-    _scenario("environment without an orbit", "[environment.models.magnetic]\n", "environment: the environment models need the orbit: add an [orbit] table", command="slew"),
-    _scenario("magnetorquers without the field", "[orbit]\naltitude_m = 500e3\n[environment.models.drag]\n[environment.magnetorquers]\n", "magnetorquers: they act on the geomagnetic field: add the magnetic model ([environment.models.magnetic])", command="slew"),
-    _scenario("magnetorquer limit negative", "[orbit]\naltitude_m = 500e3\n[environment.models.magnetic]\n[environment.magnetorquers]\ndipole_max_a_m2 = -1.0\n", "environment.magnetorquers.dipole_max_a_m2: Input should be greater than 0 (got -1.0)", command="slew"),
-    _scenario("magnetorquer gain above 1/s", "[orbit]\naltitude_m = 500e3\n[environment.models.magnetic]\n[environment.magnetorquers]\ngain_1_s = 5.0\n", "environment.magnetorquers.gain_1_s: Input should be less than or equal to 1 (got 5.0)", command="slew"),
-    _scenario("magnetorquers without wheels", "[orbit]\naltitude_m = 500e3\n[environment.models.magnetic]\n[environment.magnetorquers]\n", "environment.magnetorquers: they dump the reaction wheels' momentum: the [actuator] must be kind = 'wheels'", command="slew"),
