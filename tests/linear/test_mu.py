@@ -1,0 +1,128 @@
+"""mu bounds: a textbook matrix with a known mu, then flexsat's PD loop on its LFT."""
+
+import numpy as np
+import pytest
+
+from flexsat.config import nominal
+from flexsat.dynamics.plant import Plant
+from flexsat.errors import ConfigError
+from flexsat.linear.frequency import law_gains
+from flexsat.linear.mu import (
+    LinearController,
+    _dg_bound,
+    analyze,
+    closed_loop,
+    mu_upper_bound,
+)
+from flexsat.linear.uncertain import uncertain_model
+
+SEED = 20261207  # fixed, printed by the randomized tests
+# The grid of the PD test: the rigid and the flexible closed-loop modes (0.8 Hz is the
+# in-plane mode of the antisymmetric panel motion, the hub at rest), a few between.
+GRID_HZ = np.array([0.02, 0.1, 0.26, 0.5, 0.8, 0.824, 1.2, 5.0, 50.0, 97.3, 100.0, 102.5])
+
+
+def test_skogestad_postlethwaite_matrix():
+    """M = [[2, 2], [-1, -1]]: rho = 1 <= mu = 3 <= sigma_max = sqrt(10), diagonal Delta.
+
+    Skogestad & Postlethwaite, Multivariable Feedback Control, section 8.8: M = a b^T
+    is rank one, mu = sum |a_i b_i| = 2 + 1 = 3 for a diagonal complex Delta, and for
+    a real one (the a_i b_i are real); the destabilizing Delta = diag(1, -1)/3.
+    """
+    M = np.array([[2.0, 2.0], [-1.0, -1.0]])
+    for real in (np.zeros(2, bool), np.ones(2, bool)):
+        bound, x, g = mu_upper_bound(M, real)
+        # D-scaling is exact for rank-one matrices; the optimizer reaches it to 1e-6.
+        assert abs(bound - 3.0) <= 1e-6
+        # The reported scalings are a certificate: the bound recomputed from them.
+        assert abs(np.sqrt(_dg_bound(np.r_[x, g], M, real)[0]) - bound) <= 1e-12
+    assert abs(np.linalg.det(np.eye(2) - M @ np.diag([1.0, -1.0]) / 3.0)) <= 1e-15
+
+
+def test_rank_one_complex_matrices():
+    """mu of a rank-one u v^H is sum |u_i v_i| (Packard & Doyle); the D bound reaches it."""
+    rng = np.random.default_rng(SEED)
+    print(f"seed {SEED}")
+    for n in (3, 5, 8):
+        u = rng.normal(size=n) + 1j * rng.normal(size=n)
+        v = rng.normal(size=n) + 1j * rng.normal(size=n)
+        exact = float(np.sum(np.abs(u * v)))
+        bound = mu_upper_bound(np.outer(u, v.conj()), np.zeros(n, bool))[0]
+        # Valid bound (never below mu, round-off aside) and tight to the optimizer's 1e-4.
+        assert exact * (1 - 1e-12) <= bound <= exact * (1 + 1e-4), (n, bound, exact)
+
+
+@pytest.fixture(scope="module")
+def pd_analysis():
+    config = nominal()
+    lft = uncertain_model(config)
+    K = law_gains(Plant.from_config(config))
+    return lft, K, analyze(lft, LinearController.static(K), frequencies_hz=GRID_HZ, maxiter=100)
+
+
+def _max_real(lft, loop, delta):
+    A, B, C, D = loop
+    Dl = lft.delta_matrix(delta)
+    X = np.linalg.solve(np.eye(D.shape[0]) - Dl @ D, Dl)
+    return float(np.max(np.linalg.eigvals(A + B @ X @ C).real))
+
+
+def test_pd_loop_bounds(pd_analysis):
+    """The PD loop is stable over the thesis's box and loses it where the damping does.
+
+    Known answer: a collocated PD on a satellite with positive inertias and stiffnesses
+    and non-negative damping is stable (its energy is a Lyapunov function); the
+    panels' antisymmetric modes do not move the hub, so with zeta < 0 they grow
+    whatever the law. The box's damping factor runs 0 ... 1 (delta = -1 is zeta = 0):
+    k_max = 1 exactly, at the damping corner.
+    """
+    lft, _, r = pd_analysis
+    assert r.nominal_stable
+    # Bisection to 1e-6 in alpha.
+    assert abs(r.lower - 1.0) <= 1e-5
+    assert abs(r.k_max[1] - 1.0) <= 1e-5
+    assert abs(r.worst_factors["damping"]) <= 1e-5
+    # A valid upper bound is never below a lower bound: mu's peak lies between.
+    assert r.peak_upper >= r.lower
+    assert r.k_max[0] == pytest.approx(1.0 / r.peak_upper, rel=1e-12)
+    assert r.upper.shape == GRID_HZ.shape
+    print(f"PD: mu in [{r.lower:.4f}, {r.peak_upper:.3f}] (upper at {r.peak_frequency_hz:.3f} Hz)")
+
+
+def test_pd_sampling_check(pd_analysis):
+    """Monte Carlo in the linear model (fixed seed, 40 + 40 cases; 1,000 in bench/).
+
+    No case inside the mu-certified box (k_max[0] x the box) is unstable; no case of the
+    full box is worse than the mu worst case (largest real part of the closed-loop poles).
+    """
+    lft, K, r = pd_analysis
+    loop = closed_loop(lft, LinearController.static(K))
+    rng = np.random.default_rng(SEED)
+    print(f"seed {SEED}")
+    n_p = len(lft.parameters)
+    certified = [_max_real(lft, loop, r.k_max[0] * rng.uniform(-1, 1, n_p)) for _ in range(40)]
+    assert max(certified) < 0.0
+    box = [_max_real(lft, loop, rng.uniform(-1, 1, n_p)) for _ in range(40)]
+    worst = _max_real(lft, loop, r.worst_delta)
+    # Every sampled case has zeta > 0: strictly stable; the worst case sits on the
+    # boundary (the bisection stops 1e-6 past it in alpha).
+    assert max(box) < 0.0
+    assert worst >= max(box)
+
+
+def test_user_controller_matches_the_static_law(pd_analysis):
+    """A user's A, B, C, D without states is the static law; bad shapes are refused."""
+    lft, K, _ = pd_analysis
+    static = closed_loop(lft, LinearController.static(K))
+    user = closed_loop(lft, LinearController.from_arrays([], [], [], -K))
+    for a, b in zip(static, user, strict=True):
+        np.testing.assert_array_equal(a, b)
+    # A filtered law with one state per axis that only feeds through -K reproduces it.
+    filt = LinearController.from_arrays(-np.eye(3), np.zeros((3, 6)), np.zeros((3, 3)), -K)
+    lam = np.linalg.eigvals(closed_loop(lft, filt)[0])
+    ref = np.concatenate([np.linalg.eigvals(static[0]), [-1.0, -1.0, -1.0]])
+    assert np.max(np.abs(np.sort_complex(lam) - np.sort_complex(ref))) <= 1e-9
+    with pytest.raises(ConfigError, match=r"controller.B: expected shape \(3, 6\)"):
+        LinearController.from_arrays(-np.eye(3), np.zeros((3, 5)), np.zeros((3, 3)), -K)
+    with pytest.raises(ConfigError, match="controller: a static gain is 3 x 6"):
+        LinearController.static(np.zeros((3, 3)))
