@@ -19,9 +19,10 @@ _SAMPLES = 64  # per period: the projection of a pure sinusoid is exact to round
 
 
 def _fourier(signal, omega: float) -> np.ndarray:
-    """U with signal(t) = Re(U e^(i omega t)), from samples over one period."""
+    """U with signal(t) = Re(U e^(i omega t)), from samples over one period (``signal``
+    takes the sample times, shape (n,), and gives shape (n, 3) or (n, 1))."""
     t = np.arange(_SAMPLES) * (2.0 * np.pi / omega) / _SAMPLES
-    values = np.array([signal(tk) for tk in t])  # (samples, 3 or 1)
+    values = signal(t)
     return 2.0 / _SAMPLES * np.sum(values * np.exp(-1j * omega * t)[:, None], axis=0)
 
 
@@ -41,9 +42,11 @@ def wheel_torque_lines(axes: np.ndarray, table: dict, speed_rpm: float) -> dict[
     n = axes.shape[0]
     terms = _terms(table)
     phases = np.random.default_rng(table.get("seed", 1)).uniform(0.0, 2 * np.pi, (len(terms), n))
-    positions = np.array(table.get("positions_m", np.zeros((n, 3))), dtype=float)
+    positions = table.get("positions_m")
+    positions = np.zeros((n, 3)) if positions is None else np.array(positions, dtype=float)
+    vibrating = table.get("wheels") or range(1, n + 1)  # 1-based; phases drawn for all
     lines: dict[float, tuple[float, np.ndarray]] = {}
-    for i in range(n):
+    for i in (w - 1 for w in vibrating):
         a = axes[i]
         e1 = np.eye(3)[np.argmin(np.abs(a))]  # the hub axis least aligned with a
         e1 = e1 - (e1 @ a) * a
@@ -53,7 +56,7 @@ def wheel_torque_lines(axes: np.ndarray, table: dict, speed_rpm: float) -> dict[
             amp, phi, r = c * omega**2, phases[k, i], positions[i]
 
             def torque(t, kind=kind, h=h, amp=amp, phi=phi, r=r, a=a, e1=e1, e2=e2):
-                x = h * omega * t + phi
+                x = (h * omega * t + phi)[:, None]
                 if kind == "axial_force":
                     return np.cross(r, amp * np.sin(x) * a)
                 radial = amp * (np.cos(x) * e1 + np.sin(x) * e2)
@@ -80,7 +83,7 @@ def stepper_force_lines(stepper: dict) -> dict[float, complex]:
         omega = 2.0 * np.pi * h["number"] * rate
 
         def ripple(t, amp=h["amplitude_nm"], omega=omega, phi=phi):
-            return np.array([amp * np.sin(omega * t + phi)])
+            return (amp * np.sin(omega * t + phi))[:, None]
 
         _add(lines, h["number"] * rate, _fourier(ripple, omega)[0])
     return {f: u for f, u in lines.values()}

@@ -678,6 +678,102 @@ def _variant_fields(variant: str) -> dict:
     return {"controller": {"kind": variant}}
 
 
+JITTER = 1e-9
+"""Relative tolerance of the microvibration jitter: the closed loop rebuilt here from
+M(0), K, C (:func:`independent.state_space`), the law's gains, the wheels' gyroscopic
+torque and their motors' lag, its lines from the wheel model sampled in time
+(``tests/study/jitter_reference.py``), against flexsat's linearization and closed
+forms: both exact up to round-off."""
+JITTER_SPEED = 1e-6
+"""Relative tolerance of a worst speed: a maximum located by a bounded search here
+(to 1e-9 of the speed) and by the study's, on a total that is flat there; the printed
+4 digits dominate."""
+
+
+class _Jitter:
+    """The pointing part's jitter rebuilt from its stored inputs (pointing/jitter.json:
+    the wheels' axes, momentum, motor lag and table) and the configuration."""
+
+    def __init__(self, rb: Rebuilt) -> None:
+        from tests.study import jitter_reference as ref
+
+        self.ref = ref
+        self.data = _read(rb.root / "pointing" / "jitter.json")
+        wheels = self.data["wheels"]
+        plant = ind.state_space(rb.config)
+        A, B, Cy = np.asarray(plant.A), np.asarray(plant.B), np.asarray(plant.C)
+        J = ind.mass_matrix_at_rest(rb.config)[3:6, 3:6]
+        K = ind.sliding_gains(_read(rb.root / "frequency" / "margins.json")["gains"], J)
+        # J w_dot = tau - w x H_w: about rest, + H_w x w (the wheels' momentum fixed in B)
+        H = np.asarray(wheels["momentum_B_nms"])
+        S = np.array([[0.0, -H[2], H[1]], [H[2], 0.0, -H[0]], [-H[1], H[0], 0.0]])
+        rate = 1.0 / wheels["motor_time_constant_s"]  # tau_a_dot = (-K y - tau_a) / tau_m
+        self.A = np.block([[A + B @ S @ Cy[3:6], B], [-rate * K @ Cy, -rate * np.eye(3)]])
+        self.B = np.vstack([B, np.zeros((3, 3))])
+        self.C = np.hstack([Cy[:3], np.zeros((3, 3))])
+        self.D = np.zeros((3, 3))
+        self.axes = np.asarray(wheels["axes"])
+        self.table = wheels["microvibration"]
+        self.window = self.data["window_s"]
+
+    def outputs(self, speed_rpm: float) -> tuple[list[float], list[np.ndarray]]:
+        lines = self.ref.wheel_torque_lines(self.axes, self.table, speed_rpm)
+        return list(lines), [self.ref.response(self, f, u) for f, u in lines.items()]
+
+    def rms(self, speed_rpm: float, window: bool) -> np.ndarray:
+        freqs, Y = self.outputs(speed_rpm)
+        gains = [self.ref.rpe_gain(f, self.window) for f in freqs] if window else None
+        return self.ref.rms_arcsec(Y, gains)
+
+    def total(self, speed_rpm: float) -> float:
+        return float(np.linalg.norm(self.rms(speed_rpm, True)))
+
+
+def _jitter_at(table, rb: Rebuilt) -> dict:
+    jit = _Jitter(rb)
+    speed = jit.data["speed_rpm"]
+    rows = {"RMS": jit.rms(speed, False), f"RPE RMS over {jit.window:g} s": jit.rms(speed, True)}
+    return {(row, f"{a} [arcsec]"): Expect(float(v[i]), JITTER)
+            for row, v in rows.items() for i, a in enumerate("xyz")}  # fmt: skip
+
+
+def _jitter_lines(table, rb: Rebuilt) -> dict:
+    jit = _Jitter(rb)
+    freqs, Y = jit.outputs(jit.data["speed_rpm"])
+    out = {}
+    for k, (f, y) in enumerate(zip(freqs, Y, strict=True)):
+        out[f"line {k + 1}", "frequency [Hz]"] = Expect(f, JITTER)
+        amplitude = np.abs(y) * jit.ref.ARCSEC
+        for i, a in enumerate("xyz"):
+            out[f"line {k + 1}", f"{a} [arcsec]"] = Expect(float(amplitude[i]), JITTER)
+    return out
+
+
+def _jitter_worst(table, rb: Rebuilt) -> dict:
+    from scipy.optimize import minimize_scalar
+
+    jit = _Jitter(rb)
+    sweep = jit.data["sweep"]
+    low, high = sweep["low_rpm"], sweep["high_rpm"]
+    grid = np.linspace(low, high, sweep["count"])
+    totals = [jit.total(s) for s in grid]
+    out = {}
+    for k, row in enumerate(table.rows):
+        near = ind.printed(row[1]["text"])  # where the study found it: searched around
+        found = minimize_scalar(lambda v: -jit.total(v), method="bounded",
+                                bounds=(max(low, 0.98 * near), min(high, 1.02 * near)),
+                                options={"xatol": 1e-9 * near})  # fmt: skip
+        speed, total = (found.x, -found.fun)
+        for end in (low, high):  # a range end counts when the total rises towards it
+            if abs(near - end) <= 0.02 * near and jit.total(end) >= total:
+                speed, total = end, jit.total(end)
+        out[f"#{k + 1}", "speed [rpm]"] = Expect(float(speed), JITTER_SPEED)
+        out[f"#{k + 1}", table.columns()[2]] = Expect(float(total), JITTER)
+        if k == 0:  # the worst: no speed of the sweep's grid is worse
+            assert total >= max(totals) * (1.0 - 1e-12), (total, max(totals))
+    return out
+
+
 def _laws(table, rb: Rebuilt) -> dict:
     from flexsat.campaigns import load_campaign, resolve_cases
 
@@ -718,6 +814,9 @@ CHECKS = [
     ("frequency", r"^Loop margins", _margins),
     ("frequency", r"^Every gain crossover", _crossovers),
     ("frequency", r"^Peak loop gain of each flexible mode", _peaks),
+    ("pointing", r"^Microvibration jitter at ", _jitter_at),
+    ("pointing", r"^Each line's amplitude per hub axis$", _jitter_lines),
+    ("pointing", r"^Worst wheel speeds of the sweep$", _jitter_worst),
     ("avionics", r"^Ideal loop and realistic avionics$", _avionics_side),
     ("avionics", r"^Sweep over the computational delay$", _delay_sweep),
     ("avionics", r"^Ideal loop, plates on a solar-array drive", _sadm),

@@ -45,12 +45,13 @@ full study's 414 cases beyond the quick study (4 min 29 s against 18.5 s) took 1
 a case on each of the two cores, against 0.96 s for 120 s at the calibrated rate."""
 QUICK_OVERHEAD_S = {
     "configuration": 0.0, "modal": 5.7, "openloop": 2.9, "slew": 3.0, "frequency": 4.8,
-    "comparison": 2.0, "animation": 1.8, "avionics": 4.5, "laws": 1.5,
+    "comparison": 2.0, "animation": 1.8, "avionics": 4.5, "laws": 1.5, "pointing": 1.7,
 }  # fmt: skip
 """What each part of the quick study does besides flying its runs (figures, files,
 analyses) on the reference machine [s]: the quick study's 18.5 s there (warm,
 docs/performance.md) shared among the parts as their wall times were in one quick
-study on this 2-core machine, less their runs' simulated time."""
+study on this 2-core machine, less their runs' simulated time; the pointing part
+(frequency domain only, no run) added since, measured alone."""
 FULL_OVERHEAD_FACTOR = {"modal": 3.0, "comparison": 13.0, "animation": 2.5, "avionics": 1.4}
 """The full study's overhead against the quick one's, per part [-]: three times the
 mode GIFs (6 against 2), each compared law's 13 figures (against the one comparison

@@ -9,7 +9,7 @@ import numpy as np
 from flexsat.dynamics.plant import Plant
 from flexsat.errors import ConfigError
 
-__all__ = ["DEFAULT_MICROVIBRATION", "jitter_scenario", "write_jitter"]
+__all__ = ["DEFAULT_MICROVIBRATION", "REPORT_WINDOW_S", "jitter_scenario", "write_jitter"]
 
 _ARCSEC = 180.0 / np.pi * 3600.0
 _SWEEP_POINTS = 400
@@ -25,6 +25,10 @@ DEFAULT_MICROVIBRATION = {
 """An illustrative table of a small wheel (U_s = 0.1 g cm, U_d = 0.02 g cm^2, one radial
 and one axial harmonic), the four pyramid wheels 0.5 m below the hub's reference point:
 what the study sweeps when its scenario gives none. Not a datasheet's values."""
+
+
+REPORT_WINDOW_S = 1.0
+"""The RPE window of the study's pointing-budget section [s] (the budget's example's)."""
 
 
 def jitter_scenario(speed_rpm: float = 2000.0):
@@ -77,8 +81,10 @@ def write_jitter(
     dict
         JSON-ready summary: ``speed_rpm``, ``rms_arcsec`` per output (and
         ``rpe_rms_arcsec`` with a window), ``lines`` (each distinct frequency with its
-        response), ``worst`` speeds, the closed loop's ``modes_hz``, the ``stepper``'s
-        and ``files``.
+        response), ``worst`` speeds, the ``sweep``'s range, the closed loop's
+        ``modes_hz``, the ``stepper``'s and ``files``; ``wheels``: what the loop and
+        the lines were built from (spin axes, momentum H_w [N m s], motor time constant
+        [s], the microvibration table).
 
     Raises
     ------
@@ -116,8 +122,11 @@ def write_jitter(
     if stepper is not None:
         lines = lines + stepper_lines(stepper, model)
     freqs, Y = line_response(model, lines, rows)
+    built = {"axes": axes.tolist(), "momentum_B_nms": (axes.sum(axis=0) * h0).tolist(),
+             "motor_time_constant_s": wheels.motor_time_constant_s,
+             "microvibration": wheels.microvibration.model_dump(mode="json")}  # fmt: skip
     summary = {
-        "law": scenario.controller.kind, "speed_rpm": speed, "outputs": names,
+        "law": scenario.controller.kind, "speed_rpm": speed, "outputs": names, "wheels": built,
         "rms_arcsec": _rms(Y, np.ones(freqs.size), names),
         "lines": [{"frequency_hz": float(f), "amplitude_arcsec": _per(np.abs(y), names)}
                   for f, y in zip(freqs, Y, strict=True)],
@@ -139,6 +148,8 @@ def write_jitter(
     summary["worst"] = [{"speed_rpm": float(s), "rms_arcsec": float(r * _ARCSEC)}
                         for s, r in zip(sweep.worst_rpm, sweep.worst_rms, strict=True)]  # fmt: skip
     summary["modes_hz"] = [float(m) for m in sweep.modes_hz]
+    summary["sweep"] = {"low_rpm": float(np.min(speeds_rpm)), "high_rpm": float(np.max(speeds_rpm)),
+                        "count": int(np.size(speeds_rpm))}  # fmt: skip
     if out is not None:
         from flexsat.plots.jitter import plot_campbell
         from flexsat.plots.style import save_figure

@@ -1,7 +1,8 @@
 """The thesis study end to end: every part timed, each allowed to fail.
 
 :func:`run_study` runs the parts of :data:`PARTS` (configuration, modal analysis,
-open-loop validation, the ASMC slew, the frequency-domain analysis, the controller
+open-loop validation, the ASMC slew, the frequency-domain analysis, the wheels'
+microvibration jitter, the controller
 comparison, the slew animation, the avionics, unless ``quick`` the three thesis
 campaigns, and the law comparison), after compiling every kernel they need up front
 (its time is ``compilation_s`` in the manifest; the parts' wall times exclude it),
@@ -222,6 +223,15 @@ def _frequency(ctx: StudyContext) -> dict:
     return {"json": files[0], "figures": files[1:]}
 
 
+def _pointing(ctx: StudyContext) -> dict:
+    from flexsat.study.jitter import REPORT_WINDOW_S, jitter_scenario, write_jitter
+
+    summary = write_jitter(ctx.plant, jitter_scenario(), ctx.out / "pointing",
+                           window_s=REPORT_WINDOW_S)  # fmt: skip
+    figure, written = _relative(ctx, summary["files"])
+    return {"json": written, "figures": [figure]}
+
+
 def _animation(ctx: StudyContext) -> dict:
     from flexsat.plots.animation import write_animation
     from flexsat.simulate.result import Result
@@ -298,6 +308,7 @@ PARTS = (
     Part("openloop", "Open-loop validation", _openloop, lane=1),
     Part("slew", f"Nominal slew with {LAWS.get(LAWS.default).label}", _slew, lane=1),
     Part("frequency", "Frequency domain: plant, loop gain and margins", _frequency, lane=1),
+    Part("pointing", "Pointing budget: wheel microvibration", _pointing),
     Part("comparison", "Controller comparison", _comparison, needs=("slew",), lane=1),
     Part("animation", "Slew animation", _animation, needs=("slew",), lane=1),
     Part("avionics", "Avionics in the loop: what the thesis could not say", _avionics),

@@ -475,6 +475,39 @@ def _frequency(root: Path, outputs: dict, context: dict) -> str:
     ])  # fmt: skip
 
 
+def _pointing(root: Path, outputs: dict, context: dict) -> str:
+    src = _Source(root, outputs["json"])
+    names, window = src.get("outputs"), src.get("window_s")
+    law = _esc(str(src.get("law")).upper())
+    at = [["RMS", *(src.cell("rms_arcsec", n) for n in names)],
+          [f"RPE RMS over {window:g} s",
+           *(src.cell("rpe_rms_arcsec", n) for n in names)]]  # fmt: skip
+    lines = [[f"line {k + 1}", src.cell("lines", k, "frequency_hz"),
+              *(src.cell("lines", k, "amplitude_arcsec", n) for n in names)]
+             for k in range(len(src.get("lines")))]  # fmt: skip
+    worst = [[f"#{k + 1}", src.cell("worst", k, "speed_rpm"), src.cell("worst", k, "rms_arcsec")]
+             for k in range(len(src.get("worst")))]  # fmt: skip
+    return "".join([
+        "<p>The four wheels spinning at their initial speed with an illustrative "
+        "imbalance and harmonic table (docs/pointing.md, 'Microvibration': the "
+        "empirical wheel model, its lines carried through the flexible satellite "
+        f"linearized about rest, every flexible mode kept, the {law} law's loop closed "
+        "through the wheels' motors). Each line is a sinusoid: its amplitude per hub "
+        "axis, the RMS of all lines together, and their RPE, each record less the "
+        f"mean of the {window:g} s window around it (the periodic column of "
+        "docs/pointing.md, 'What each class adds to each index'). The sweep takes every "
+        "wheel at one speed from 1 % of the wheels' limit to it; the Campbell diagram "
+        "shows where a harmonic crosses a mode of the closed loop.</p>",
+        _table(["", *(f"{n} [arcsec]" for n in names)], at,
+               f"Microvibration jitter at {src.get('speed_rpm'):g} rpm, {law} loop"),
+        _table(["line", "frequency [Hz]", *(f"{n} [arcsec]" for n in names)], lines,
+               "Each line's amplitude per hub axis"),
+        _table(["", "speed [rpm]", f"RPE RMS over {window:g} s, the axes together [arcsec]"],
+               worst, "Worst wheel speeds of the sweep"),
+        _figures(root, outputs["figures"]),
+    ])  # fmt: skip
+
+
 def _campaign_cases(root: Path, store: str) -> str:
     """Every case of a stored campaign, one row each, sortable by any column."""
     keys = ("final_pointing_error_deg", "ape_deg", "max_rate_error_deg_s", "settling_time_s",
@@ -643,6 +676,7 @@ SECTIONS: list[Section] = [
     Section("openloop", _openloop, caveat=_THESIS_CAVEAT),
     Section("slew", _slew, caveat=_THESIS_CAVEAT),
     Section("frequency", _frequency),
+    Section("pointing", _pointing),
     Section("comparison", _comparison),
     Section("animation", _animation),
     Section("avionics", _avionics),
