@@ -19,6 +19,7 @@ READING_ORDER = (
     "montecarlo_statistics.py",
     "replay_case.py",
     "linear_design.py",
+    "microvibration.py",
 )
 
 
