@@ -43,6 +43,7 @@ class PlantClient:
         self.malformed = 0
         self.answered = 0
         self._received_ns = 0
+        self._sequence = -1  # the last sensor packet returned
 
     def connect(self, timeout_s: float) -> packets.Sensor:
         """Say HELLO until the first sensor packet arrives; return it.
@@ -73,7 +74,9 @@ class PlantClient:
     def next(self, timeout_s: float) -> packets.Sensor | packets.Header | None:
         """The next sensor or END packet, waiting at most ``timeout_s`` [s]; None if none.
 
-        Malformed packets are counted (:attr:`malformed`) and skipped.
+        Malformed packets are counted (:attr:`malformed`) and skipped, and so is a sensor
+        packet not newer than the last one returned (the plant repeats its last packet
+        when a HELLO comes before any command).
 
         Parameters
         ----------
@@ -95,7 +98,12 @@ class PlantClient:
             except packets.PacketError:
                 self.malformed += 1
                 continue
-            if isinstance(packet, packets.Sensor) or packet.type == packets.END:
+            if isinstance(packet, packets.Sensor):
+                if packet.sequence <= self._sequence:
+                    continue
+                self._sequence = packet.sequence
+                return packet
+            if packet.type == packets.END:
                 return packet
 
     def command(self, sensor: packets.Sensor, torque: np.ndarray) -> None:

@@ -113,6 +113,7 @@ class _RemoteLaw:
         self.held = np.zeros(3)  # zero before the first command arrives
         self.answer: np.ndarray | None = None  # the command answering the last packet
         self.k = 0
+        self.last_sent: bytes | None = None  # the last sensor packet sent
         self.start = 0.0
         self.last_heard = 0.0
 
@@ -149,7 +150,13 @@ class _RemoteLaw:
             self._malformed(error)
             return
         if not isinstance(packet, packets.Command):
-            return  # a repeated HELLO
+            # a repeated HELLO: before its first command, the client has not had a
+            # sensor packet (over ZeroMQ one sent before its connection was up is
+            # dropped): send it the last one again
+            if packet.type == packets.HELLO and self.stats.commands == 0 and self.last_sent:
+                self.last_heard = now
+                self.link.send(self.last_sent)
+            return
         self.last_heard = now
         self.stats.commands += 1
         self.stats.latency_s.append((time.monotonic_ns() - packet.echo_stamp_ns) * 1e-9)
@@ -190,7 +197,8 @@ class _RemoteLaw:
                 self.held = self.answer
         self.answer = None
         self.stats.instants += 1
-        self.link.send(packets.encode_sensor(k, round(t * 1e9), time.monotonic_ns(), q, omega))
+        self.last_sent = packets.encode_sensor(k, round(t * 1e9), time.monotonic_ns(), q, omega)
+        self.link.send(self.last_sent)
         return self.held
 
 
