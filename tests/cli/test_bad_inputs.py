@@ -222,6 +222,40 @@ CONFIGS = [
     Bad("config is a folder", ["modal", "--config", "{tmp}"], "cannot read config file"),
 ]
 
+
+def _controller_npz(**overrides) -> bytes:
+    """A statespace law's controller file (order 2, dt 1 ms) with ``overrides``; None drops one."""
+    arrays = {"A": 0.5 * np.eye(2), "B": np.ones((2, 6)), "C": np.ones((3, 2)),
+              "D": np.zeros((3, 6)), "dt": np.array(1e-3)}  # fmt: skip
+    arrays.update(overrides)
+    return npz_bytes({k: v for k, v in arrays.items() if v is not None})
+
+
+def _controller(id: str, fragment: str, name: str = "k.npz", **overrides) -> Bad:
+    body = f'duration_s = 100.0\n[controller]\nkind = "statespace"\nfile = "{name}"\n'
+    content = overrides.pop("content", None) or _controller_npz(**overrides)
+    return Bad(
+        id, ["slew", "--scenario", "{tmp}/s.toml"], fragment, {"s.toml": body, name: content}
+    )
+
+
+# A discrete state-space controller file (statespace law): shapes, finite, dt = control_dt_s.
+STATESPACE_FILES = [
+    _controller("controller B of 5 columns", "controller file {tmp}/k.npz: B must have shape (2, 6)", B=np.ones((2, 5))),
+    _controller("controller C of 4 rows", "C must have shape (3, 2)", C=np.ones((4, 2))),
+    _controller("controller A not square", "A must have shape (2, 2)", A=np.ones((2, 3))),
+    _controller("controller with NaN", "A must hold finite entries within +-1e+12", A=np.full((2, 2), np.nan)),
+    _controller("controller order 65", "the order (rows of A) must be in 1..64, got 65", A=np.eye(65), B=np.ones((65, 6)), C=np.ones((3, 65))),
+    _controller("controller without dt", "missing variable(s) dt (needs A, B, C, D, dt)", dt=None),
+    _controller("controller dt negative", "dt must be one number in (0, 10] s", dt=np.array(-1e-3)),
+    _controller("controller dt of another loop", "controller.file: the controller was discretized at dt = 0.01 s, the loop runs at control_dt_s = 0.001 s", dt=np.array(1e-2)),
+    _controller("controller file not an NPZ", "controller file {tmp}/k.npz: not a readable .npz file", content=b"not a zip"),
+    _controller("controller file .txt", "controller file {tmp}/k.txt: the suffix must be .npz or .mat, got '.txt'", name="k.txt"),
+    _controller("controller .mat not a MAT file", "controller file {tmp}/k.mat: not a readable .mat file", name="k.mat", content=b"MATLAB 5.0 garbage"),
+    Bad("controller file missing", ["slew", "--scenario", "{tmp}/s.toml"], "controller file not found", {"s.toml": '[controller]\nkind = "statespace"\nfile = "absent.npz"\n'}),
+    Bad("controller file not named", ["slew", "--scenario", "{tmp}/s.toml"], "controller.file", {"s.toml": '[controller]\nkind = "statespace"\n'}),
+]  # fmt: skip
+
 SCENARIOS = [
     _scenario("dt 1e-9 s", "dt_s = 1e-9\nrecord_dt_s = 1e-2\n", "steps is more than the 1e+09 allowed"),
     _scenario("duration 1e6 s", "duration_s = 1e6\n", "GiB in memory"),
@@ -576,7 +610,7 @@ REALTIME = [
 ]  # fmt: skip
 
 TABLE = (CONFIGS + SCENARIOS + PATHS + SPECIAL_FILES + ROBUSTNESS + CAMPAIGNS + BUDGET + NASTRAN
-         + ORBIT + REALTIME)  # fmt: skip
+         + ORBIT + REALTIME + STATESPACE_FILES)  # fmt: skip
 
 
 def test_the_table_is_at_least_sixty_rows():

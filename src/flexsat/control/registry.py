@@ -91,12 +91,18 @@ class Registry(Generic[Spec]):
     def __init__(self, what: str, group: str) -> None:
         self.what, self.group = what, group
         self._specs: dict[str, Spec] = {}
+        self._unlisted: set[str] = set()
         self._default: str | None = None
         self._discovered = False
 
-    def register(self, name: str, spec: Spec, default: bool = False) -> Spec:
-        """Add (or replace) ``spec`` under ``name``; ``default``: used when a table has no kind."""
+    def register(self, name: str, spec: Spec, default: bool = False, listed: bool = True) -> Spec:
+        """Add (or replace) ``spec`` under ``name``; ``default``: used when a table has no kind;
+        ``listed=False``: a table may name it, but :meth:`names` (what runs "every piece",
+        e.g. the laws compared) leaves it out."""
         self._specs[name] = spec
+        self._unlisted.discard(name)
+        if not listed:
+            self._unlisted.add(name)
         if default:
             self._default = name
         return spec
@@ -106,14 +112,15 @@ class Registry(Generic[Spec]):
         if name not in self._specs:
             raise ValueError(f"no {self.what} {name!r} is registered")
         spec = self._specs.pop(name)
+        self._unlisted.discard(name)
         if self._default == name:
             self._default = None
         return spec
 
     def names(self) -> tuple[str, ...]:
-        """Every registered name, built-ins first, in registration order."""
+        """Every listed name, built-ins first, in registration order."""
         self._discover()
-        return tuple(self._specs)
+        return tuple(name for name in self._specs if name not in self._unlisted)
 
     def get(self, name: str) -> Spec:
         """The specification registered as ``name``; ValueError listing the names if none."""
@@ -156,10 +163,11 @@ class Registry(Generic[Spec]):
             kind = value.get("kind", self.default)
         else:
             raise PydanticCustomError("model_type", "expected a TOML table (section)")
-        if kind not in self.names():
+        self._discover()
+        if kind not in self._specs:
             raise PydanticCustomError(
                 "union_tag_invalid", "unknown kind",
-                {"expected_tags": ", ".join(self.names()), "tag": kind},
+                {"expected_tags": ", ".join(self._specs), "tag": kind},
             )  # fmt: skip
         model = config_of(self._specs[kind])
         if isinstance(value, BaseModel):

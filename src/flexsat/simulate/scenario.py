@@ -416,7 +416,7 @@ class SlewScenario(_TimedRun):
 
     @model_validator(mode="after")
     def _stages_fit_the_run(self) -> SlewScenario:
-        for field, stage in self.stage_chain():
+        for field, stage in [("controller", self.controller), *self.stage_chain()]:
             try:
                 stage.check(self)
             except ValueError as error:
@@ -519,7 +519,13 @@ def _read_scenario(path: str | Path | None, model: type[_Frozen]) -> _Frozen:
     """``model`` validated from the TOML file ``path``; its defaults when ``path`` is None."""
     if path is None:
         return model()
-    return validate_config(read_toml(path, "scenario"), source=str(path), model=model)
+    data = read_toml(path, "scenario")
+    controller = data.get("controller")
+    name = controller.get("file") if isinstance(controller, dict) else None
+    if isinstance(name, str) and name and not Path(name).is_absolute():
+        # a controller file (statespace law) is relative to the scenario's folder
+        data = {**data, "controller": {**controller, "file": str(Path(path).parent / name)}}
+    return validate_config(data, source=str(path), model=model)
 
 
 def thesis_openloop() -> OpenLoopScenario:

@@ -27,6 +27,7 @@ from flexsat.control.laws.registry import (
     validate_law_config,
 )
 from flexsat.control.laws.smc import SMC
+from flexsat.control.laws.statespace import STATESPACE
 from flexsat.control.laws.stsmc import STSMC
 from flexsat.control.registry import channel_columns
 
@@ -47,6 +48,7 @@ register_law(SMC)
 register_law(PD)
 register_law(STSMC)
 register_law(ISMC)
+register_law(STATESPACE)
 
 
 class CompiledLaw:

@@ -90,6 +90,11 @@ class LawConfig(_Frozen):
         """
         raise NotImplementedError
 
+    def check(self, scenario: Any) -> None:
+        """Refuse a setting inconsistent with the rest of ``scenario`` (a ValueError whose
+        message starts with the field's name, e.g. a controller discretized at another
+        control period); default: nothing to check."""
+
     def plot_attributes(self) -> dict[str, float | str]:
         """What the slew plots draw for this law, written into the result's attributes.
 
@@ -161,6 +166,10 @@ LAWS: Registry[LawSpec] = Registry("control law", "flexsat.laws")
 def register_law(spec: LawSpec, default: bool = False) -> LawSpec:
     """Register a law under ``spec.name`` (replacing one of that name).
 
+    A law whose parameter model has a required field (a file to read) is registered
+    but not listed by :func:`law_names`: a ``[controller]`` table selects it, the
+    comparisons over every law leave it out.
+
     Parameters
     ----------
     spec : LawSpec
@@ -175,7 +184,10 @@ def register_law(spec: LawSpec, default: bool = False) -> LawSpec:
     """
     if spec.config.model_fields["kind"].default != spec.name:
         raise ValueError(f"law {spec.name!r}: its config's kind must default to {spec.name!r}")
-    return LAWS.register(spec.name, spec, default=default)
+    # a law with a required parameter (the statespace law's file) cannot run from its
+    # defaults: a table names it, the every-law comparisons leave it out
+    runs_alone = not any(f.is_required() for f in spec.config.model_fields.values())
+    return LAWS.register(spec.name, spec, default=default, listed=runs_alone)
 
 
 def get_law(name: str) -> LawSpec:
@@ -199,7 +211,7 @@ def get_law(name: str) -> LawSpec:
 
 
 def law_names() -> tuple[str, ...]:
-    """Names of every registered law, built-ins first."""
+    """Names of every registered law that runs from its defaults, built-ins first."""
     return LAWS.names()
 
 
