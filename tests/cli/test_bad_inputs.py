@@ -432,6 +432,19 @@ ROBUSTNESS = [
     _scenario("MEKF without gyro or star tracker", _MEKF_ALONE, "sensor_stages[0].kind: an MEKF needs a gyro or a star tracker", command="slew"),
 ]  # fmt: skip
 
+_ROBUST = ["robust", "analyze", "--points", "8"]
+_MU_K = {"A": -np.eye(2), "B": np.zeros((2, 6)), "C": np.zeros((3, 2)), "D": np.zeros((3, 6))}
+ROBUST_ANALYZE = [
+    Bad("robust analyze on 3 frequencies", ["robust", "analyze", "--points", "3"], "--points: the frequency grid needs 8 ... 2000 points, got 3"),
+    Bad("robust analyze at SADM 500 deg", [*_ROBUST, "--sadm-angle", "500"], "--sadm-angle: an angle within [-180, 180] deg, got 500"),
+    Bad("robust analyze of a missing controller", [*_ROBUST, "--controller", "{tmp}/none.npz"], "--controller {tmp}/none.npz: no such file"),
+    Bad("robust analyze of a text controller", [*_ROBUST, "--controller", "{tmp}/k.npz"], "--controller {tmp}/k.npz: not an NPZ of arrays A, B, C, D", {"k.npz": "A = 1\n"}),
+    Bad("robust analyze of a controller without D", [*_ROBUST, "--controller", "{tmp}/k.npz"], "--controller {tmp}/k.npz: missing array D", {"k.npz": npz_bytes({k: v for k, v in _MU_K.items() if k != "D"})}),
+    Bad("robust analyze of a controller with B 2 x 5", [*_ROBUST, "--controller", "{tmp}/k.npz"], "controller.B: expected shape (2, 6)", {"k.npz": npz_bytes({**_MU_K, "B": np.zeros((2, 5))})}),
+    Bad("robust analyze of a controller with a NaN", [*_ROBUST, "--controller", "{tmp}/k.npz"], "controller.A: every entry must be a finite number", {"k.npz": npz_bytes({**_MU_K, "A": np.full((2, 2), np.nan)})}),
+]  # fmt: skip
+ROBUSTNESS += ROBUST_ANALYZE  # the inputs of `flexsat robust analyze`
+
 CAMPAIGNS = [
     _campaign("campaign named with ../", 'name = "../../../outside"\n', "name: contains characters"),
     _campaign("campaign named with an absolute path", 'name = "/tmp/outside"\n', "name: contains characters"),

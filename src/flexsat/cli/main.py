@@ -59,6 +59,12 @@ fmu_app = typer.Typer(
     rich_markup_mode=None,
 )
 app.add_typer(fmu_app, name="fmu")
+robust_app = typer.Typer(
+    help="Robustness of the loops to the satellite's uncertain parameters (mu).",
+    no_args_is_help=True,
+    rich_markup_mode=None,
+)
+app.add_typer(robust_app, name="robust")
 
 _console = Console(markup=False)  # names and paths are printed as written, never as markup
 _errors = Console(stderr=True, soft_wrap=True)
@@ -340,6 +346,60 @@ def _print_margins(summary: dict) -> None:
              m["delay_crossover_hz"]] for axis, m in axes.items()]  # fmt: skip
     header = ("axis", "PM [deg]", "GM [-]", "delay margin [s]", "set at [Hz]")
     print_table(_console, f"{law} loop margins — {name}", header, rows)
+
+
+@robust_app.command("analyze")
+def robust_analyze(
+    config: ConfigOption = None,
+    scenario: Annotated[
+        Path | None,
+        typer.Option(help="Slew scenario (TOML): its law (pd, smc, asmc). Default: PD defaults."),
+    ] = None,
+    controller: Annotated[
+        Path | None,
+        typer.Option(
+            help="A linear controller instead: NPZ of A, B, C, D (attitude, rate -> N m)."
+        ),
+    ] = None,
+    sadm_angle: Annotated[
+        float | None, typer.Option(help="Every plate's SADM angle [deg]. Default: the config's.")
+    ] = None,
+    points: Annotated[int, typer.Option(help="Log-spaced frequencies, 1e-3 ... 200 Hz.")] = 60,
+    json_output: JsonOption = False,
+    out: Annotated[Path | None, typer.Option(help="Write mu.json and mu.png here.")] = None,
+) -> None:
+    """mu-analysis of the loop over the thesis's parameter box: bounds, k_max, worst case.
+
+    Panel frequencies +-20 %, damping 0 ... nominal, hub and panel inertias +-20 %.
+    """
+    from flexsat.config import load_config
+    from flexsat.simulate.scenario import load_slew
+    from flexsat.study.mu import robust_analysis
+
+    slew_scenario = None if scenario is None else load_slew(scenario)
+    cfg = load_config(config)
+    summary = robust_analysis(cfg, slew_scenario, controller, sadm_angle, points, out)
+    if json_output:
+        typer.echo(dumps(summary))
+        return
+    rows = [[p["name"], p["low"], p["high"], p["block_size"]] for p in summary["parameters"]]
+    print_table(_console, f"Uncertain parameters — {summary['config_name']}",
+                ("parameter", "low [-]", "high [-]", "channels"), rows)  # fmt: skip
+    rows = [
+        ["mu upper bound (peak)", summary["peak_upper"], summary["peak_frequency_hz"]],
+        ["mu lower bound", summary["lower"], summary["lower_frequency_hz"]],
+        ["k_max, certified (1/upper)", summary["k_max_lower"], ""],
+        ["k_max, not above (1/lower)", summary["k_max_upper"], ""],
+    ]
+    print_table(_console, f"Robust stability, {summary['law'].upper()} loop",
+                ("quantity", "value [-]", "at [Hz]"), rows)  # fmt: skip
+    rows = [[k, v] for k, v in summary["worst_factors"].items()]
+    print_table(_console, "Worst case (destabilizing point): factor on nominal",
+                ("parameter", "factor [-]"), rows)  # fmt: skip
+    if not summary["nominal_stable"]:
+        _console.print("the loop is unstable at the box's centre: mu bounds do not apply")
+    for path in summary.get("files", []):
+        _console.print(f"wrote {path}")
 
 
 @app.command()

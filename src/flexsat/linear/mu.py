@@ -341,6 +341,7 @@ def analyze(
     frequencies_hz: np.ndarray | None = None,
     refine: bool = True,
     maxiter: int = 200,
+    add_modes: bool = True,
 ) -> MuAnalysis:
     """Robust stability of a loop: mu bounds, k_max and the worst parameter point.
 
@@ -351,12 +352,14 @@ def analyze(
     controller : LinearController
         The law (``LinearController.static(law_gains(...))`` for flexsat's laws).
     frequencies_hz : ndarray, optional
-        The grid [Hz]; default 200 log-spaced points over 1e-3 ... 200 Hz plus the
-        closed loop's modal frequencies at the box's centre.
+        The grid [Hz]; default 200 log-spaced points over 1e-3 ... 200 Hz.
     refine : bool
         Refine the upper bound's peak with a bounded scalar search.
     maxiter : int
         L-BFGS-B iterations of the D-G scalings per frequency (:func:`mu_upper_bound`).
+    add_modes : bool
+        Add the closed loop's modal frequencies at the box's centre (within the
+        grid's span) to the grid.
 
     Returns
     -------
@@ -366,12 +369,12 @@ def analyze(
     poles = np.linalg.eigvals(loop[0])
     nominal_stable = bool(np.max(poles.real) < 0.0)
     if frequencies_hz is None:
+        frequencies_hz = np.logspace(-3, np.log10(200.0), 200)
+    frequencies_hz = np.asarray(frequencies_hz, dtype=float)
+    if add_modes:  # the closed loop's modes at the box's centre, within the grid's span
         modal = np.abs(poles.imag[poles.imag > 0]) / (2 * np.pi)
-        frequencies_hz = np.unique(
-            np.concatenate(
-                [np.logspace(-3, np.log10(200.0), 200), modal[(modal > 1e-3) & (modal < 200)]]
-            )
-        )
+        lo, hi = np.min(frequencies_hz), np.max(frequencies_hz)
+        frequencies_hz = np.unique(np.r_[frequencies_hz, modal[(modal >= lo) & (modal <= hi)]])
     f = np.sort(np.asarray(frequencies_hz, dtype=float))
     real = np.ones(model.n_channels, dtype=bool)
     upper = np.empty(f.size)
@@ -392,6 +395,8 @@ def analyze(
         )  # fmt: skip
         if -res.fun > peak:
             peak, f_peak = float(-res.fun), float(10**res.x)
+            j = int(np.searchsorted(f, f_peak))
+            f, upper = np.insert(f, j, f_peak), np.insert(upper, j, peak)
     n_p = len(model.parameters)
     vertices = np.array(np.meshgrid(*[[-1.0, 1.0]] * n_p)).reshape(n_p, -1).T
     axes = np.vstack([np.eye(n_p), -np.eye(n_p)])
