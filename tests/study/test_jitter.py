@@ -116,3 +116,24 @@ def test_a_scenario_without_microvibration_is_refused(plant):
     static = SlewScenario.model_validate({})
     with pytest.raises(ConfigError, match='kind = "wheels"'):
         write_jitter(plant, static)
+
+
+def test_the_lines_are_the_budgets_periodic_contributors(plant, tmp_path):
+    from flexsat.analysis.budget import budget_rows, load_requirements
+
+    summary = write_jitter(plant, jitter_scenario(), tmp_path / "j",
+                           speeds_rpm=np.linspace(500.0, 3000.0, 5), window_s=1.0)  # fmt: skip
+    header = ("[pointing]\n[pointing.indices.APE]\nbound_deg = 0.01\n"
+              "[pointing.indices.RPE]\nbound_deg = 0.01\nwindow_s = 1.0\n")  # fmt: skip
+    requirements = tmp_path / "req.toml"
+    requirements.write_text(header + (tmp_path / "j" / "contributors.toml").read_text())
+    rows = budget_rows(load_requirements(requirements))
+    sigma = {(r["index"], r["axis"]): r["sigma_deg"] * 3600.0 for r in rows}
+    # Each line is a sinusoid per axis: the budget's sigma A / sqrt(2) summed in power
+    # is the jitter's RMS, its RPE's A |1 - sinc(dt / T)| the windowed RMS. Both sides
+    # are the same sums of the same amplitudes (repr round-trips floats exactly):
+    # round-off, 1e-12.
+    for axis in "xyz":
+        assert sigma["APE", axis] == pytest.approx(summary["rms_arcsec"][axis], rel=1e-12)
+        assert sigma["RPE", axis] == pytest.approx(summary["rpe_rms_arcsec"][axis], rel=1e-12)
+    assert len(rows) == 6 and sigma["APE", "y"] > 0.01  # arcsec: the lines are all there

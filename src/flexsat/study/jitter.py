@@ -9,7 +9,13 @@ import numpy as np
 from flexsat.dynamics.plant import Plant
 from flexsat.errors import ConfigError
 
-__all__ = ["DEFAULT_MICROVIBRATION", "REPORT_WINDOW_S", "jitter_scenario", "write_jitter"]
+__all__ = [
+    "DEFAULT_MICROVIBRATION",
+    "REPORT_WINDOW_S",
+    "budget_contributors",
+    "jitter_scenario",
+    "write_jitter",
+]
 
 _ARCSEC = 180.0 / np.pi * 3600.0
 _SWEEP_POINTS = 400
@@ -66,7 +72,8 @@ def write_jitter(
         law closes the loop (:func:`flexsat.linear.jitter.closed_loop`), its wheels'
         ``initial_speed_rpm`` is the speed the jitter is given at.
     out : Path, optional
-        Folder for ``jitter.json`` and ``campbell.png``.
+        Folder for ``jitter.json``, ``campbell.png`` and ``contributors.toml`` (the
+        lines as the budget's periodic contributors, :func:`budget_contributors`).
     speeds_rpm : ndarray, optional
         Speeds to sweep [rpm]; default 400 from 1 % of the wheels' limit to it.
     window_s : float, optional
@@ -151,15 +158,50 @@ def write_jitter(
     summary["sweep"] = {"low_rpm": float(np.min(speeds_rpm)), "high_rpm": float(np.max(speeds_rpm)),
                         "count": int(np.size(speeds_rpm))}  # fmt: skip
     if out is not None:
+        from flexsat.files import write_text
         from flexsat.plots.jitter import plot_campbell
         from flexsat.plots.style import save_figure
         from flexsat.study.outputs import prepare_output_dir, write_json
 
         folder = prepare_output_dir(out)
         figure = save_figure(plot_campbell(sweep), folder / "campbell.png", dpi=110)
-        summary["files"] = [str(figure), str(folder / "jitter.json")]
+        toml = write_text(folder / "contributors.toml", budget_contributors(summary))
+        summary["files"] = [str(figure), str(folder / "jitter.json"), str(toml)]
         write_json(folder / "jitter.json", summary)
     return summary
+
+
+def budget_contributors(summary: dict) -> str:
+    """The jitter's lines as periodic contributors of a pointing budget, TOML text.
+
+    One ``[[pointing.contributors]]`` table per line: ``kind = "periodic"``, its
+    amplitude per hub axis and its period 1/f (docs/pointing.md, 'Contributors'). Each
+    axis's sinusoids add in the budget as σ = A/√2 each, so its statistical sum's σ is
+    the RMS jitter of the line response, and its RPE's the windowed jitter.
+
+    Parameters
+    ----------
+    summary : dict
+        :func:`write_jitter`'s summary.
+
+    Returns
+    -------
+    str
+        TOML to append to a requirement file (``flexsat budget --requirements``).
+    """
+    head = (f"# the microvibration lines at {summary['speed_rpm']:g} rpm "
+            f"({summary['law']} loop): periodic contributors, amplitudes [deg]\n")  # fmt: skip
+    blocks = []
+    for k, line in enumerate(summary["lines"], start=1):
+        amplitude = [line["amplitude_arcsec"][a] / 3600.0 for a in ("x", "y", "z")]
+        blocks.append(
+            "[[pointing.contributors]]\n"
+            f'name = "microvibration line {k} ({line["frequency_hz"]:.6g} Hz)"\n'
+            'kind = "periodic"\n'
+            f"amplitude_deg = [{', '.join(repr(float(a)) for a in amplitude)}]\n"
+            f"period_s = {1.0 / line['frequency_hz']!r}\n"
+        )
+    return head + "\n".join(blocks)
 
 
 def _per(values: np.ndarray, names: list[str]) -> dict:

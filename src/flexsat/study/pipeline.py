@@ -228,8 +228,8 @@ def _pointing(ctx: StudyContext) -> dict:
 
     summary = write_jitter(ctx.plant, jitter_scenario(), ctx.out / "pointing",
                            window_s=REPORT_WINDOW_S)  # fmt: skip
-    figure, written = _relative(ctx, summary["files"])
-    return {"json": written, "figures": [figure]}
+    figure, written, contributors = _relative(ctx, summary["files"])
+    return {"json": written, "figures": [figure], "contributors": contributors}
 
 
 def _animation(ctx: StudyContext) -> dict:
