@@ -103,7 +103,7 @@ P_J_I = 16  # (9) J_I, inertia about the interface point [kg m^2]
 P_RES = 25  # (36) M_rr - L^T L at eta = 0, about the interface, row-major 6 x 6
 P_N = 61  # (1) number of modes n
 P_DAMP_AT = 62  # (1) offset of the n x n modal damping matrix [1/s]; 0: diagonal (MODE_C)
-P_SECOND_AT = 63  # (1) offset of the n x n blocks of SO_SIZE (large motion); 0: none
+P_SECOND_AT = 63  # (1) offset of the (SO_SIZE n) x n matrix A (large motion); 0: none
 P_MODES = 64  # n blocks of MODE_SIZE
 MODE_K = 0  # omega_k^2 [1/s^2]
 MODE_C = 1  # 2 zeta_k omega_k [1/s]
@@ -112,13 +112,17 @@ MODE_LR = 5  # (3) l_r,k [sqrt(kg) m]
 MODE_TIP = 8  # (3) tip mode-shape row, frame M [m / (sqrt(kg) m)]
 MODE_DJ = 11  # (9) J'_k = dJ_I / d eta_k, B, row-major [sqrt(kg) m]
 MODE_SIZE = 20
-# The large-motion invariants of mode pair (k, l), block (k n + l) of SO_SIZE, frame B.
+# The large-motion invariants, frame B, as one row-major matrix A of SO_SIZE n rows and
+# n columns: A[r n + k, l] is component r of mode pair (k, l), so that A eta and
+# A eta_dot hold every mode's sums over l (two matrix-vector products, BLAS).
 SO_C = 0  # (3) C_kl = d^2 c~ / d eta_k d eta_l [1/m]
 SO_E = 3  # (3) E_kl = d h_k / d eta_l [-]
 SO_ET = 6  # (3) E_lk [-]
 SO_J = 9  # (9) J''_kl = d^2 J_I / d eta_k d eta_l [-]
 SO_SIZE = 18
+SO_RATE = 9  # rows r < SO_RATE of A are also multiplied by eta_dot
 WORK_MODE = 7  # per mode in pass 1's scratch: L_t,k(eta) (3), h_k(eta) (3), its force (1)
+# after those n WORK_MODE columns: A eta (SO_SIZE n), then A[:SO_RATE n] eta_dot
 
 Scale = Annotated[float, Strict(), AllowInfNan(False), Field(gt=0.0, le=1e3)]
 
@@ -260,18 +264,40 @@ def _mode_rows(q, qd, o, p, k):
     b = P_MODES + MODE_SIZE * k
     l_t, h, J_k = load_seg(p, b + MODE_LT), load_seg(p, b + MODE_LR), load_m33_at(p, b + MODE_DJ)
     c_d, e_d, et_d = (0.0, 0.0, 0.0), (0.0, 0.0, 0.0), (0.0, 0.0, 0.0)
-    base = int(p[P_SECOND_AT]) + SO_SIZE * n * k
+    at, nn = int(p[P_SECOND_AT]) + n * k, n * n  # A[r n + k, l] = p[at + r n^2 + l]
     for m in range(n):
-        c = base + SO_SIZE * m
         e, e_dot = q[o + m], qd[o + m]
-        C, E = load_seg(p, c + SO_C), load_seg(p, c + SO_E)
+        c = at + m
+        C = (p[c + SO_C * nn], p[c + (SO_C + 1) * nn], p[c + (SO_C + 2) * nn])
+        E = (p[c + SO_E * nn], p[c + (SO_E + 1) * nn], p[c + (SO_E + 2) * nn])
+        ET = (p[c + SO_ET * nn], p[c + (SO_ET + 1) * nn], p[c + (SO_ET + 2) * nn])
+        c = at + m + SO_J * nn
+        J2 = ((p[c], p[c + nn], p[c + 2 * nn]), (p[c + 3 * nn], p[c + 4 * nn], p[c + 5 * nn]),
+              (p[c + 6 * nn], p[c + 7 * nn], p[c + 8 * nn]))  # fmt: skip
         l_t = add(l_t, scale(e, C))
         h = add(h, scale(e, E))
         c_d = add(c_d, scale(e_dot, C))
         e_d = add(e_d, scale(e_dot, E))
-        et_d = add(et_d, scale(e_dot, load_seg(p, c + SO_ET)))
-        J_k = _madd(J_k, load_m33_at(p, c + SO_J), e)
+        et_d = add(et_d, scale(e_dot, ET))
+        J_k = _madd(J_k, J2, e)
     return l_t, h, J_k, c_d, e_d, et_d
+
+
+@njit(cache=True, error_model="numpy")
+def _rows_at(p, k, ye, e0, es, yd, d0, ds):
+    """Mode k's rows from the products y_e = A eta (entry r at ye[e0 + r es]) and
+    y_d = A eta_dot (yd[d0 + r ds]): see :func:`_mode_rows`."""
+    b = P_MODES + MODE_SIZE * k
+    l_t, h, J_k = load_seg(p, b + MODE_LT), load_seg(p, b + MODE_LR), load_m33_at(p, b + MODE_DJ)
+    c_d = (yd[d0 + SO_C * ds], yd[d0 + (SO_C + 1) * ds], yd[d0 + (SO_C + 2) * ds])
+    e_d = (yd[d0 + SO_E * ds], yd[d0 + (SO_E + 1) * ds], yd[d0 + (SO_E + 2) * ds])
+    et_d = (yd[d0 + SO_ET * ds], yd[d0 + (SO_ET + 1) * ds], yd[d0 + (SO_ET + 2) * ds])
+    l_t = add(l_t, (ye[e0 + SO_C * es], ye[e0 + (SO_C + 1) * es], ye[e0 + (SO_C + 2) * es]))
+    h = add(h, (ye[e0 + SO_E * es], ye[e0 + (SO_E + 1) * es], ye[e0 + (SO_E + 2) * es]))
+    j = e0 + SO_J * es
+    J2 = ((ye[j], ye[j + es], ye[j + 2 * es]), (ye[j + 3 * es], ye[j + 4 * es], ye[j + 5 * es]),
+          (ye[j + 6 * es], ye[j + 7 * es], ye[j + 8 * es]))  # fmt: skip
+    return l_t, h, _madd(J_k, J2, 1.0), c_d, e_d, et_d
 
 
 @njit(cache=True, error_model="numpy")
@@ -286,9 +312,21 @@ def _second_sums(q, qd, o, p, omega, work, j, store):
     z = (0.0, 0.0, 0.0)
     s, s_dot, h_r, quad_t, quad_r = z, z, z, z, z
     J, J_dot = load_m33_at(p, P_J_I), (z, z, z)
-    for k in range(int(p[P_N])):
+    n = int(p[P_N])
+    w0 = WORK_MODE * n
+    ye = work[j, w0 : w0 + SO_SIZE * n]
+    yd = work[j, w0 + SO_SIZE * n : w0 + (SO_SIZE + SO_RATE) * n]
+    if store:  # A eta and A[:SO_RATE n] eta_dot into the scratch, by BLAS
+        at = int(p[P_SECOND_AT])
+        A = p[at : at + SO_SIZE * n * n].reshape((SO_SIZE * n, n))
+        np.dot(A, q[o : o + n], ye)
+        np.dot(A[: SO_RATE * n], qd[o : o + n], yd)
+    for k in range(n):
         b = P_MODES + MODE_SIZE * k
-        l_t, h, J_k, c_d, e_d, et_d = _mode_rows(q, qd, o, p, k)
+        if store:
+            l_t, h, J_k, c_d, e_d, et_d = _rows_at(p, k, ye, k, n, yd, k, n)
+        else:
+            l_t, h, J_k, c_d, e_d, et_d = _mode_rows(q, qd, o, p, k)
         e, e_dot = q[o + k], qd[o + k]
         s = add(s, scale(0.5 * e, add(load_seg(p, b + MODE_LT), l_t)))
         J = _madd(_madd(J, load_m33_at(p, b + MODE_DJ), 0.5 * e), J_k, 0.5 * e)
@@ -685,20 +723,21 @@ class ModalModel(AppendageModel):
             at += n * n
         if data.second_order:
             row[P_SECOND_AT] = at
-            pairs = np.zeros((n, n, SO_SIZE))
+            pairs = np.zeros((n, n, SO_SIZE))  # [k, l, r], packed as A[r n + k, l]
             C, E = data.first_moment_hessian_array(), data.coupling_gradient_array()
             pairs[:, :, SO_C : SO_C + 3] = C @ R.T
             pairs[:, :, SO_E : SO_E + 3] = E @ R.T
             pairs[:, :, SO_ET : SO_ET + 3] = (E @ R.T).transpose(1, 0, 2)
             J2 = R @ data.inertia_hessian_array() @ R.T
             pairs[:, :, SO_J : SO_J + 9] = J2.reshape(n, n, 9)
-            blocks.append(pairs.ravel())
+            blocks.append(pairs.transpose(2, 0, 1).ravel())
         return np.concatenate(blocks) if len(blocks) > 1 else row
 
     def work_columns(self, params: np.ndarray) -> int:
         # Pass 1 leaves each mode's rows at eta for pass 2 when the large-motion terms
-        # are on.
-        return WORK_MODE * int(params[P_N]) if params[P_SECOND_AT] > 0.0 else 0
+        # are on, after the products A eta and A eta_dot.
+        n = int(params[P_N])
+        return (WORK_MODE + SO_SIZE + SO_RATE) * n if params[P_SECOND_AT] > 0.0 else 0
 
     @staticmethod
     def _modes(params: np.ndarray) -> np.ndarray:
