@@ -173,6 +173,24 @@ def test_wheel_lines_and_speed_sweep_refuse_bad_input(plant):
     assert wheel_lines(WheelsConfig(), 1000.0).frequency_hz.size == 0
 
 
+def test_wheels_at_rest_give_no_line_and_no_jitter(plant):
+    # C Omega^2 = 0 at rest: no line (a line at 0 Hz would ask H(0), singular with the
+    # hub's free translation), so zero jitter instead of a failed solve.
+    model = closed_loop(plant, PDConfig())
+    config = WheelsConfig.model_validate(
+        {**FRICTIONLESS, "microvibration": {**VIBRATION, "wheels": None}}
+    )
+    rest = wheel_lines(config, 0.0, model.B.shape[1])
+    assert rest.frequency_hz.size == 0 and rest.amplitude.shape == (0, model.B.shape[1])
+    np.testing.assert_array_equal(jitter_rms(model, rest), np.zeros(3))
+    # wheel 2 at rest among spinning ones: the others' lines only, each unchanged
+    mixed = wheel_lines(config, [1500.0, 0.0, 1500.0, 1500.0])
+    spinning = wheel_lines(config, 1500.0)
+    assert [s for s in spinning.source if not s.startswith("wheel 2 ")] == list(mixed.source)
+    keep = [not s.startswith("wheel 2 ") for s in spinning.source]
+    np.testing.assert_array_equal(mixed.amplitude, spinning.amplitude[keep])
+
+
 def test_backwards_spin_gives_the_mirrored_lines():
     # Omega -> -Omega: theta(t) = -|Omega| t, so each line is the conjugate, same power.
     config = WheelsConfig.model_validate({**FRICTIONLESS, "microvibration": VIBRATION})

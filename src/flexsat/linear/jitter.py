@@ -225,7 +225,7 @@ def wheel_lines(
     phases = vib.phases(n)
     names = ("radial_force", "axial_force", "radial_torque")
     freqs, amps, source = [], [], []
-    on = vib.vibrating(n)
+    on = vib.vibrating(n) & (speeds != 0.0)  # a wheel at rest: no line (C 0^2 = 0)
     for k, (kind, h, c) in enumerate(vib.terms()):
         for i in np.nonzero(on)[0]:
             rotor = np.exp(1j * phases[k, i]) * c * speeds[i] ** 2
@@ -236,7 +236,8 @@ def wheel_lines(
             freqs.append(h * abs(speeds[i]) / (2.0 * np.pi))
             amps.append(row if speeds[i] >= 0.0 else np.conj(row))  # spinning backwards
             source.append(f"wheel {i + 1} {names[kind]} h={h:g}")
-    return Lines(np.array(freqs), np.array(amps), tuple(source))
+    amplitude = np.array(amps, dtype=complex).reshape(len(freqs), n_inputs)
+    return Lines(np.array(freqs, dtype=float), amplitude, tuple(source))
 
 
 def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -332,6 +333,9 @@ def line_response(
         The output lines [rad].
     """
     freqs, where = np.unique(lines.frequency_hz, return_inverse=True)
+    if freqs.size == 0:  # no line (wheels at rest, no table): no jitter
+        n_y = model.C.shape[0] if rows is None else np.asarray(rows).shape[0]
+        return freqs, np.zeros((0, n_y), dtype=complex)
     U = np.zeros((freqs.size, lines.amplitude.shape[1]), dtype=complex)
     np.add.at(U, where, lines.amplitude)
     G = model.frequency_response(freqs)  # (n_f, n_out, n_u)
