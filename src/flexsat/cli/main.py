@@ -1274,8 +1274,8 @@ def jitter(
 
     chosen = jitter_scenario() if scenario is None else load_slew(scenario, check_window=False)
     swept = None if speeds is None else _parse_speeds(speeds)
-    if window is not None and not window > 0.0:
-        raise FlexsatError(f"--window: the RPE window must be > 0 s, got {window:g}")
+    if window is not None and not 0.0 < window < float("inf"):
+        raise FlexsatError(f"--window: the RPE window must be finite and > 0 s, got {window:g}")
     aim = None if boresight is None else _parse_triple(boresight, "--boresight")
     motor = None
     if stepper is not None:
