@@ -254,6 +254,13 @@ STATESPACE_FILES = [
     _controller("controller .mat not a MAT file", "controller file {tmp}/k.mat: not a readable .mat file", name="k.mat", content=b"MATLAB 5.0 garbage"),
     Bad("controller file missing", ["slew", "--scenario", "{tmp}/s.toml"], "controller file not found", {"s.toml": '[controller]\nkind = "statespace"\nfile = "absent.npz"\n'}),
     Bad("controller file not named", ["slew", "--scenario", "{tmp}/s.toml"], "controller.file", {"s.toml": '[controller]\nkind = "statespace"\n'}),
+    # flexsat robust synthesize: options refused before the (slow) synthesis
+    Bad("robust synthesize to a .txt", ["robust", "synthesize", "--out", "{tmp}/k.txt"], "--out: the suffix must be .npz or .mat, got '.txt'"),
+    Bad("robust synthesize into a missing folder", ["robust", "synthesize", "--out", "{tmp}/none/k.npz"], "--out: the folder {tmp}/none does not exist"),
+    Bad("robust synthesize of order 0", ["robust", "synthesize", "--out", "{tmp}/k.npz", "--order", "0"], "--order: must be in 1 ... 64, got 0"),
+    Bad("robust synthesize of order 65", ["robust", "synthesize", "--out", "{tmp}/k.npz", "--order", "65"], "--order: must be in 1 ... 64, got 65"),
+    Bad("robust synthesize with -1 modes", ["robust", "synthesize", "--out", "{tmp}/k.npz", "--modes", "-1"], "--modes: must be in 0 ... 50, got -1"),
+    Bad("robust synthesize at dt 0", ["robust", "synthesize", "--out", "{tmp}/k.npz", "--control-dt", "0"], "--control-dt: must be in (0, 10] s, got 0"),
 ]  # fmt: skip
 
 SCENARIOS = [

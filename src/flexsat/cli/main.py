@@ -402,6 +402,62 @@ def robust_analyze(
         _console.print(f"wrote {path}")
 
 
+@robust_app.command("synthesize")
+def robust_synthesize(
+    out: Annotated[Path, typer.Option(help="The controller file to write (.npz or .mat).")],
+    config: ConfigOption = None,
+    order: Annotated[int, typer.Option(help="States of the reduced controller, 1 ... 64.")] = 16,
+    modes: Annotated[int, typer.Option(help="Flexible modes in the design plant.")] = 6,
+    control_dt: Annotated[
+        float, typer.Option(help="Control period it is discretized at [s] (the loop's).")
+    ] = 1e-3,
+    json_output: JsonOption = False,
+) -> None:
+    """H-infinity mixed-sensitivity design of an attitude controller for the statespace law.
+
+    Weights from the requirements (R1 and R2 bands, the torque limit, the first mode's
+    damping: docs/control.md); reduced by balanced truncation, discretized (Tustin).
+    """
+    from flexsat.config import load_config
+    from flexsat.control.laws.statespace import MAX_ORDER, save_controller
+    from flexsat.dynamics.plant import Plant
+    from flexsat.errors import ConfigError
+    from flexsat.linear import linearize
+    from flexsat.linear.hinf import synthesize
+
+    if out.suffix.lower() not in (".npz", ".mat"):
+        raise ConfigError(f"--out: the suffix must be .npz or .mat, got {out.suffix or 'none'!r}")
+    if not out.parent.is_dir():
+        raise ConfigError(f"--out: the folder {out.parent} does not exist")
+    if not 1 <= order <= MAX_ORDER:
+        raise ConfigError(f"--order: must be in 1 ... {MAX_ORDER}, got {order}")
+    if not 0 <= modes <= 50:
+        raise ConfigError(f"--modes: must be in 0 ... 50, got {modes}")
+    if not (math.isfinite(control_dt) and 0.0 < control_dt <= 10.0):
+        raise ConfigError(f"--control-dt: must be in (0, 10] s, got {control_dt:g}")
+    cfg = load_config(config)
+    design = synthesize(linearize(Plant.from_config(cfg)), control_dt, order, modes)
+    save_controller(design.discrete, out)
+    summary = {
+        "config_name": cfg.name, "gamma": design.gamma,
+        "full_order": int(design.controller.nstates), "order": int(design.reduced.nstates),
+        "reduction_bound": design.reduction_bound, "control_dt_s": control_dt,
+        "modes": modes, "file": str(out),
+    }  # fmt: skip
+    if json_output:
+        typer.echo(dumps(summary))
+        return
+    rows = [
+        ["gamma = ||T_zw||_inf bound", summary["gamma"]],
+        ["full controller order", summary["full_order"]],
+        ["reduced order (balanced truncation)", summary["order"]],
+        ["reduction error bound [N m per unit input]", summary["reduction_bound"]],
+        ["control period [s]", control_dt],
+    ]
+    print_table(_console, f"H-infinity controller — {cfg.name}", ("quantity", "value"), rows)
+    _console.print(f'wrote {out} (kind = "statespace", file = "{out.name}")')
+
+
 @app.command()
 def openloop(
     config: ConfigOption = None,
