@@ -60,7 +60,7 @@ fmu_app = typer.Typer(
 )
 app.add_typer(fmu_app, name="fmu")
 robust_app = typer.Typer(
-    help="Robustness of the loops to the satellite's uncertain parameters (mu).",
+    help="Robust control: mu-analysis of the loops (analyze), H-infinity design (synthesize).",
     no_args_is_help=True,
     rich_markup_mode=None,
 )
