@@ -254,6 +254,8 @@ STATESPACE_FILES = [
     _controller("controller .mat not a MAT file", "controller file {tmp}/k.mat: not a readable .mat file", name="k.mat", content=b"MATLAB 5.0 garbage"),
     Bad("controller file missing", ["slew", "--scenario", "{tmp}/s.toml"], "controller file not found", {"s.toml": '[controller]\nkind = "statespace"\nfile = "absent.npz"\n'}),
     Bad("controller file not named", ["slew", "--scenario", "{tmp}/s.toml"], "controller.file", {"s.toml": '[controller]\nkind = "statespace"\n'}),
+    Bad("hybrid controller of another period", ["slew", "--scenario", "{tmp}/s.toml"], "controller.file: the controller was discretized at dt = 0.01 s", {"s.toml": '[controller]\nkind = "hybrid"\nfile = "k.npz"\n', "k.npz": _controller_npz(dt=np.array(1e-2))}),
+    Bad("hybrid switch at 0 deg", ["slew", "--scenario", "{tmp}/s.toml"], "controller.switch_pointing_deg", {"s.toml": '[controller]\nkind = "hybrid"\nfile = "k.npz"\nswitch_pointing_deg = 0.0\n', "k.npz": _controller_npz()}),
     # flexsat robust synthesize: options refused before the (slow) synthesis
     Bad("robust synthesize to a .txt", ["robust", "synthesize", "--out", "{tmp}/k.txt"], "--out: the suffix must be .npz or .mat, got '.txt'"),
     Bad("robust synthesize into a missing folder", ["robust", "synthesize", "--out", "{tmp}/none/k.npz"], "--out: the folder {tmp}/none does not exist"),

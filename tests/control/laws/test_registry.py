@@ -143,8 +143,8 @@ def test_unknown_law_lists_the_registered_ones(qpid):
     # The flexsat command turns this error into one line and exit code 2 (tests/cli).
     result = CliRunner().invoke(app, ["slew", "--controller", "qpdi", "--duration", "1"])
     assert isinstance(result.exception, ConfigError)
-    # every kind a table may name, the statespace law (which needs a file) included
-    allowed = f"{', '.join(BUILT_IN)}, statespace, qpid"
+    # every kind a table may name, the laws that need a file (statespace, hybrid) included
+    allowed = f"{', '.join(BUILT_IN)}, statespace, hybrid, qpid"
     assert f"must be one of {allowed} (got 'qpdi')" in str(result.exception)
 
 

@@ -14,6 +14,7 @@ from __future__ import annotations
 import numpy as np
 
 from flexsat.control.laws.asmc import ASMC
+from flexsat.control.laws.hybrid import HYBRID
 from flexsat.control.laws.ismc import ISMC
 from flexsat.control.laws.pd import PD
 from flexsat.control.laws.registry import (
@@ -49,6 +50,7 @@ register_law(PD)
 register_law(STSMC)
 register_law(ISMC)
 register_law(STATESPACE)
+register_law(HYBRID)
 
 
 class CompiledLaw:
