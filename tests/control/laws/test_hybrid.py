@@ -7,6 +7,7 @@ import pytest
 
 pytest.importorskip("slycot")
 
+from flexsat.analysis.requirements import slew_metrics
 from flexsat.control.laws import get_law, law_names
 from flexsat.control.laws.statespace import (
     controller_input,
@@ -19,6 +20,9 @@ from flexsat.simulate import SlewScenario, run_slew
 
 DT = 1e-3
 SWITCH_DEG, SWITCH_RATE_DEG_S = 0.5, 0.05  # the law's defaults
+# the root actuators of docs/control.md, "Hybrid active damping"
+DAMPING = {"kind": "rate_feedback", "coordinates": ["eta_rx", "eta_ry", "eta_rz"],
+           "gain": 10.0, "limit": 0.1, "bandwidth_hz": 20.0}  # fmt: skip
 
 
 @pytest.fixture(scope="module")
@@ -69,3 +73,31 @@ def test_the_transfer_is_bumpless(run, hinf_file):
 def test_the_hybrid_needs_a_file_and_is_not_compared_by_default():
     assert get_law("hybrid").label == "ASMC+H-inf"
     assert "hybrid" not in law_names()
+
+
+def _slew(plant, hinf_file, **fields):
+    scenario = SlewScenario.model_validate(
+        {"controller": {"kind": "hybrid", "file": str(hinf_file)}, **fields}
+    )
+    return run_slew(plant, scenario, progress=False).dataset
+
+
+def test_the_thesis_slew_meets_r1_and_r2(nominal_plant, hinf_file):
+    # 120 s, disturbances at maximum (docs/control.md, "The hybrid controller"):
+    # measured APE 1.9e-3 deg (R1: 0.05), rate error up to 4.1e-4 deg/s (R2: 1e-3)
+    metrics = slew_metrics(_slew(nominal_plant, hinf_file))
+    assert metrics["r1_pass"] and metrics["r2_pass"] and metrics["r3_pass"]
+
+
+def test_with_the_root_actuators_the_loop_rings_at_the_first_coupled_mode(nominal_plant, hinf_file):
+    # The limit the docs state: the controller, designed against the open-loop modes,
+    # and the root-rate loop settle into a 0.23 Hz oscillation that breaks R2
+    # (measured 4.9e-3 deg/s over 90-120 s). The spectrum's resolution over the 30 s
+    # window is 1/30 Hz: the peak is asserted within one bin of 0.23 Hz.
+    ds = _slew(nominal_plant, hinf_file, joint_actuator=DAMPING)
+    assert not slew_metrics(ds)["r2_pass"]
+    t = ds.time.values
+    w = ds.omega.values[t >= 90.0, 0]
+    f = np.fft.rfftfreq(w.size, float(t[1] - t[0]))
+    peak = f[np.abs(np.fft.rfft(w - w.mean())).argmax()]
+    assert abs(peak - 0.233) <= 1.0 / 30.0
