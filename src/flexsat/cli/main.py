@@ -406,8 +406,10 @@ def robust_analyze(
 def robust_synthesize(
     out: Annotated[Path, typer.Option(help="The controller file to write (.npz or .mat).")],
     config: ConfigOption = None,
-    order: Annotated[int, typer.Option(help="States of the reduced controller, 1 ... 64.")] = 16,
-    modes: Annotated[int, typer.Option(help="Flexible modes in the design plant.")] = 6,
+    order: Annotated[int, typer.Option(help="States of the reduced controller, 1 ... 64.")] = 6,
+    modes: Annotated[
+        int, typer.Option(help="Flexible modes in the design plant (0: the rigid attitude).")
+    ] = 0,
     control_dt: Annotated[
         float, typer.Option(help="Control period it is discretized at [s] (the loop's).")
     ] = 1e-3,

@@ -245,8 +245,8 @@ def _as_model(K) -> LinearModel:
 def synthesize(
     model: LinearModel,
     control_dt_s: float,
-    order: int = 20,
-    n_modes: int = 6,
+    order: int = 6,
+    n_modes: int = 0,
     weights: HinfWeights | None = None,
 ) -> HinfDesign:
     """Design, reduce and discretize an H-infinity attitude controller.
@@ -262,7 +262,10 @@ def synthesize(
         States of the reduced controller (balanced truncation); at most the full
         controller's order (then nothing is discarded).
     n_modes : int
-        Flexible modes in the design plant.
+        Flexible modes in the design plant; the default 0 designs against the rigid
+        attitude, the roll-off of W_u keeping the modes out of the loop (robust to
+        the root actuators' damping, which a design against the modes is not:
+        ``docs/control.md``, "The hybrid controller").
     weights : HinfWeights, optional
         Default: :class:`HinfWeights` (the thesis's requirements).
 
