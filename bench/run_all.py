@@ -53,6 +53,7 @@ ORDER = (
     "bench_modal",
     "bench_modal_large_motion",
     "bench_environment",
+    "bench_realtime",
     "bench_demo",
     "bench_basilisk",
     "bench_basilisk_chain",
