@@ -160,7 +160,7 @@ def _print_modal(summary: dict) -> None:
     print_table(_console, "Rigid design inertia J_tot about the hub centre of mass [kg m^2]",
                 ("", "x", "y", "z"), rows)  # fmt: skip
     for path in summary.get("files", []):
-        _console.print(f"wrote {path}")
+        _console.print(f"wrote {path}", soft_wrap=True)
 
 
 @fe_app.command("import")
@@ -223,7 +223,7 @@ def fe_import(
         _console.print(f"warning: the OP2's frequencies differ by up to "
                        f"{np.abs(errors).max():.2g}: is it this deck clamped at grid "
                        f"{model.interface_grid}?")  # fmt: skip
-    _console.print(f"wrote {path}")
+    _console.print(f"wrote {path}", soft_wrap=True)
 
 
 @app.command()
@@ -280,7 +280,7 @@ def linearize(
         _console.print(f"{red['method']} truncation to {red['order']} states: error bound "
                        f"{format_number(red['error_bound'])}")  # fmt: skip
     for path in summary.get("files", []):
-        _console.print(f"wrote {path}")
+        _console.print(f"wrote {path}", soft_wrap=True)
 
 
 @app.command()
@@ -324,7 +324,7 @@ def margins(
         print_table(_console, f"Delay margin per case [s] — {campaign}",
                     ("case", "x", "y", "z"), rows)  # fmt: skip
     for path in summary.get("files", []):
-        _console.print(f"wrote {path}")
+        _console.print(f"wrote {path}", soft_wrap=True)
 
 
 def _print_margins(summary: dict) -> None:
@@ -399,7 +399,7 @@ def robust_analyze(
     if not summary["nominal_stable"]:
         _console.print("the loop is unstable at the box's centre: mu bounds do not apply")
     for path in summary.get("files", []):
-        _console.print(f"wrote {path}")
+        _console.print(f"wrote {path}", soft_wrap=True)
 
 
 @robust_app.command("synthesize")
@@ -702,7 +702,7 @@ def plot(
 
     folder = prepare_output_dir(out if out is not None else result.parent)
     for path in write_result_figures(loaded.dataset, folder, chosen):
-        _console.print(f"wrote {path}")
+        _console.print(f"wrote {path}", soft_wrap=True)
 
 
 @app.command()
@@ -822,9 +822,9 @@ def campaign(
         found = summary["worst_case"]
         _console.print(f"  worst-case search: {found['case_id']}  {found['metric']} = "
                        f"{format_number(found['value'])} (worst_case.json)")  # fmt: skip
-    _console.print(f"wrote {summary['parquet']} and {summary['csv']}")
+    _console.print(f"wrote {summary['parquet']} and {summary['csv']}", soft_wrap=True)
     for path in summary["figures"]:
-        _console.print(f"wrote {path}")
+        _console.print(f"wrote {path}", soft_wrap=True)
 
 
 def _worst_line(group: dict) -> str:
@@ -1092,7 +1092,7 @@ def _print_metrics(metrics: dict, title: str = "Open-loop run") -> None:
     rows = [[key, value] for key, value in metrics.items() if key != "files"]
     print_table(_console, title, ("metric", "value"), rows)
     for path in metrics.get("files", []):
-        _console.print(f"wrote {path}")
+        _console.print(f"wrote {path}", soft_wrap=True)
 
 
 @config_app.command("show")
@@ -1189,7 +1189,7 @@ def config_preset(
         shutil.copyfile(source, output)
     except OSError as exc:
         raise FlexsatError(f"-o {output}: cannot write it ({exc.strerror or exc})") from None
-    _console.print(f"wrote {output}")
+    _console.print(f"wrote {output}", soft_wrap=True)
 
 
 @app.command()
@@ -1252,7 +1252,7 @@ def budget(
         return
     _print_budget(report)
     if out is not None:
-        _console.print(f"wrote {out / 'budget.json'} and {out / 'budget.csv'}")
+        _console.print(f"wrote {out / 'budget.json'} and {out / 'budget.csv'}", soft_wrap=True)
 
 
 def _print_budget(report: dict) -> None:
@@ -1361,7 +1361,7 @@ def jitter(
     print_table(_console, "Worst wheel speeds of the sweep", ["speed [rpm]", "RMS [arcsec]"],
                 [[w["speed_rpm"], w["rms_arcsec"]] for w in summary["worst"]])  # fmt: skip
     for path in summary.get("files", []):
-        _console.print(f"wrote {path}")
+        _console.print(f"wrote {path}", soft_wrap=True)
 
 
 def _parse_speeds(text: str):
