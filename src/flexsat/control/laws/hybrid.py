@@ -20,17 +20,16 @@ from typing import Literal
 
 import numpy as np
 from numba import njit
-from pydantic import Field, PrivateAttr, model_validator
+from pydantic import Field
 
 from flexsat.config.models import Positive
 from flexsat.control.laws._sliding import SLIDING_DIAGNOSTICS
 from flexsat.control.laws.asmc import ASMCConfig, asmc_step
-from flexsat.control.laws.registry import LawConfig, LawSpec
+from flexsat.control.laws.registry import LawSpec
 from flexsat.control.laws.statespace import (
     MAX_ORDER,
-    DiscreteController,
+    ControllerFileConfig,
     controller_input,
-    load_controller,
     pack_controller,
     ss_output,
     ss_update,
@@ -47,11 +46,10 @@ _N_SLIDING = sum(c.size for c in SLIDING_DIAGNOSTICS)
 _MODE, _ASMC_STATE, _X = 0, 1, 3
 
 
-class HybridConfig(LawConfig):
+class HybridConfig(ControllerFileConfig):
     """ASMC for the slew, a linear controller near the target (module docstring)."""
 
     kind: Literal["hybrid"] = Field("hybrid", description="the law's registered name")
-    file: str = Field(description="the linear controller's file (.npz or .mat: A, B, C, D, dt)")
     asmc: ASMCConfig = Field(default_factory=ASMCConfig, description="the slewing ASMC")
     switch_pointing_deg: Positive = Field(
         0.5, description="pointing error below which the linear controller takes over [deg]"
@@ -59,25 +57,6 @@ class HybridConfig(LawConfig):
     switch_rate_deg_s: Positive = Field(
         0.05, description="body-rate error below which it may take over [deg/s]"
     )
-    _controller: DiscreteController | None = PrivateAttr(None)
-
-    @model_validator(mode="after")
-    def _read(self) -> HybridConfig:
-        self._controller = load_controller(self.file)  # ConfigError names the file
-        return self
-
-    @property
-    def controller(self) -> DiscreteController:
-        """The linear controller the file holds."""
-        return self._controller
-
-    def check(self, scenario) -> None:
-        dt = self.controller.dt
-        if abs(dt - scenario.control_dt_s) > 1e-9 * scenario.control_dt_s:
-            raise ValueError(
-                f"file: the controller was discretized at dt = {dt:g} s, the loop runs at "
-                f"control_dt_s = {scenario.control_dt_s:g} s; they must be equal"
-            )
 
     def gains(self, actuator) -> np.ndarray:
         asmc = self.asmc.gains(actuator)

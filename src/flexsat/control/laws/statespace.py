@@ -36,6 +36,7 @@ __all__ = [
     "CONTROLLER_INPUTS",
     "MAX_ORDER",
     "STATESPACE",
+    "ControllerFileConfig",
     "DiscreteController",
     "StateSpaceConfig",
     "load_controller",
@@ -231,15 +232,15 @@ def pack_controller(controller: DiscreteController, t_max: float, rf: float) -> 
                                                        controller.C, controller.D))])  # fmt: skip
 
 
-class StateSpaceConfig(LawConfig):
-    """A discrete state-space controller read from a file (module docstring)."""
+class ControllerFileConfig(LawConfig):
+    """What a law flying a discrete controller from a file holds: the file, read and
+    checked once, and its discretization period against the loop's."""
 
-    kind: Literal["statespace"] = Field("statespace", description="the law's registered name")
     file: str = Field(description="the controller file (.npz or .mat: A, B, C, D, dt)")
     _controller: DiscreteController | None = PrivateAttr(None)
 
     @model_validator(mode="after")
-    def _read(self) -> StateSpaceConfig:
+    def _read(self) -> ControllerFileConfig:
         self._controller = load_controller(self.file)  # ConfigError is a ValueError: names file
         return self
 
@@ -255,6 +256,12 @@ class StateSpaceConfig(LawConfig):
                 f"file: the controller was discretized at dt = {dt:g} s, the loop runs at "
                 f"control_dt_s = {scenario.control_dt_s:g} s; they must be equal"
             )
+
+
+class StateSpaceConfig(ControllerFileConfig):
+    """A discrete state-space controller read from a file (module docstring)."""
+
+    kind: Literal["statespace"] = Field("statespace", description="the law's registered name")
 
     def gains(self, actuator) -> np.ndarray:
         return pack_controller(self.controller, actuator.t_max_nm, actuator.reduction_factor)
