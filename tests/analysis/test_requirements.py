@@ -171,9 +171,22 @@ def test_rpe_is_the_window_by_window_definition():
             inside = error[index == k]
             distance = np.linalg.norm(inside - inside.mean(axis=0), axis=1).max()
             expected = distance if distance > expected else expected
+        if np.bincount(index).max() < 2:  # no window holds two records: not measured
+            expected = np.nan
         assert relative_performance_error(t, error, duration) == pytest.approx(
-            expected, rel=1e-14, abs=0.0
+            expected, rel=1e-14, abs=0.0, nan_ok=True
         )
+
+
+def test_rpe_is_not_measured_when_every_window_holds_one_record():
+    # Records 1 s apart and 1 s windows: each window's mean is its lone record, whose
+    # distance from it is 0 whatever the error does. That is no stability measured:
+    # NaN (reported as not measured), where 2 s windows see the 1 deg step.
+    t = np.arange(0.0, 10.0, 1.0)
+    error = np.zeros((t.size, 3))
+    error[1::2, 0] = 1.0  # [deg]
+    assert np.isnan(relative_performance_error(t, error, 1.0))
+    assert relative_performance_error(t, error, 2.0) == pytest.approx(0.5, rel=1e-15)
 
 
 def test_error_rotation_vector_is_the_error_quaternion_angle():

@@ -481,6 +481,8 @@ def slew_metrics(ds, plates: bool = True) -> dict:
     for b in np.unique(bins):
         chunk = ew[bins == b]
         rpe = max(rpe, float(np.linalg.norm(chunk - chunk.mean(axis=0), axis=1).max()))
+    if bins.size and np.bincount(bins - bins.min()).max() < 2:
+        rpe = float("nan")  # every window a lone record: not measured
     applied = np.abs(stored(ds, "tau_applied"))
     t_max = sc["actuator"]["t_max_nm"]
     lam = stored(ds, "lambda_act") if "lambda_act" in ds else None

@@ -180,7 +180,9 @@ def relative_performance_error(t: np.ndarray, error: np.ndarray, duration_s: flo
     one (a shorter last window counts too); in each window the error vector's mean
     is taken and the RPE is the largest distance of a record from its window's
     mean. It measures the pointing stability over ``duration_s``, without the bias.
-    A window holding a NaN record (a failed run's last state) is passed over.
+    A window holding a NaN record (a failed run's last state) is passed over. When
+    no window holds two records (windows no longer than the record interval) the RPE
+    is not measured: NaN, not the 0 a lone record would read.
 
     Parameters
     ----------
@@ -194,7 +196,8 @@ def relative_performance_error(t: np.ndarray, error: np.ndarray, duration_s: flo
     Returns
     -------
     float
-        The RPE, in the unit of ``error`` [u]; NaN if there is no record.
+        The RPE, in the unit of ``error`` [u]; NaN if there is no record, or no
+        window holds two.
     """
     t = np.asarray(t, dtype=float)
     error = np.asarray(error, dtype=float)
@@ -205,6 +208,8 @@ def relative_performance_error(t: np.ndarray, error: np.ndarray, duration_s: flo
     # quantity serves every window (a loop over windows cost ~50 us each, ~1.5 ms a case)
     starts = np.flatnonzero(np.diff(index, prepend=index[0] - 1))
     counts = np.diff(starts, append=t.size)
+    if counts.max() < 2:
+        return float("nan")
     means = np.add.reduceat(error, starts, axis=0) / counts[:, None]
     distance = np.linalg.norm(error - np.repeat(means, counts, axis=0), axis=1)
     worst = np.maximum.reduceat(distance, starts)  # NaN for a window holding a NaN
