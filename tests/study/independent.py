@@ -23,6 +23,7 @@ from dataclasses import dataclass, field
 from html.parser import HTMLParser
 
 import numpy as np
+import scipy.signal
 from scipy.linalg import eigh
 from scipy.spatial.transform import Rotation
 
@@ -748,10 +749,15 @@ def loop_margins(plant: control.StateSpace, K: np.ndarray, axis: int) -> dict:
     others = [i for i in range(3) if i != axis]
     A_cl = A - B[:, others] @ K[others] @ C
     L = control.ss(A_cl, B[:, [axis]], K[[axis]] @ C, 0.0)
+    # The polynomial form from scipy whether or not slycot is installed: python-control
+    # converts with slycot's tb04ad when it can, whose polynomials of this stiff loop
+    # give spurious phase crossings near 0 Hz.
+    num, den = scipy.signal.ss2tf(A_cl, B[:, [axis]], K[[axis]] @ C, np.zeros((1, 1)))
+    polynomial = control.tf(num[0], den)
     with warnings.catch_warnings():  # python-control's polynomial pass overflows harmlessly
         warnings.simplefilter("ignore", RuntimeWarning)
-        gm, pm, _, wpc, wgc, _ = control.stability_margins(L)
-        _, pms, _, _, wgcs, _ = control.stability_margins(L, returnall=True)
+        gm, pm, _, wpc, wgc, _ = control.stability_margins(polynomial)
+        _, pms, _, _, wgcs, _ = control.stability_margins(polynomial, returnall=True)
     crossings = sorted(zip(np.atleast_1d(wgcs), np.atleast_1d(pms), strict=True))
     delays = [math.radians(p % 360.0) / w for w, p in crossings]
     k_dm = int(np.argmin(delays))
