@@ -17,7 +17,10 @@ shim starts a count. Valgrind's virtual CPU is not this machine's, so numba woul
 its cache and compile for that CPU: the run names this machine's CPU and features
 (``NUMBA_CPU_NAME``, ``NUMBA_CPU_FEATURES``, as numba's cache keys them) and loads
 the machine code a native run executes, after one short native flight of each case
-has filled the cache. Under valgrind, each case is prepared
+has filled the cache. On a host with AVX-512, which valgrind 3.19 cannot execute, the
+script compiles for Haswell (AVX2, FMA) natively and under valgrind alike: counts are
+then comparable between runs on such hosts, not with a native AVX-512 run. Under
+valgrind, each case is prepared
 (``closedloop.prepare_slew``) and flown once for 0.1 s (nothing loads or compiles
 later; checked), then flown for ``--short``, ``--check`` and ``--long`` seconds
 (default 1, 3 and the thesis's 120), each flight one call of the compiled loop
@@ -63,8 +66,22 @@ import tempfile
 import time
 from pathlib import Path
 
-import harness
-from bench_avionics import CASES, TARGET  # the benchmarks run with bench/ on sys.path
+# Valgrind 3.19 cannot execute AVX-512 (EVEX) instructions: on a host that has them,
+# numba compiles this run for Haswell (AVX2, FMA), natively and under valgrind alike,
+# before anything imports numba, when run as a script (imported by the harness, it
+# leaves the environment alone). Both sides of a comparison must be run this way.
+HASWELL_FEATURES = ("+64bit,+avx,+avx2,+bmi,+bmi2,+cmov,+cx16,+cx8,+f16c,+fma,+fsgsbase,"
+                    "+fxsr,+lzcnt,+mmx,+movbe,+pclmul,+popcnt,+rdrnd,+sahf,+sse,+sse2,+sse3,"
+                    "+sse4.1,+sse4.2,+ssse3,+xsave,+xsaveopt")  # fmt: skip
+try:
+    _AVX512 = " avx512f" in Path("/proc/cpuinfo").read_text()
+except OSError:
+    _AVX512 = False
+if __name__ == "__main__" and _AVX512 and "NUMBA_CPU_NAME" not in os.environ:
+    os.environ |= {"NUMBA_CPU_NAME": "haswell", "NUMBA_CPU_FEATURES": HASWELL_FEATURES}
+
+import harness  # noqa: E402
+from bench_avionics import CASES, TARGET  # noqa: E402  (bench/ on sys.path)
 
 SHIM = r"""
 #include <valgrind/callgrind.h>
@@ -197,6 +214,12 @@ def main(argv: list[str] | None = None) -> dict:
         version = subprocess.run(["valgrind", "--version"], capture_output=True, text=True,
                                  check=False).stdout.strip()  # fmt: skip
         cpu_name, features = native_warm_up()
+        if "+avx512f" in features:
+            print("numba compiled for AVX-512, which valgrind cannot run: run this script "
+                  "on its own (python bench/bench_avionics_instructions.py), or set "
+                  "NUMBA_CPU_NAME=haswell and NUMBA_CPU_FEATURES as HASWELL_FEATURES",
+                  file=sys.stderr)  # fmt: skip
+            raise SystemExit(2)
         # Valgrind's CPU is not this machine's: numba would miss its cache and compile
         # for that CPU. Naming this machine's CPU loads the code a native run executes.
         env = os.environ | {"NUMBA_CPU_NAME": cpu_name, "NUMBA_CPU_FEATURES": features}
