@@ -33,7 +33,8 @@ from flexsat.fe import craig_bampton
 from flexsat.fe.nastran import import_nastran
 from flexsat.simulate import OpenLoopScenario, run_openloop
 
-DATA = Path(__file__).resolve().parent / "data"
+# The gallery runs each example from its own folder, where __file__ is not defined.
+DATA = Path(globals().get("__file__", "nastran_wing.py")).resolve().parent / "data"
 wing = import_nastran(DATA / "nastran_plate.bdf", DATA / "nastran_plate.op4", n_modes=4,
                       damping_ratio=0.005)  # fmt: skip
 print(f"{wing.stiffness_name}/{wing.mass_name}: {len(wing.dofs)} DOFs, interface grid "

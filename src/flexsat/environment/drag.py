@@ -2,14 +2,14 @@
 
 The flow meets the satellite at v_rel = v - omega_E x r (ECI; the atmosphere
 co-rotates with the Earth). A flat surface of area A, outward normal n and drag
-coefficient C_D facing the flow (cos(alpha) = n . u > 0, u = v_rel / |v_rel|) takes
+coefficient C_D facing the flow (cos(alpha) = n . u > 0, u = v_rel / ‖v_rel‖) takes
 (Vallado, *Fundamentals of Astrodynamics and Applications*, sec. 8.6.2;
 docs/environment.md, 'Aerodynamic drag')::
 
-    F = -1/2 rho C_D A cos(alpha) |v_rel|^2 u
+    F = -1/2 rho C_D A cos(alpha) ‖v_rel‖^2 u
 
 the projected area A cos(alpha) of a flat plate; a surface in the wake takes none.
-The density rho at altitude h = |r| - R_E comes from the exponential atmosphere of
+The density rho at altitude h = ‖r‖ - R_E comes from the exponential atmosphere of
 Vallado's Table 8-4 (rho = rho_0 exp(-(h - h_0) / H) in the band of base h_0),
 the default, or from NRLMSIS 2.1 (``density = "nrlmsis"``, the optional
 ``pymsis`` package) tabulated along the ephemeris before the run and interpolated

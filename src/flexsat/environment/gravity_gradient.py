@@ -7,7 +7,7 @@ Dynamics and Control*, sec. 6.3; docs/environment.md, 'Gravity gradient')::
     tau_gg = 3 mu / r^3  o_B x (J_hub o_B)
 
 and each mass element m_k at rho_k (frame B, from the hub centre of mass) takes the
-tidal force of the field linearized about the orbit (|rho_k| << r)::
+tidal force of the field linearized about the orbit (‖rho_k‖ << r)::
 
     f_k = m_k mu / r^3 (3 o_B (o_B . rho_k) - rho_k)
 

@@ -10,8 +10,8 @@ a point of an appendage also adds G_k^T F_k to that appendage's generalized forc
 (:mod:`flexsat.environment.geometry`; docs/environment.md, 'Appendage loads').
 They are evaluated every ``period_s`` of the ``[environment]`` table (a whole number of
 control periods) and held in between, like the actuators' torque: they turn at the
-orbit's rate n and the attitude's |omega|, so a hold of T moves them by about
-(n + |omega|) T of their size, 1e-4 for n T at 0.1 s in low Earth orbit
+orbit's rate n and the attitude's ‖omega‖, so a hold of T moves them by about
+(n + ‖omega‖) T of their size, 1e-4 for n T at 0.1 s in low Earth orbit
 (docs/environment.md, 'When the loads are evaluated').
 """
 

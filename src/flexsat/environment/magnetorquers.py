@@ -5,7 +5,7 @@ At each control instant the magnetorquers command the dipole of the cross-produc
 *Fundamentals of Spacecraft Attitude Determination and Control*, sec. 7.5;
 docs/environment.md, 'Magnetorquers and momentum dumping')::
 
-    m_cmd = k (h_w x B_B) / |B_B|^2        (= -k (B_B x h_w) / |B_B|^2)
+    m_cmd = k (h_w x B_B) / ‖B_B‖^2        (= -k (B_B x h_w) / ‖B_B‖^2)
 
 with h_w the reaction wheels' stored momentum (hub frame B, the wheels' own record
 ``wheel_momentum_B``) and B_B the field of the ``magnetic`` model at the satellite.
@@ -79,7 +79,7 @@ def quantized(value, quantum):
 
 @njit(cache=True)
 def dumping_dipole(B, h, k):
-    """The cross-product law's dipole k (h x B) / |B|^2 [A m^2] (module docstring).
+    """The cross-product law's dipole k (h x B) / ‖B‖^2 [A m^2] (module docstring).
 
     Parameters
     ----------
@@ -154,7 +154,7 @@ def dump_momentum(dump, row, C_BN, magnetic_params, held, torque, dipole):
     Returns
     -------
     float
-        |m|, the dipole's magnitude [A m^2].
+        ‖m‖, the dipole's magnitude [A m^2].
     """
     bx, by, bz = field_at(row, magnetic_params)
     B = (C_BN[0, 0] * bx + C_BN[0, 1] * by + C_BN[0, 2] * bz,

@@ -8,8 +8,8 @@ closed loop of :func:`closed_loop` (the linearized flexible satellite, every fle
 mode included, with the law's static feedback as :func:`~flexsat.linear.frequency.law_gains`
 builds it for the margins). Lines of one frequency add coherently (the wheels of a
 cluster spinning at one speed); lines of different frequencies are uncorrelated, so
-the jitter's mean square is the sum of the lines' |Y_k|^2 / 2, and its power spectral
-density is |H|^2 times the disturbance spectrum: H S_u H^H, S_u = sum_k U_k U_k^H / 2
+the jitter's mean square is the sum of the lines' ‖Y_k‖^2 / 2, and its power spectral
+density is ‖H‖^2 times the disturbance spectrum: H S_u H^H, S_u = sum_k U_k U_k^H / 2
 delta(f - f_k) (:func:`jitter_psd` spreads each line over its frequency bin).
 
 A window Δt (the RPE's, ``docs/pointing.md``) removes from each line its mean over the
@@ -370,7 +370,7 @@ def jitter_rms(
     model: LinearModel, lines: Lines, rows: np.ndarray | None = None,
     window_s: float | None = None,
 ) -> np.ndarray:  # fmt: skip
-    """RMS jitter per output: sqrt(sum_k |Y_k|^2 / 2), windowed by 1 - sinc(f Δt).
+    """RMS jitter per output: sqrt(sum_k ‖Y_k‖^2 / 2), windowed by 1 - sinc(f Δt).
 
     Parameters
     ----------
@@ -399,7 +399,7 @@ def jitter_psd(
 ) -> np.ndarray:  # fmt: skip
     """One-sided PSD of the jitter on a uniform grid: each line's power over its bin.
 
-    Each line's power |Y_k|^2 / 2 (H at the line's own frequency: exact however coarse
+    Each line's power ‖Y_k‖^2 / 2 (H at the line's own frequency: exact however coarse
     the grid) is divided by the bin width, in the bin whose centre is nearest; so
     sum(PSD) df is the mean square of :func:`jitter_rms`.
 

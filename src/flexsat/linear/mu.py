@@ -3,7 +3,7 @@
 The uncertain satellite (:mod:`flexsat.linear.uncertain`) closed by a linear
 controller (a static gain on attitude and rate, or a state-space law) leaves the
 interconnection ``N(s)`` seen by ``Delta``: the loop is stable for every
-``||Delta|| <= 1/beta`` iff ``mu_Delta(N(i w)) < beta`` at every frequency (the main
+``‖Delta‖ <= 1/beta`` iff ``mu_Delta(N(i w)) < beta`` at every frequency (the main
 loop theorem), so ``k_max = 1 / max_w mu`` is the factor by which the parameter box
 can grow (or must shrink) before the loop can lose stability.
 
@@ -199,7 +199,7 @@ def mu_upper_bound(
 
 
 def _poles_max_real(model: UncertainModel, loop, delta: np.ndarray) -> tuple[float, float]:
-    """(max Re, |Im| of that pole) of the closed loop at the parameter point delta."""
+    """(max Re, ‖Im‖ of that pole) of the closed loop at the parameter point delta."""
     A, B, C, D = loop
     Dl = model.delta_matrix(delta)
     X = np.linalg.solve(np.eye(D.shape[0]) - Dl @ D, Dl)
@@ -220,7 +220,7 @@ def stability_boundary(
     loop : tuple
         :func:`closed_loop`'s (A, B, C, D).
     direction : ndarray, shape (n_parameters,)
-        [-] A point of the box's boundary (max |delta_i| = 1).
+        [-] A point of the box's boundary (max ‖delta_i‖ = 1).
     alpha_max : float
         Search up to this scale [-].
 
@@ -230,7 +230,7 @@ def stability_boundary(
         The scale at which a pole crosses into Re > 0 (``inf`` if none up to
         ``alpha_max``), to 1e-6 [-].
     frequency : float
-        That pole's |Im| at the crossing [rad/s].
+        That pole's ‖Im‖ at the crossing [rad/s].
     """
     grid = np.linspace(0.0, alpha_max, 41)[1:]
     prev = 0.0
@@ -271,7 +271,7 @@ class MuAnalysis:
         (1/peak_upper, 1/lower): the stability margin lies between [-]; the loop is
         stable over k x the box for every k < k_max[0].
     worst_delta : ndarray, shape (n_parameters,)
-        The destabilizing perturbation, normalized (max |delta| = alpha) [-].
+        The destabilizing perturbation, normalized (max ‖delta‖ = alpha) [-].
     worst_factors : dict
         Each parameter's factor on its nominal value there [-].
     nominal_stable : bool

@@ -97,8 +97,8 @@ def elements_to_state(orbit: OrbitConfig) -> np.ndarray:
 def j2_acceleration(r: np.ndarray, j2: float = EARTH_J2) -> np.ndarray:
     """Gravity of the Earth to J2 (Vallado eq. 8-30), ECI, the pole along z.
 
-    a = -mu r / |r|^3 - (3/2) J2 mu R_E^2 / |r|^5 (x (1 - 5 z^2/|r|^2),
-    y (1 - 5 z^2/|r|^2), z (3 - 5 z^2/|r|^2)).
+    a = -mu r / ‖r‖^3 - (3/2) J2 mu R_E^2 / ‖r‖^5 (x (1 - 5 z^2/‖r‖^2),
+    y (1 - 5 z^2/‖r‖^2), z (3 - 5 z^2/‖r‖^2)).
 
     Parameters
     ----------

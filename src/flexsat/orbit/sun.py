@@ -84,7 +84,7 @@ def sun_position(jd_tt):
 def illuminated_fraction(rx, ry, rz, sx, sy, sz, sun_distance):
     """Fraction of the Sun's disc visible from the satellite (conical shadow, penumbra).
 
-    With a = asin(R_sun / d) the Sun's apparent radius, b = asin(R_E / |r|) the
+    With a = asin(R_sun / d) the Sun's apparent radius, b = asin(R_E / ‖r‖) the
     Earth's and c the angle between them seen from the satellite: 1 for c >= a + b,
     0 for c <= b - a (umbra), 1 - b^2 / a^2 in an annular eclipse (c <= a - b), else
     1 - A / (pi a^2) with A the area of the discs' overlap (Montenbruck and Gill,

@@ -3,7 +3,7 @@
 The inertial frame of flexsat's orbits is the mean equator and equinox of J2000 (ECI;
 the GCRF to within its 0.02 arcsec frame bias). Times are UTC at the boundary (an
 ISO 8601 epoch), Terrestrial Time (TT) for the Sun's ephemeris and precession, and
-UT1 taken equal to UTC for the Earth's rotation (|UT1 - UTC| < 0.9 s: 0.004 deg of
+UT1 taken equal to UTC for the Earth's rotation (‖UT1 - UTC‖ < 0.9 s: 0.004 deg of
 Earth rotation). docs/orbit.md, 'Frames and time'.
 """
 

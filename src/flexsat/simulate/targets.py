@@ -66,7 +66,7 @@ def tracking_errors(
     Returns
     -------
     pointing : ndarray, shape (m,)
-        2 asin |q_v,e| of q_e = q_d^-1 (x) q [rad].
+        2 asin ‖q_v,e‖ of q_e = q_d^-1 (x) q [rad].
     omega_error : ndarray, shape (m, 3)
         omega - C_BD omega_d, frame B [rad/s].
     """

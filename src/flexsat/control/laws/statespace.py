@@ -7,7 +7,7 @@ at [s], which must equal the loop's ``control_dt_s``). Its input, per call, is
     y = [theta_x, theta_y, theta_z, omega_e,x, omega_e,y, omega_e,z]
 
 theta the attitude error as a rotation vector in the hub frame B [rad]
-(theta_err q_v,e / |q_v,e|, q_e = q_d^-1 (x) q with q_e0 >= 0; to first order the
+(theta_err q_v,e / ‖q_v,e‖, q_e = q_d^-1 (x) q with q_e0 >= 0; to first order the
 small ZYX angles phi, theta, psi of :func:`flexsat.linear.linearize`), omega_e the
 body-rate error [rad/s]. Its output is the body torque command [N m], clipped to
 RF T_max per axis like every law's. Sign convention: the controller is

@@ -1,11 +1,11 @@
 """Nadir (LVLH) pointing: the target attitude turns with the orbit's local vertical frame.
 
-The LVLH frame L: z toward nadir, -r/|r|; y against the orbit normal, -h/|h| with
+The LVLH frame L: z toward nadir, -r/‖r‖; y against the orbit normal, -h/‖h‖ with
 h = r x v; x = y x z (along the velocity on a circular orbit), r and v from the run's
 ephemeris (:mod:`flexsat.orbit.ephemeris`). The target is q_d = q_NL (x) q_off with
 q_off the scenario's ``target_euler_deg`` read as the body's attitude in L (0, 0, 0:
-body z at nadir). L turns about the orbit normal at |h| / |r|^2, so
-omega_d = -(|h| / |r|^2) y_L and omega_dot_d = (2 |h| (r . v) / |r|^4) y_L, both
+body z at nadir). L turns about the orbit normal at ‖h‖ / ‖r‖^2, so
+omega_d = -(‖h‖ / ‖r‖^2) y_L and omega_dot_d = (2 ‖h‖ (r . v) / ‖r‖^4) y_L, both
 in the reference frame D; the out-of-plane turn J2 adds (the node's 1e-6 rad/s) is
 left out. docs/orbit.md, 'Pointing targets'.
 """
@@ -58,8 +58,8 @@ class NadirReferenceConfig(PlantStageConfig):
 def lvlh_target(row, params, q_d, omega_d, omega_dot_d):
     """The nadir target from one ephemeris row: q_d, omega_d, omega_dot_d (frame D).
 
-    The LVLH frame: z to nadir, y against the orbit normal; its rate |h|/r^2 and
-    acceleration -2 |h| (r . v)/r^4 about -y (docs/orbit.md, 'Pointing targets').
+    The LVLH frame: z to nadir, y against the orbit normal; its rate ‖h‖/r^2 and
+    acceleration -2 ‖h‖ (r . v)/r^4 about -y (docs/orbit.md, 'Pointing targets').
 
     Parameters
     ----------

@@ -1,12 +1,12 @@
 """Sun pointing: a body axis held on the Sun as seen from the satellite.
 
 The Sun frame S: z toward the Sun, s (the ephemeris's satellite-to-Sun unit vector);
-x = (Z x s) / |Z x s| with Z the ECI pole (never parallel: the Sun's declination stays
+x = (Z x s) / ‖Z x s‖ with Z the ECI pole (never parallel: the Sun's declination stays
 within 23.44 deg); y = z x x. The target is q_d = q_NS (x) q_off with q_off the
 scenario's ``target_euler_deg`` read as the body's attitude in S (0, 0, 0: body z on
 the Sun). S turns as s does (the year's 2e-7 rad/s and the orbit's parallax): with
 s' from the ephemeris's slope (central difference over one grid step),
-omega_N = s x s' + ((Z x s') . y / |Z x s|) s, rotated into D; omega_dot_d is taken
+omega_N = s x s' + ((Z x s') . y / ‖Z x s‖) s, rotated into D; omega_dot_d is taken
 as zero (about 1e-11 rad/s^2). docs/orbit.md, 'Pointing targets'.
 """
 
