@@ -29,6 +29,7 @@ from flexsat.environment.registry import (
     EPH_R,
     EnvironmentModelConfig,
     EnvironmentModelSpec,
+    load_kernel,
 )
 
 __all__ = ["GRAVITY_GRADIENT", "MU_EARTH", "GravityGradientConfig", "gravity_gradient_load"]
@@ -50,32 +51,12 @@ class GravityGradientConfig(EnvironmentModelConfig):
 
 
 @njit(cache=True)  # compiled with LOAD_SIGNATURE on first use
+@load_kernel
 def gravity_gradient_load(eph, C_BN, points, surfaces, params, force, torque):
     """Hub torque 3 mu/r^3 o x (J o) and the tidal force on each mass element (module
     docstring), frame B; surfaces take none.
 
-    Parameters
-    ----------
-    eph : ndarray, shape (13,)
-        The ephemeris row at the instant (``EPHEMERIS_COLUMNS``, ECI)
-        [s, m, m/s, -, m, -, rad].
-    C_BN : ndarray, shape (3, 3)
-        Rotation from ECI to hub frame B [-].
-    points : ndarray, shape (k, 4)
-        Mass elements: position from the hub centre of mass, frame B [m], mass [kg].
-    surfaces : ndarray, shape (s, SURFACE_SIZE)
-        Surfaces (``SURF_*`` slots of :mod:`flexsat.environment.registry`) [m, -, m^2, -].
-    params : ndarray, shape (p,)
-        The model's packed parameters (its config's ``packed``) [SI].
-    force : ndarray, shape (k + s, 3)
-        Force on each mass element, then each surface's centre, frame B [N], added to.
-    torque : ndarray, shape (3,)
-        Torque on the hub acting on no point, frame B [N m], added to.
-
-    Returns
-    -------
-    int
-        0 (the load cannot fail).
+    {contract}
     """
     rx, ry, rz = eph[EPH_R], eph[EPH_R + 1], eph[EPH_R + 2]
     r = sqrt(rx * rx + ry * ry + rz * rz)

@@ -30,6 +30,7 @@ from flexsat.environment.registry import (
     EPH_T,
     EnvironmentModelConfig,
     EnvironmentModelSpec,
+    load_kernel,
 )
 from flexsat.errors import ConfigError
 
@@ -148,31 +149,11 @@ def field_at(eph, params):
 
 
 @njit(cache=True)  # compiled with LOAD_SIGNATURE on first use
+@load_kernel
 def magnetic_load(eph, C_BN, points, surfaces, params, force, torque):
     """tau = m_res x B_B on the hub (module docstring).
 
-    Parameters
-    ----------
-    eph : ndarray, shape (13,)
-        The ephemeris row at the instant (``EPHEMERIS_COLUMNS``, ECI)
-        [s, m, m/s, -, m, -, rad].
-    C_BN : ndarray, shape (3, 3)
-        Rotation from ECI to hub frame B [-].
-    points : ndarray, shape (k, 4)
-        Mass elements: position from the hub centre of mass, frame B [m], mass [kg].
-    surfaces : ndarray, shape (s, SURFACE_SIZE)
-        Surfaces (``SURF_*`` slots of :mod:`flexsat.environment.registry`) [m, -, m^2, -].
-    params : ndarray, shape (p,)
-        The model's packed parameters (its config's ``packed``) [SI].
-    force : ndarray, shape (k + s, 3)
-        Force on each mass element, then each surface's centre, frame B [N], added to.
-    torque : ndarray, shape (3,)
-        Torque on the hub acting on no point, frame B [N m], added to.
-
-    Returns
-    -------
-    int
-        0 (the load cannot fail).
+    {contract}
     """
     bx, by, bz = field_at(eph, params)
     b0 = C_BN[0, 0] * bx + C_BN[0, 1] * by + C_BN[0, 2] * bz

@@ -57,6 +57,7 @@ __all__ = [
     "EnvironmentModelSpec",
     "environment_model",
     "environment_model_names",
+    "load_kernel",
     "register_environment_model",
 ]
 
@@ -78,6 +79,52 @@ _v = types.float64[::1]
 _m = types.float64[:, ::1]
 LOAD_SIGNATURE = types.int64(_v, _m, _m, _m, _v, _m, _v)
 """``load(eph, C_BN, points, surfaces, params, force, torque) -> status``."""
+
+_LOAD_CONTRACT = """\
+    Parameters
+    ----------
+    eph : ndarray, shape (13,)
+        The ephemeris row at the instant (``EPHEMERIS_COLUMNS``, ECI)
+        [s, m, m/s, -, m, -, rad].
+    C_BN : ndarray, shape (3, 3)
+        Rotation from ECI to hub frame B [-].
+    points : ndarray, shape (k, 4)
+        Mass elements: position from the hub centre of mass, frame B [m], mass [kg].
+    surfaces : ndarray, shape (s, SURFACE_SIZE)
+        Surfaces (``SURF_*`` slots of :mod:`flexsat.environment.registry`) [m, -, m^2, -].
+    params : ndarray, shape (p,)
+        The model's packed parameters (its config's ``packed``) [SI].
+    force : ndarray, shape (k + s, 3)
+        Force on each mass element, then each surface's centre, frame B [N], added to.
+    torque : ndarray, shape (3,)
+        Torque on the hub acting on no point, frame B [N m], added to.
+
+    Returns
+    -------
+    int
+        0 (the load cannot fail).
+"""
+
+
+def load_kernel(kernel):
+    """Give a load kernel's docstring the contract's parameters and return value.
+
+    Its ``{contract}`` line becomes the numpydoc sections every load shares (the
+    arguments of :data:`LOAD_SIGNATURE`), written once here. Apply it beneath
+    ``njit``.
+
+    Parameters
+    ----------
+    kernel : function
+        The Python function of a load, its docstring holding ``{contract}``.
+
+    Returns
+    -------
+    function
+        ``kernel``, its docstring completed.
+    """
+    kernel.__doc__ = kernel.__doc__.replace("    {contract}\n", _LOAD_CONTRACT)
+    return kernel
 
 
 class EnvironmentModelConfig(BaseModel):

@@ -32,6 +32,7 @@ from flexsat.environment.registry import (
     SURF_SPECULAR,
     EnvironmentModelConfig,
     EnvironmentModelSpec,
+    load_kernel,
 )
 
 __all__ = ["ASTRONOMICAL_UNIT", "SOLAR_PRESSURE", "SRP", "SrpConfig", "srp_load"]
@@ -57,31 +58,11 @@ class SrpConfig(EnvironmentModelConfig):
 
 
 @njit(cache=True)  # compiled with LOAD_SIGNATURE on first use
+@load_kernel
 def srp_load(eph, C_BN, points, surfaces, params, force, torque):
     """The pressure force on each lit surface's centre, frame B (module docstring).
 
-    Parameters
-    ----------
-    eph : ndarray, shape (13,)
-        The ephemeris row at the instant (``EPHEMERIS_COLUMNS``, ECI)
-        [s, m, m/s, -, m, -, rad].
-    C_BN : ndarray, shape (3, 3)
-        Rotation from ECI to hub frame B [-].
-    points : ndarray, shape (k, 4)
-        Mass elements: position from the hub centre of mass, frame B [m], mass [kg].
-    surfaces : ndarray, shape (s, SURFACE_SIZE)
-        Surfaces (``SURF_*`` slots of :mod:`flexsat.environment.registry`) [m, -, m^2, -].
-    params : ndarray, shape (p,)
-        The model's packed parameters (its config's ``packed``) [SI].
-    force : ndarray, shape (k + s, 3)
-        Force on each mass element, then each surface's centre, frame B [N], added to.
-    torque : ndarray, shape (3,)
-        Torque on the hub acting on no point, frame B [N m], added to.
-
-    Returns
-    -------
-    int
-        0 (the load cannot fail).
+    {contract}
     """
     lit = eph[EPH_LIT]
     if lit <= 0.0:
