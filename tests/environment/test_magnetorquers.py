@@ -108,3 +108,20 @@ def test_dumping_keeps_the_wheel_momentum_bounded_over_three_orbits(monkeypatch)
     assert free[2] > 2.5 * free[0]
     assert max(dumped) < 1.1 * dumped[0]
     assert max(dumped) < 0.2 * free[2]
+
+
+def test_magnetorquers_without_wheels_are_refused_when_the_scenario_is_read() -> None:
+    """The scenario itself refuses them (not only the run's set-up), so a campaign's
+    check of its base scenario stops before any case flies."""
+    from pydantic import ValidationError
+
+    from flexsat.simulate.scenario import SlewScenario
+
+    table = {
+        "orbit": {"altitude_m": 500e3},
+        "environment": {"models": {"magnetic": {}}, "magnetorquers": {}},
+    }
+    with pytest.raises(ValidationError, match="the \\[actuator\\] must be kind = 'wheels'"):
+        SlewScenario.model_validate(table)
+    wheels = {**table, "actuator": {"kind": "wheels"}}
+    assert SlewScenario.model_validate(wheels).environment.magnetorquers is not None

@@ -415,6 +415,18 @@ class SlewScenario(_TimedRun):
         return self
 
     @model_validator(mode="after")
+    def _magnetorquers_dump_the_wheels(self) -> SlewScenario:
+        # They unload the wheels' stored momentum (docs/environment.md, 'Magnetorquers'):
+        # refused here, so a campaign refuses it before its first case flies.
+        if self.environment is not None and self.environment.magnetorquers is not None:
+            if self.actuator.kind != "wheels":
+                raise ValueError(
+                    "environment.magnetorquers: they dump the reaction wheels' momentum: "
+                    f"the [actuator] must be kind = 'wheels', got {self.actuator.kind!r}"
+                )
+        return self
+
+    @model_validator(mode="after")
     def _stages_fit_the_run(self) -> SlewScenario:
         for field, stage in [("controller", self.controller), *self.stage_chain()]:
             try:
