@@ -16,11 +16,80 @@ from flexsat.config.models import SatelliteConfig
 from flexsat.errors import ConfigError
 from flexsat.study.outputs import prepare_output_dir, write_json
 
-__all__ = ["POINTS_RANGE", "load_controller", "robust_analysis"]
+__all__ = ["POINTS_RANGE", "case_factors", "load_controller", "robust_analysis"]
 
 POINTS_RANGE = (8, 2000)
 """Allowed number of log-spaced frequencies of the grid (the modal frequencies are added)."""
 _BAND_HZ = (1e-3, 200.0)
+# The tails of the campaign paths the LFT models (docs/linear.md, 'The 24 critical cases').
+_CASE_PATHS = (
+    "target_frequencies_hz.flapping",
+    "target_frequencies_hz.in_plane",
+    "target_frequencies_hz.torsion",
+    "damping_ratio",
+    "inertia",
+    "sadm_angle_deg",
+)
+
+
+def case_factors(case, config: SatelliteConfig) -> tuple[dict, float]:
+    """The LFT's factors of a campaign case: what its modifiers did to the satellite.
+
+    Parameters
+    ----------
+    case : ResolvedCase
+        A resolved case (:func:`flexsat.campaigns.resolve_cases`) of ``config``.
+    config : SatelliteConfig
+        The campaign's base satellite, every appendage a plate.
+
+    Returns
+    -------
+    factors : dict
+        Factor on the base value of ``frequency`` (the rotation joints' target
+        frequencies, the three alike), ``damping`` (the damping ratio),
+        ``hub_inertia`` and ``panel_inertia`` [-], read from the case's satellite
+        against the base (the inertias from the modifiers' realised factors, which
+        is what ``hub.inertia`` and ``appendages[*].inertia`` are);
+        :meth:`flexsat.linear.uncertain.UncertainModel.deltas` turns them into the
+        normalized deltas.
+    sadm_angle_deg : float
+        The case's SADM angle, every plate's [deg].
+
+    Raises
+    ------
+    ConfigError
+        A case that changes something the LFT does not model, or a factor (or SADM
+        angle) that differs between appendages or between the three frequencies (the
+        LFT applies one factor to every appendage).
+    """
+    for path in case.parameters:
+        tail = path.split(".", 1)[1] if path.startswith("appendages[") else path
+        if path != "hub.inertia" and tail not in _CASE_PATHS:
+            raise ConfigError(f"case {case.case_id}: {path!r} is not a parameter of the "
+                              "uncertain model (it models the rotation joints' target "
+                              "frequencies, the damping ratio, hub.inertia, "
+                              "appendages[*].inertia and the SADM angle)")  # fmt: skip
+    base = config.model_dump()["appendages"]
+    found: dict[str, set] = {}
+    for k, (app, ref) in enumerate(zip(case.plant["appendages"], base, strict=True)):
+        for axis in ("flapping", "in_plane", "torsion"):
+            ratio = app["target_frequencies_hz"][axis] / ref["target_frequencies_hz"][axis]
+            found.setdefault("frequency", set()).add(round(ratio, 12))
+        found.setdefault("damping", set()).add(
+            round(app["damping_ratio"] / ref["damping_ratio"], 12)
+        )
+        found.setdefault("panel_inertia", set()).add(
+            float(case.parameters.get(f"appendages[{k}].inertia", 1.0))
+        )
+        found.setdefault("sadm_angle_deg", set()).add(float(app["sadm_angle_deg"]))
+    found["hub_inertia"] = {float(case.parameters.get("hub.inertia", 1.0))}
+    for name, values in found.items():
+        if len(values) > 1:
+            raise ConfigError(f"case {case.case_id}: {name} differs between appendages or "
+                              f"frequencies ({sorted(values)}); the uncertain model applies "
+                              "one factor to every appendage")  # fmt: skip
+    sadm = next(iter(found.pop("sadm_angle_deg")))
+    return {name: next(iter(values)) for name, values in found.items()}, sadm
 
 
 def load_controller(path: str | Path):
