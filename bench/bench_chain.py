@@ -11,12 +11,28 @@ Run with ``python bench/bench_chain.py`` (``--quick`` for fewer steps). Prints:
 3. the centrifugal stiffening of a spinning cantilever: frequency against spin rate up
    to Omega/omega_0 = 2 for the chain (N = 16) and the single rigid plate, written to
    ``docs/figures/chain_spin_stiffening.png`` (the figure of docs/model.md).
+
+``--instructions`` prints table 1 in executed instructions instead (valgrind's
+callgrind, event Ir), which the machine's load does not move: the script re-runs
+itself under ``valgrind --tool=callgrind`` with instrumentation off until the shim of
+``bench_avionics_instructions.py`` starts a count around one call of the compiled RK4
+loop; instructions per step = (Ir(long) - Ir(short)) / (long - short steps), which
+removes the call's fixed cost. numba compiles for the CPU that script names (Haswell
+on an AVX-512 host, which valgrind 3.19 cannot execute), natively first (filling the
+cache) and then under valgrind, which loads that machine code. Needs valgrind and gcc;
+about a minute.
 """
 
 from __future__ import annotations
 
 import argparse
+import gc
+import json
+import os
+import shutil
+import subprocess
 import sys
+import tempfile
 from pathlib import Path
 
 import numpy as np
@@ -30,6 +46,7 @@ from flexsat.dynamics.plant import Plant
 from flexsat.linear import linearize
 
 ROOT = Path(__file__).resolve().parents[1]
+SIZES = (1, 2, 4, 8, 16, 32)  # segments per chain in the cost tables
 
 
 def _cantilever():
@@ -63,7 +80,7 @@ def _two_arrays(n: int) -> Plant:
 
 
 def step_cost_table(console: Console, steps: int) -> None:
-    sizes = [1, 2, 4, 8, 16, 32]
+    sizes = list(SIZES)
     costs = []
     for n in sizes:
         plant = _two_arrays(n)
@@ -96,6 +113,87 @@ def step_cost_table(console: Console, steps: int) -> None:
     console.print(table)
     console.print(f"slope {slope:.3f} us per segment (two chains), intercept {intercept:.2f} us; "
                   f"cost(32) / cost(16) = {costs[-1] / costs[-2]:.2f} (linear: ~2)")  # fmt: skip
+
+
+def _counted_flights(out: Path | None, shim: Path | None, short: int, long: int) -> None:
+    """Fly every N for ``short`` and ``long`` steps, each call alone counted under
+    callgrind (``out``: where the flights are listed); natively (``shim`` None) only
+    compile or load the loop for every N."""
+    import ctypes
+
+    from flexsat.dynamics.integrators import rk4_hold as loop
+
+    cg = None
+    if shim is not None:
+        cg = ctypes.CDLL(str(shim))
+        cg.cg_stop.argtypes = [ctypes.c_char_p]
+    flights = []
+    for n in SIZES:
+        plant = _two_arrays(n)
+        x = np.zeros(2 * plant.n_dof + 2)
+        x[plant.n_dof + 3 : plant.n_dof + 6] = (0.01, -0.02, 0.015)
+        loop(x.copy(), 1e-6, 10, (0.0, 0.0, 0.0), plant.packed, identity_frame())
+        if cg is None:
+            continue
+        overloads = len(loop.overloads)
+        for steps in (short, long):
+            trial, label = x.copy(), f"N{n}-{steps}"
+            gc.disable()
+            cg.cg_start()
+            status, done = loop(trial, 1e-6, steps, (0.0, 0.0, 0.0), plant.packed,
+                                identity_frame())  # fmt: skip
+            cg.cg_stop(label.encode())
+            gc.enable()
+            if status != 0 or done != steps or len(loop.overloads) != overloads:
+                sys.exit(f"N = {n}: status {status} after {done} of {steps} steps")
+            flights.append({"N": n, "steps": steps, "dump": label})
+    if out is not None:
+        out.write_text(json.dumps(flights))
+
+
+def instruction_table(console: Console, short: int = 200, long: int = 1200) -> dict[int, float]:
+    """Table 1 in instructions (callgrind Ir) per RK4 step; returns them per N."""
+    from numba.core.registry import cpu_target
+
+    from bench_avionics_instructions import HASWELL_FEATURES, INSTALL, build_shim, read_dumps
+
+    work = Path(tempfile.mkdtemp(prefix="flexsat-callgrind-"))
+    try:
+        shim = build_shim(work)
+        if isinstance(shim, str):
+            raise SystemExit(f"{shim}: install valgrind and gcc ({INSTALL})")
+        _, cpu_name, features = cpu_target.target_context.codegen().magic_tuple()
+        if "+avx512f" in features:
+            cpu_name, features = "haswell", HASWELL_FEATURES
+        env = os.environ | {"NUMBA_CPU_NAME": cpu_name, "NUMBA_CPU_FEATURES": features}
+        script = [sys.executable, str(Path(__file__).resolve()), "--inner-steps",
+                  f"{short},{long}"]  # fmt: skip
+        subprocess.run(script, env=env, check=True)  # fills the cache natively
+        flights_file = work / "flights.json"
+        command = ["valgrind", "--tool=callgrind", "--instr-atstart=no", "--collect-atstart=no",
+                   f"--callgrind-out-file={work / 'out.%p'}", f"--log-file={work / 'log'}",
+                   *script, "--inner", str(flights_file), "--shim", str(shim)]  # fmt: skip
+        done = subprocess.run(command, env=env, check=False)
+        if done.returncode != 0 or not flights_file.exists():
+            raise SystemExit(f"the run under callgrind failed (exit status {done.returncode})")
+        flights = json.loads(flights_file.read_text())
+        counts = read_dumps(work)
+    finally:
+        shutil.rmtree(work, ignore_errors=True)
+    ir = {(f["N"], f["steps"]): counts[f["dump"]] for f in flights}
+    per_step = {n: (ir[n, long] - ir[n, short]) / (long - short) for n in SIZES}
+    slope, intercept = np.polyfit(SIZES, [per_step[n] for n in SIZES], 1)
+    table = harness.table(
+        f"RK4 step cost, two chains of N hinged segments, instructions (callgrind Ir, "
+        f"{cpu_name}) per step, steps {short} to {long}",
+        ("N", "instructions per step", "per segment (both chains)"),
+        left=0,
+    )
+    for n in SIZES:
+        table.add_row(str(n), f"{per_step[n]:,.0f}", f"{per_step[n] / (2 * n):,.0f}")
+    console.print(table)
+    console.print(f"line: {intercept:,.0f} + {slope:,.0f} instructions per segment (two chains)")
+    return per_step
 
 
 def beam_table(console: Console) -> None:
@@ -164,8 +262,20 @@ def spin_figure(console: Console) -> None:
 def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="fewer steps in the cost table")
+    parser.add_argument("--instructions", action="store_true",
+                        help="the cost table in instructions (callgrind) alone")  # fmt: skip
+    parser.add_argument("--inner-steps", help=argparse.SUPPRESS)
+    parser.add_argument("--inner", type=Path, help=argparse.SUPPRESS)
+    parser.add_argument("--shim", type=Path, help=argparse.SUPPRESS)
     args = parser.parse_args(argv)
+    if args.inner_steps is not None:
+        short, long = (int(v) for v in args.inner_steps.split(","))
+        _counted_flights(args.inner, args.shim, short, long)
+        return
     console = harness.console()
+    if args.instructions:
+        instruction_table(console)
+        return
     step_cost_table(console, 2_000 if args.quick else 20_000)
     beam_table(console)
     spin_figure(console)

@@ -34,6 +34,7 @@ from flexsat.dynamics.appendages.chain_kernels import (
     G_FREE,
     G_J,
     G_K,
+    G_KIND,
     G_MASS,
     G_NEXT,
     G_NF,
@@ -44,6 +45,8 @@ from flexsat.dynamics.appendages.chain_kernels import (
     H_TIP,
     H_TIP0,
     HEADER,
+    JOINT_GENERAL,
+    JOINT_HINGE_X,
     SEG,
     WSEG,
     bias_forces,
@@ -181,6 +184,7 @@ class ChainModel(AppendageModel):
                 row[g + G_C + np.array(free)] = seg.damping
             row[g + G_OFF] = offset
             row[g + G_NF] = len(free)
+            row[g + G_KIND] = _joint_kind(free)
             offset += len(free)
         return row
 
@@ -432,6 +436,15 @@ class ChainModel(AppendageModel):
             if joint == "0":
                 out[:, DOF_NAMES.index(dof)] = q_block[:, a]
         return out[:, :3], out[:, 3:]
+
+
+def _joint_kind(free: list[int]) -> int:
+    """The kernels' joint-kind code of a joint with these free DOFs (indices into
+    ``DOF_NAMES``): a hinge about axis a (one free rotation, a = 0, 1, 2 for rx, ry, rz)
+    takes the specialized recursion step, any other joint the general one."""
+    if len(free) == 1 and free[0] >= 3:
+        return JOINT_HINGE_X + free[0] - 3
+    return JOINT_GENERAL
 
 
 def _with_point_mass(seg, tip_mass: float, point: np.ndarray):

@@ -77,6 +77,7 @@ __all__ = [
     "G_FREE",
     "G_J",
     "G_K",
+    "G_KIND",
     "G_MASS",
     "G_NEXT",
     "G_NF",
@@ -87,6 +88,8 @@ __all__ = [
     "H_R_BM",
     "H_TIP",
     "H_TIP0",
+    "JOINT_GENERAL",
+    "JOINT_HINGE_X",
     "SEG",
     "WSEG",
     "bias_forces",
@@ -114,7 +117,15 @@ G_K = 22  # (6) stiffness per DOF [N/m, N m/rad] (0 where locked)
 G_C = 28  # (6) damping per DOF [N s/m, N m s/rad]
 G_OFF = 34  # (1) offset of the joint's first coordinate in the chain's block
 G_NF = 35  # (1) number of free DOFs n_k
-SEG = 36
+G_KIND = 36  # (1) joint kind: JOINT_GENERAL, or JOINT_HINGE_X + a for a hinge about axis a
+SEG = 37
+
+# Joint kinds (slot G_KIND). A hinge frees one rotation (rx, ry or rz) and nothing else:
+# its axis is constant in the parent-side frame, S_k = [e_a; 0], c_J = 0, and its
+# recursion step has a scalar D_k and elementary rotations (docs/model.md, 'Chain
+# appendages', paragraph 'Hinges'). Every other joint takes the general step.
+JOINT_GENERAL = 0
+JOINT_HINGE_X = 1  # + a: hinge about the parent-side frame's axis a = 0, 1, 2 (x, y, z)
 
 # Scratch per segment in a work row (pass 1 -> pass 2).
 W_R = 0  # (9) R_{parent, P_k}, row-major
@@ -126,7 +137,8 @@ W_PA = 90  # (6) bias force p^A_k [n; f]
 W_U = 96  # (36) U_k = I^A_k S_k, column a at W_U + 6 a
 W_DI = 132  # (36) D_k^-1, row-major, stride 6
 W_TAU = 168  # (6) tau_k, then u_k = tau_k - S_k^T p^A_k
-WSEG = 174
+W_CS = 174  # (2) a hinge's cos and sin of its angle
+WSEG = 176
 
 MIN_COS = 1e-9  # |cos(ry)| below this is a gimbal lock when rx and rz are both free
 _ZERO = (0.0, 0.0, 0.0)
@@ -235,27 +247,116 @@ def _add_block(dst, d, r0, c0, m, swap):
 
 
 @njit(cache=True, error_model="numpy")
+def _shift_add(A, B, D, pos, dst, d, swap):
+    """dst[d:d+36] += T^T [[A, B], [B^T, D]] T, T = [[1, 0], [-[pos]x, 1]].
+
+    The blocks are a spatial inertia's in the parent's axes; the result is
+    [[A + [p]B^T - (B + [p]D)[p], B + [p]D], [C - D[p], D]] ([p] = [pos]x), the lower
+    left block the transposed upper right one. [p]M and M[p] are written as cross
+    products, column by column and row by row (the products with skew(pos) without
+    their zero terms). ``swap`` = 3 writes it in the hub exchange order
+    [force; torque] x [a; omega_dot].
+    """
+    Dc = transpose(D)
+    pD = transpose((cross(pos, Dc[0]), cross(pos, Dc[1]), cross(pos, Dc[2])))
+    pBt = transpose((cross(pos, B[0]), cross(pos, B[1]), cross(pos, B[2])))
+    upper_right = _msum(B, pD, 1.0)
+    up_p = (cross(upper_right[0], pos), cross(upper_right[1], pos),
+            cross(upper_right[2], pos))  # fmt: skip
+    upper_left = _msum(_msum(A, pBt, 1.0), up_p, -1.0)
+    _add_block(dst, d, 0, 0, upper_left, swap)
+    _add_block(dst, d, 0, 3, upper_right, swap)
+    _add_block(dst, d, 3, 0, transpose(upper_right), swap)
+    _add_block(dst, d, 3, 3, D, swap)
+
+
+@njit(cache=True, error_model="numpy")
 def _add_congruence(src, s, R, pos, dst, d, swap):
     """dst[d:d+36] += X^T (src[s:s+36]) X, X the parent -> child motion transform.
 
-    X = diag(R^T, R^T) T with T = [[1, 0], [-[pos]x, 1]]: with the blocks of src
-    rotated to the parent's axes, [[A, B], [C, D]], the result is
-    [[A + [p]C - (B + [p]D)[p], B + [p]D], [C - D[p], D]] ([p] = [pos]x). src is a
-    spatial inertia, symmetric: C = B^T, D = D^T, so the lower-left block is the
-    transposed upper-right one and C is never rotated.
-    ``swap`` = 3 writes it in the hub exchange order [force; torque] x [a; omega_dot].
+    X = diag(R^T, R^T) T with T = [[1, 0], [-[pos]x, 1]]: the blocks of src rotated
+    to the parent's axes (R M R^T), then moved by :func:`_shift_add`. src is a spatial
+    inertia, symmetric: its lower-left block is the transposed upper-right one and is
+    never rotated.
     """
     Rt = transpose(R)
     A = mm(R, mm(_block(src, s, 0, 0), Rt))
     B = mm(R, mm(_block(src, s, 0, 3), Rt))
     D = mm(R, mm(_block(src, s, 3, 3), Rt))
-    P = skew(pos)
-    upper_right = _msum(B, mm(P, D), 1.0)
-    upper_left = _msum(_msum(A, mm(P, transpose(B)), 1.0), mm(upper_right, P), -1.0)
-    _add_block(dst, d, 0, 0, upper_left, swap)
-    _add_block(dst, d, 0, 3, upper_right, swap)
-    _add_block(dst, d, 3, 0, transpose(upper_right), swap)
-    _add_block(dst, d, 3, 3, D, swap)
+    _shift_add(A, B, D, pos, dst, d, swap)
+
+
+# -- hinges: elementary rotations -------------------------------------------------------
+
+
+@njit(cache=True, error_model="numpy")
+def _rot_axis(axis, c, s, u):
+    """R_a u, R_a the rotation about coordinate axis a (0, 1, 2: Rx, Ry, Rz) by the
+    angle of cosine c and sine s; two components change. R_a^T u is _rot_axis(a, c, -s, u)."""
+    if axis == 0:
+        return u[0], c * u[1] - s * u[2], s * u[1] + c * u[2]
+    if axis == 1:
+        return c * u[0] + s * u[2], u[1], c * u[2] - s * u[0]
+    return c * u[0] - s * u[1], s * u[0] + c * u[1], u[2]
+
+
+@njit(cache=True, error_model="numpy")
+def _rot_rows(axis, c, s, m):
+    """R_a m for a 3 x 3 m: two of its rows combined."""
+    r0, r1, r2 = m
+    if axis == 0:
+        return r0, _comb(c, r1, -s, r2), _comb(s, r1, c, r2)
+    if axis == 1:
+        return _comb(c, r0, s, r2), r1, _comb(c, r2, -s, r0)
+    return _comb(c, r0, -s, r1), _comb(s, r0, c, r1), r2
+
+
+@njit(cache=True, error_model="numpy")
+def _comb(x, u, y, v):
+    """x u + y v for 3-vectors."""
+    return x * u[0] + y * v[0], x * u[1] + y * v[1], x * u[2] + y * v[2]
+
+
+@njit(cache=True, error_model="numpy")
+def _sandwich(axis, c, s, m):
+    """R_a m R_a^T = (R_a (R_a m)^T)^T: 24 products instead of the 54 of two 3 x 3 products."""
+    return transpose(_rot_rows(axis, c, s, transpose(_rot_rows(axis, c, s, m))))
+
+
+@njit(cache=True, error_model="numpy")
+def _add_axis(u, axis, x):
+    """u + x e_a."""
+    if axis == 0:
+        return u[0] + x, u[1], u[2]
+    if axis == 1:
+        return u[0], u[1] + x, u[2]
+    return u[0], u[1], u[2] + x
+
+
+@njit(cache=True, error_model="numpy")
+def _cross_axis(u, axis, x):
+    """u x (x e_a)."""
+    if axis == 0:
+        return 0.0, u[2] * x, -u[1] * x
+    if axis == 1:
+        return -u[2] * x, 0.0, u[0] * x
+    return u[1] * x, -u[0] * x, 0.0
+
+
+@njit(cache=True, error_model="numpy")
+def _xm_hinge(axis, c, s, pos, ua, ul):
+    """:func:`_xm` for a hinge's R = R_a (joint k > 0, parallel to the parent's frame)."""
+    return _rot_axis(axis, c, -s, ua), _rot_axis(axis, c, -s, sub(ul, cross(pos, ua)))
+
+
+@njit(cache=True, error_model="numpy")
+def _rotation_axis(axis, c, s):
+    """R_a as a 3 x 3 matrix (for the root, whose R = R_BM R_a is a general rotation)."""
+    if axis == 0:
+        return (1.0, 0.0, 0.0), (0.0, c, -s), (0.0, s, c)
+    if axis == 1:
+        return (c, 0.0, s), (0.0, 1.0, 0.0), (-s, 0.0, c)
+    return (c, -s, 0.0), (s, c, 0.0), (0.0, 0.0, 1.0)
 
 
 @njit(cache=True, error_model="numpy")
@@ -398,6 +499,88 @@ def _body_force(p, g, va, vl, aa, al):
     return add(fn, gn), add(ff, gf)
 
 
+@njit(cache=True, error_model="numpy")
+def _hinge_outward(q, qd, Q, o, p, g, w, b, first, axis, va, vl, hub):
+    """Pass 1's outward step (eq. C.1) for a hinge about axis a of its parent-side frame.
+
+    S_k = [e_a; 0] and c_J = 0 (the axis does not move in the parent-side frame), so
+    v_k = X_k v_{k-1} + q_dot e_a and c_k = v_k x_m [q_dot e_a; 0]; R = R_a(q) for
+    k > 0, an elementary rotation (R_BM R_a at the root). Stores the pose, c_k, I_k,
+    p_k = v_k x_f I_k v_k and tau_k as the general step does; returns v_k.
+    """
+    col = o + int(p[g + G_OFF])
+    angle, rate = q[col], qd[col]
+    c, s = cos(angle), sin(angle)
+    w[b + W_CS], w[b + W_CS + 1] = c, s
+    if first:  # J_0 is the mount frame M: R = R_BM R_a, a general rotation
+        R = mm(load_m33_at(p, H_R_BM), _rotation_axis(axis, c, s))
+        pos = load_seg(p, H_MOUNT)
+        _put_m33(w, b + W_R, R)
+        xa, xl = _xm(R, pos, va, vl)
+    else:
+        pos = load_seg(p, g - SEG + G_NEXT)
+        xa, xl = _xm_hinge(axis, c, s, pos, va, vl)
+    _put3(w, b + W_POS, pos)
+    va, vl = _add_axis(xa, axis, rate), xl
+    _put3(w, b + W_CA, _cross_axis(va, axis, rate))
+    _put3(w, b + W_CA + 3, _cross_axis(vl, axis, rate))
+    m, cm, J = p[g + G_MASS], load_seg(p, g + G_COM), load_m33_at(p, g + G_J)
+    _store_inertia(w, b + W_IA, m, cm, J)
+    hn, hf = _inertia_mul(m, cm, J, va, vl)
+    pn, pf = _crf(va, vl, hn, hf)
+    _put3(w, b + W_PA, pn)
+    _put3(w, b + W_PA + 3, pf)
+    damping = p[g + G_C + 3 + axis]
+    w[b + W_TAU] = Q[col] - p[g + G_K + 3 + axis] * angle - damping * rate
+    hub[HUB_DISSIPATION] += damping * rate * rate  # eq. 2.36
+    return va, vl
+
+
+@njit(cache=True, error_model="numpy")
+def _hinge_inward(w, b, k, axis, hub):
+    """Pass 1's inward step (eqs. C.3, C.4) for a hinge about axis a: U = I^A e_a (a
+    column of I^A), D = I^A_aa (a scalar, no inverse), u = tau - p^A_a; then
+    I^a = I^A - U U^T / D on its 21 distinct entries, p^a = p^A + I^a c + U u / D,
+    and both moved to the parent (X^T I^a X by elementary rotations, or to the hub).
+    Leaves U, 1 / D and u for pass 2 at W_U, W_DI and W_TAU.
+    """
+    ia = b + W_IA
+    d_inv = 1.0 / w[ia + 7 * axis]
+    u = w[b + W_TAU] - w[b + W_PA + axis]
+    w[b + W_DI], w[b + W_TAU] = d_inv, u
+    for r in range(6):
+        w[b + W_U + r] = w[ia + 6 * r + axis]
+    y = d_inv * u
+    for r in range(6):
+        w[b + W_PA + r] += w[b + W_U + r] * y
+    for r in range(6):  # I^a = I^A - U D^-1 U^T, upper triangle mirrored
+        v = d_inv * w[b + W_U + r]
+        for e in range(r, 6):
+            x = w[ia + 6 * r + e] - v * w[b + W_U + e]
+            w[ia + 6 * r + e] = x
+            w[ia + 6 * e + r] = x
+    ia_n, ia_f = _mul6(w, ia, load_seg(w, b + W_CA), load_seg(w, b + W_CA + 3))
+    pn, pf = add(load_seg(w, b + W_PA), ia_n), add(load_seg(w, b + W_PA + 3), ia_f)
+    if k > 0:
+        up = b - WSEG
+        c, s, pos = w[b + W_CS], w[b + W_CS + 1], load_seg(w, b + W_POS)
+        _shift_add(_sandwich(axis, c, s, _block(w, ia, 0, 0)),
+                   _sandwich(axis, c, s, _block(w, ia, 0, 3)),
+                   _sandwich(axis, c, s, _block(w, ia, 3, 3)), pos, w, up + W_IA, 0)  # fmt: skip
+        Rf = _rot_axis(axis, c, s, pf)
+        pn = add(_rot_axis(axis, c, s, pn), cross(pos, Rf))
+        for r in range(3):
+            w[up + W_PA + r] += pn[r]
+            w[up + W_PA + 3 + r] += Rf[r]
+    else:
+        R, pos = _pose_of(w, b)
+        _add_congruence(w, ia, R, pos, hub, HUB_INERTIA, 3)
+        pn, pf = _xft(R, pos, pn, pf)
+        for r in range(3):
+            hub[HUB_FORCE + r] -= pf[r]
+            hub[HUB_TORQUE + r] -= pn[r]
+
+
 @njit(cache=True, error_model="numpy")  # compiled with PASS1_SIGNATURE on first use
 def pass1(q, qd, Q, members, params, work, hub, qdd):
     """Velocities outward, articulated inertias inward; the root's share to the hub.
@@ -434,6 +617,11 @@ def pass1(q, qd, Q, members, params, work, hub, qdd):
         va, vl = omega_B, _ZERO
         for k in range(n_seg):
             g, b = HEADER + k * SEG, k * WSEG
+            kind = int(p[g + G_KIND])
+            if kind != JOINT_GENERAL:
+                va, vl = _hinge_outward(q, qd, Q, o, p, g, w, b, k == 0, kind - JOINT_HINGE_X,
+                                        va, vl, hub)  # fmt: skip
+                continue
             R, pos, R_JP, S_rho, ja, jl, ca, cl, status = _joint_pose(q, qd, o, p, g, k == 0)
             if status != STATUS_OK:
                 return status
@@ -462,6 +650,10 @@ def pass1(q, qd, Q, members, params, work, hub, qdd):
                     a += 1
         for k in range(n_seg - 1, -1, -1):
             g, b = HEADER + k * SEG, k * WSEG
+            kind = int(p[g + G_KIND])
+            if kind != JOINT_GENERAL:
+                _hinge_inward(w, b, k, kind - JOINT_HINGE_X, hub)
+                continue
             nf = int(p[g + G_NF])
             # U = I^A S, D = S^T U, u = tau - S^T p^A
             for a in range(nf):
@@ -554,8 +746,24 @@ def pass2(q, qd, members, params, work, hub, qdd):
         aa, al = load_seg(hub, HUB_ALPHA), load_seg(hub, HUB_ACC)
         for k in range(int(p[H_N])):
             g, b = HEADER + k * SEG, k * WSEG
-            nf = int(p[g + G_NF])
             col = o + int(p[g + G_OFF])
+            kind = int(p[g + G_KIND])
+            if kind != JOINT_GENERAL:  # q_ddot = D^-1 (u - U^T a'), a = a' + q_ddot e_a
+                axis = kind - JOINT_HINGE_X
+                if k == 0:
+                    R, pos = _pose_of(w, b)
+                    xa, xl = _xm(R, pos, aa, al)
+                else:
+                    xa, xl = _xm_hinge(axis, w[b + W_CS], w[b + W_CS + 1],
+                                       load_seg(w, b + W_POS), aa, al)  # fmt: skip
+                aa = add(xa, load_seg(w, b + W_CA))
+                al = add(xl, load_seg(w, b + W_CA + 3))
+                un, uf = _col(w, b + W_U)
+                x = w[b + W_DI] * (w[b + W_TAU] - dot(un, aa) - dot(uf, al))
+                qdd[col] = x
+                aa = _add_axis(aa, axis, x)
+                continue
+            nf = int(p[g + G_NF])
             R, pos = _pose_of(w, b)
             xa, xl = _xm(R, pos, aa, al)
             aa = add(xa, load_seg(w, b + W_CA))
