@@ -122,6 +122,9 @@ class EnvironmentData(NamedTuple):
     every : int
         Loop steps between two evaluations, a whole number of control periods (the
         ``[environment]`` table's ``period_s``; 1 outside a loop).
+    record : int
+        Where in the loop's record row the torque (3) and, when dumping, the dipole
+        (3) are written at each evaluation; -1: not recorded.
     """
 
     active: bool
@@ -144,6 +147,7 @@ class EnvironmentData(NamedTuple):
     dump: np.ndarray
     dipole: np.ndarray
     every: int
+    record: int
 
 
 @njit(cache=True)
@@ -165,6 +169,7 @@ def environment_data(
     epoch: str,
     momentum_column: int | None = None,
     every: int = 1,
+    record_column: int | None = None,
 ) -> EnvironmentData:
     """The environment of a run, packed for the loop.
 
@@ -185,6 +190,9 @@ def environment_data(
     every : int, optional
         Loop steps between two evaluations of the loads (a whole number of control
         periods) [-].
+    record_column : int, optional
+        Where the loop's record row holds the environment's channels (its torque, then
+        the magnetorquers' dipole when they dump); none: not recorded.
 
     Returns
     -------
@@ -215,7 +223,7 @@ def environment_data(
         n_models=len(models), force=np.zeros((rows, 3)), torque=np.zeros(3),
         Q=np.zeros(plant.n_dof), applied=np.zeros(plant.n_dof),
         dumping=config.magnetorquers is not None, dump=dump, dipole=np.zeros(3),
-        every=max(1, int(every)),
+        every=max(1, int(every)), record=-1 if record_column is None else int(record_column),
     )  # fmt: skip
 
 
@@ -241,7 +249,7 @@ def idle_environment(n_dof: int) -> EnvironmentData:
         kernels=(filler,) * MODEL_SLOTS, params=(np.zeros(0),) * MODEL_SLOTS, n_models=0,
         force=np.zeros((0, 3)), torque=np.zeros(3), Q=np.zeros(n_dof),
         applied=np.zeros(n_dof), dumping=False, dump=np.zeros(DUMP_SIZE), dipole=np.zeros(3),
-        every=1,
+        every=1, record=-1,
     )  # fmt: skip
 
 
@@ -311,7 +319,8 @@ def environment_loads(env, held):
     env : EnvironmentData
         Its ``force``, ``torque``, ``Q`` and ``dipole`` are overwritten.
     held : ndarray
-        The loop's record row, where the wheels' momentum is read [per channel].
+        The loop's record row, where the wheels' momentum is read and, when
+        ``env.record >= 0``, the torque and the dipole are written [per channel].
 
     Returns
     -------
@@ -342,6 +351,11 @@ def environment_loads(env, held):
     if env.dumping:
         dump_momentum(env.dump, env.row, env.C_BN, env.params[int(env.dump[4])], held, torque,
                       env.dipole)  # fmt: skip
+    if env.record >= 0:
+        r = env.record
+        held[r], held[r + 1], held[r + 2] = torque[0], torque[1], torque[2]
+        if env.dumping:
+            held[r + 3], held[r + 4], held[r + 5] = env.dipole[0], env.dipole[1], env.dipole[2]
     return status
 
 

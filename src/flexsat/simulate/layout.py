@@ -35,7 +35,8 @@ class LoopLayout:
     Control record row (``record_size``,), held between control instants:
     ``[tau_cmd]`` (3) and ``[tau_applied]`` (3) [N m], the law's diagnostics
     ``[law_diag]``, the sensing chain's and the actuation chain's records, then the
-    reference's and the joint actuator's.
+    reference's and the joint actuator's, then the environment's (its torque on the
+    hub and the magnetorquers' dipole, when the run has an ``[environment]``).
 
     Parameters
     ----------
@@ -50,6 +51,10 @@ class LoopLayout:
         The reference generator.
     joint_actuator : StageSpec
         The joint actuator.
+    environment : tuple of Channel
+        The environment's recorded channels (none without an ``[environment]``),
+        written by its loads at each evaluation and held between
+        (:func:`flexsat.environment.loads.environment_loads`).
     """
 
     plant: StateLayout
@@ -58,6 +63,7 @@ class LoopLayout:
     actuators: tuple[StageSpec, ...]
     reference: StageSpec = STEP_REFERENCE
     joint_actuator: StageSpec = NO_JOINT_ACTUATOR
+    environment: tuple[Channel, ...] = ()
 
     @property
     def law_state(self) -> slice:
@@ -138,8 +144,12 @@ class LoopLayout:
         return _after(self.reference_record, self.joint_actuator.record_size)
 
     @property
+    def environment_record(self) -> slice:
+        return _after(self.joint_record, sum(c.size for c in self.environment))
+
+    @property
     def record_size(self) -> int:
-        return self.joint_record.stop
+        return self.environment_record.stop
 
     def channels(self) -> Iterator[tuple[Channel, slice]]:
         """Each declared channel of the law and the stages with its record columns."""
@@ -148,7 +158,8 @@ class LoopLayout:
         blocks = [(self.law_diag, self.law.diagnostics)]
         blocks += [(r, s.records) for r, s in zip(records, stages, strict=True)]
         blocks += [(self.reference_record, self.reference.records),
-                   (self.joint_record, self.joint_actuator.records)]  # fmt: skip
+                   (self.joint_record, self.joint_actuator.records),
+                   (self.environment_record, self.environment)]  # fmt: skip
         for block, channels in blocks:
             start = block.start
             for channel in channels:

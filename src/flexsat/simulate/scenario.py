@@ -416,8 +416,9 @@ class SlewScenario(_TimedRun):
 
     @model_validator(mode="after")
     def _magnetorquers_dump_the_wheels(self) -> SlewScenario:
-        # They unload the wheels' stored momentum (docs/environment.md, 'Magnetorquers'):
-        # refused here, so a campaign refuses it before its first case flies.
+        # They unload the wheels' stored momentum (docs/environment.md, 'Magnetorquers
+        # and momentum dumping'): refused here, so a campaign refuses it before its
+        # first case flies.
         if self.environment is not None and self.environment.magnetorquers is not None:
             if self.actuator.kind != "wheels":
                 raise ValueError(

@@ -7,6 +7,7 @@ import numpy as np
 from flexsat.compiled.first_class import first_class
 from flexsat.control.laws import LAW_SIGNATURE, get_law
 from flexsat.control.quaternion import target_quaternion
+from flexsat.control.registry import Channel
 from flexsat.control.stages import ACTUATORS, JOINT_ACTUATORS, REFERENCES, SENSORS
 from flexsat.control.stages.registry import (
     ACTUATOR_SIGNATURE,
@@ -28,8 +29,23 @@ EPHEMERIS_STEP_S = 10.0
 """Step of the ephemeris a slew's environment is interpolated in [s]: the cubic Hermite
 position is within 1 mm of the orbit in low Earth orbit at this step (docs/environment.md)."""
 
+ENVIRONMENT_TORQUE = Channel(
+    "environment_torque_B", "N m",
+    "the environment's torque on the hub (every model's, and the magnetorquers'), held "
+    "between evaluations, hub frame B", per_axis=True,
+)  # fmt: skip
+"""The environment's record: written at each evaluation of its loads."""
+MAGNETORQUER_DIPOLE = Channel(
+    "magnetorquer_dipole_B", "A m^2",
+    "the magnetorquers' dipole, clipped and quantized, held between evaluations, hub frame B",
+    per_axis=True,
+)  # fmt: skip
+"""Recorded when the scenario has ``[environment.magnetorquers]``."""
+
 __all__ = [
+    "ENVIRONMENT_TORQUE",
     "EPHEMERIS_STEP_S",
+    "MAGNETORQUER_DIPOLE",
     "flown_chain",
     "loop_data",
     "loop_layout",
@@ -109,7 +125,18 @@ def loop_layout(plant: Plant, scenario: SlewScenario) -> LoopLayout:
     LoopLayout
         The offsets of the plant state, control state and record row.
     """
-    return LoopLayout(plant.layout, *_specs(scenario))
+    return LoopLayout(plant.layout, *_specs(scenario), _environment_channels(scenario))
+
+
+def _environment_channels(scenario: SlewScenario) -> tuple[Channel, ...]:
+    """The environment's recorded channels: its torque when a model acts, and the
+    magnetorquers' dipole when they dump."""
+    config = getattr(scenario, "environment", None)
+    if config is None or not config.active():
+        return ()
+    if config.magnetorquers is None:
+        return (ENVIRONMENT_TORQUE,)
+    return (ENVIRONMENT_TORQUE, MAGNETORQUER_DIPOLE)
 
 
 def loop_stages(scenario: SlewScenario) -> LoopStages:
@@ -256,7 +283,8 @@ def slew_environment(scenario: SlewScenario, plant: Plant,
     plant : Plant
         The plant flown (its geometry and mass elements).
     layout : LoopLayout, optional
-        The loop's layout: where the magnetorquers read the wheels' momentum.
+        The loop's layout: where the magnetorquers read the wheels' momentum, and
+        where the environment's record is written.
 
     Returns
     -------
@@ -279,5 +307,6 @@ def slew_environment(scenario: SlewScenario, plant: Plant,
         if channel.name == "wheel_momentum_B":
             column = columns.start
     periods = max(1, round(config.period_s / scenario.control_dt_s))
+    record = layout.environment_record.start if layout is not None else None
     return environment_data(plant, config, ephemeris.table, ephemeris.epoch, column,
-                            periods * scenario.control_every)  # fmt: skip
+                            periods * scenario.control_every, record)  # fmt: skip
