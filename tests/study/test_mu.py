@@ -10,9 +10,11 @@ angle is not pulled out), analysed on its own.
 from __future__ import annotations
 
 import dataclasses
+import json
 
 import numpy as np
 import pytest
+import xarray as xr
 
 from flexsat.campaigns import load_campaign, resolve_cases
 from flexsat.config import nominal
@@ -129,3 +131,97 @@ def test_a_case_the_lft_does_not_model_is_refused(critical):
     odd = dataclasses.replace(case, parameters={**case.parameters, "hub.mass_kg": 9.0})
     with pytest.raises(ConfigError, match=r"'hub\.mass_kg' is not a parameter of the uncertain"):
         case_factors(odd, nominal())
+
+
+# -- the study's robustness part, alone ------------------------------------------------------
+
+
+@pytest.fixture(scope="module")
+def robust_part(tmp_path_factory):
+    """The robustness part of the quick study on the nominal satellite, and its report."""
+    from flexsat.study import pipeline
+    from flexsat.study.report import write_report
+
+    out = tmp_path_factory.mktemp("robust_study")
+    part = next(p for p in pipeline.PARTS if p.name == "robust")
+    entry = pipeline._run_part(part, pipeline.StudyContext(nominal(), out, quick=True))
+    manifest = {"flexsat_version": "test", "created_utc": "now", "config_name": "nominal",
+                "config_source": "a test", "quick": True, "parts": [entry]}  # fmt: skip
+    (out / "study.json").write_text(json.dumps(manifest))
+    write_report(out)
+    return out, json.loads((out / "study.json").read_text())["parts"][0]
+
+
+def test_the_robust_part_states_its_bounds_and_worst_cases(robust_part):
+    """mu.json and robust.json hold what the section shows; their relations hold."""
+    out, entry = robust_part
+    assert entry["status"] == "ok", entry["error"]
+    mu = json.loads((out / entry["outputs"]["mu"]).read_text())
+    rob = json.loads((out / entry["outputs"]["json"]).read_text())
+    # A valid upper bound is never below a lower bound: at the lower bound's frequency
+    # (evaluated there) and at the peak; the peak is the curve's largest value.
+    assert rob["upper_at_lower_frequency"] >= mu["lower"]
+    assert mu["peak_upper"] >= mu["lower"] and mu["peak_upper"] == max(mu["mu_upper"])
+    assert mu["k_max_lower"] == pytest.approx(1.0 / mu["peak_upper"], rel=1e-12)
+    assert mu["k_max_upper"] == pytest.approx(1.0 / mu["lower"], rel=1e-12)
+    # The sampling check passed: nothing unstable in the certified box, nothing in the
+    # full box further right than the mu worst case.
+    assert rob["certified_unstable"] == 0 and rob["certified_max_real_1_s"] < 0.0
+    assert rob["box_max_real_1_s"] <= rob["cases"]["mu_worst"]["max_real_1_s"]
+    # Each flown case's record is the perturbed satellite the factors make.
+    for case in rob["cases"].values():
+        ds = xr.load_dataset(out / "robust" / case["result"])
+        flown = json.loads(ds.attrs["config"])
+        ref = nominal().model_dump(mode="json")
+        for app, base in zip(flown["appendages"], ref["appendages"], strict=True):
+            ratio = (
+                app["target_frequencies_hz"]["flapping"] / base["target_frequencies_hz"]["flapping"]
+            )
+            assert ratio == pytest.approx(case["factors"]["frequency"], rel=1e-12)
+            assert app["damping_ratio"] == pytest.approx(
+                case["factors"]["damping"] * base["damping_ratio"], rel=1e-12, abs=1e-15
+            )
+    text = (out / "report.html").read_text()
+    for caption in ("μ bounds and k_max of the ASMC loop", "Worst-case parameter combination",
+                    "Sampling check in the linear model",
+                    "Worst cases flown in the nonlinear simulator"):  # fmt: skip
+        assert caption in text
+    print(f"mu upper {mu['peak_upper']:.4g} at {mu['peak_frequency_hz']:.4g} Hz, lower "
+          f"{mu['lower']:.6g} at {mu['lower_frequency_hz']:.4g} Hz; decay rates: mu worst "
+          f"{rob['cases']['mu_worst']['decay_rate_1_s']:.3g}, sampled worst "
+          f"{rob['cases']['sampled_worst']['decay_rate_1_s']:.3g} 1/s")  # fmt: skip
+
+
+def test_a_robust_section_that_cannot_be_drawn_fails_its_part(robust_part, tmp_path):
+    """robust.json without its sampling check: the part is failed, never 'ok'."""
+    import shutil
+
+    from flexsat.study.report import write_report
+
+    src, _ = robust_part
+    out = tmp_path / "study"
+    shutil.copytree(src, out)
+    path = out / "robust" / "robust.json"
+    data = json.loads(path.read_text())
+    del data["certified_unstable"]
+    path.write_text(json.dumps(data))
+    write_report(out)
+    entry = json.loads((out / "study.json").read_text())["parts"][0]
+    assert entry["status"] == "failed" and entry["report_failed"]
+    assert "robust section could not be drawn: KeyError('certified_unstable')" in entry["error"]
+    assert "Failed parts: Robust stability" in (out / "report.html").read_text()
+
+
+def test_the_robust_part_is_skipped_for_a_satellite_without_an_uncertain_model(tmp_path):
+    """A chain appendage has no LFT: the part is skipped, naming why."""
+    from flexsat.config import validate_config
+    from flexsat.study import pipeline
+    from tests.conftest import nominal_dict
+    from tests.dynamics.chain_satellites import plate_as_chain
+
+    data = nominal_dict()
+    data["appendages"][0] = plate_as_chain(data["appendages"][0])
+    part = next(p for p in pipeline.PARTS if p.name == "robust")
+    entry = pipeline._run_part(part, pipeline.StudyContext(validate_config(data), tmp_path))
+    assert entry["status"] == "skipped"
+    assert entry["error"].startswith("not applicable: appendages[0]: an uncertain model is built")

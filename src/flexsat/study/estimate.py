@@ -46,16 +46,23 @@ a case on each of the two cores, against 0.96 s for 120 s at the calibrated rate
 QUICK_OVERHEAD_S = {
     "configuration": 0.0, "modal": 5.7, "openloop": 2.9, "slew": 3.0, "frequency": 4.8,
     "comparison": 2.0, "animation": 1.8, "avionics": 4.5, "laws": 1.5, "pointing": 1.7,
+    "robust": 5.0,
 }  # fmt: skip
 """What each part of the quick study does besides flying its runs (figures, files,
 analyses) on the reference machine [s]: the quick study's 18.5 s there (warm,
 docs/performance.md) shared among the parts as their wall times were in one quick
 study on this 2-core machine, less their runs' simulated time; the pointing part
-(frequency domain only, no run) added since, measured alone."""
-FULL_OVERHEAD_FACTOR = {"modal": 3.0, "comparison": 13.0, "animation": 2.5, "avionics": 1.4}
+(frequency domain only, no run) added since, measured alone; the robustness part's
+mu analysis (8 log-spaced frequencies and the modal ones) and its 2,000 linear cases,
+measured alone on a loaded machine and scaled by its calibration slew (3.4 to 7 s)."""
+FULL_OVERHEAD_FACTOR = {
+    "modal": 3.0, "comparison": 13.0, "animation": 2.5, "avionics": 1.4, "robust": 5.0,
+}  # fmt: skip
 """The full study's overhead against the quick one's, per part [-]: three times the
 mode GIFs (6 against 2), each compared law's 13 figures (against the one comparison
-figure), 150 animation frames against 60, the longer delay sweep."""
+figure), 150 animation frames against 60, the longer delay sweep, the mu grid of 60
+log-spaced frequencies at 200 iterations each against 8 at 100 (72 against 20 with the
+modal ones)."""
 
 
 @dataclass(frozen=True)
@@ -208,6 +215,13 @@ def part_work(name: str, ctx, side_by_side: int = 2) -> PartWork:
         runs = 2 + delays + around + 1 + 2  # ideal and avionics, the sweep, the arrays x2
         return PartWork(runs, runs * slew_s, side_by_side, overhead,
                         f"about {runs} slews of {slew_s:g} s")  # fmt: skip
+    if name == "robust":
+        from flexsat.study import mu
+
+        points = mu.QUICK_POINTS if quick else mu.STUDY_POINTS
+        return PartWork(2, 2 * mu.FLIGHT_S, 1, overhead,
+                        f"mu on {points} frequencies and the modal ones, {2 * mu.SAMPLES} "
+                        f"linear cases, 2 runs of {mu.FLIGHT_S:g} s")  # fmt: skip
     if name in ("campaigns", "laws"):
         cases = _cases(ctx)
         every = sum(c for c, _ in cases.values())

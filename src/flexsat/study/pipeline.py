@@ -1,8 +1,8 @@
 """The thesis study end to end: every part timed, each allowed to fail.
 
 :func:`run_study` runs the parts of :data:`PARTS` (configuration, modal analysis,
-open-loop validation, the ASMC slew, the frequency-domain analysis, the wheels'
-microvibration jitter, the controller
+open-loop validation, the ASMC slew, the frequency-domain analysis, the robust
+stability (mu) of its law, the wheels' microvibration jitter, the controller
 comparison, the slew animation, the avionics, unless ``quick`` the three thesis
 campaigns, and the law comparison), after compiling every kernel they need up front
 (its time is ``compilation_s`` in the manifest; the parts' wall times exclude it),
@@ -294,6 +294,35 @@ def _campaigns_fly(ctx: StudyContext) -> str | None:
     return ctx.results[key]
 
 
+def _robust(ctx: StudyContext) -> dict:
+    from flexsat.simulate import SlewScenario
+    from flexsat.study.mu import robust_study
+
+    out = ctx.out / "robust"
+    robust = robust_study(ctx.config, SlewScenario(), out, quick=ctx.quick)
+    flown = [out / case["result"] for case in robust["cases"].values()]
+    mu_json, robust_json, figure = _relative(ctx, [out / "mu.json", out / "robust.json",
+                                                   out / "mu.png"])  # fmt: skip
+    return {"mu": mu_json, "json": robust_json, "results": _relative(ctx, flown),
+            "figures": [figure]}  # fmt: skip
+
+
+def _uncertain_model_builds(ctx: StudyContext) -> str | None:
+    """Why the satellite has no uncertain model (an appendage that is not a plate on a
+    fixed SADM angle), or None."""
+    from flexsat.errors import ConfigError
+    from flexsat.linear.uncertain import uncertain_model
+
+    key = "uncertain model"  # not a part's name: the answer, kept
+    if key not in ctx.results:
+        ctx.results[key] = None
+        try:
+            uncertain_model(ctx.config)
+        except ConfigError as exc:
+            ctx.results[key] = f"not applicable: {exc}"
+    return ctx.results[key]
+
+
 def _avionics(ctx: StudyContext) -> dict:
     from flexsat.study.avionics import avionics_study
 
@@ -308,6 +337,12 @@ PARTS = (
     Part("openloop", "Open-loop validation", _openloop, lane=1),
     Part("slew", f"Nominal slew with {LAWS.get(LAWS.default).label}", _slew, lane=1),
     Part("frequency", "Frequency domain: plant, loop gain and margins", _frequency, lane=1),
+    Part(
+        "robust",
+        "Robust stability: μ over the thesis's parameter box",
+        _robust,
+        applies=_uncertain_model_builds,
+    ),
     Part("pointing", "Pointing budget: wheel microvibration", _pointing),
     Part("comparison", "Controller comparison", _comparison, needs=("slew",), lane=1),
     Part("animation", "Slew animation", _animation, needs=("slew",), lane=1),
@@ -441,7 +476,7 @@ def _compile_runs(ctx: StudyContext) -> list[tuple[dict | str | None, frozenset[
     from flexsat.study.laws import HYBRID_DAMPING
 
     laws = [{"controller": {"kind": kind}} for kind in ctx.laws]
-    every_law = frozenset({"slew", "comparison", "laws"})
+    every_law = frozenset({"slew", "comparison", "laws", "robust"})
     avionics = frozenset({"avionics"})
     return [(laws[0], every_law), ("stages", frozenset()), ("drive plant", frozenset()),
             ("open loop", frozenset({"openloop"})),

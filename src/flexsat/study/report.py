@@ -14,7 +14,8 @@ shown there and written into ``study.json`` (``report_failed``: the report faile
 Sections follow the thesis: the configuration (section 3.1), the model's M(0) and
 rigid inertia (appendix B), the coupled modes (table 3.3), the open-loop validation
 (section 3.3), the ASMC slew and its requirements (section 5.1), the frequency-domain
-analysis of its law (loop margins with the flexible modes), the controller
+analysis of its law (loop margins with the flexible modes), its robust stability
+(mu over the thesis's parameter box, the worst case flown), the controller
 comparison, and the campaigns (chapter 5). :data:`SECTIONS` lists them; a new section
 is one drawing function and one entry there (docs/results.md, 'The study report').
 
@@ -475,6 +476,78 @@ def _frequency(root: Path, outputs: dict, context: dict) -> str:
     ])  # fmt: skip
 
 
+def _robust(root: Path, outputs: dict, context: dict) -> str:
+    mu, rob = _Source(root, outputs["mu"]), _Source(root, outputs["json"])
+    law = _esc(str(rob.get("law")).upper())
+    bounds = [
+        ["peak of the upper bound [-]", mu.cell("peak_upper")],
+        ["frequency of the peak [Hz]", mu.cell("peak_frequency_hz")],
+        ["lower bound [-]", mu.cell("lower")],
+        ["frequency of the lower bound [Hz]", mu.cell("lower_frequency_hz")],
+        ["upper bound at the lower bound's frequency [-]", rob.cell("upper_at_lower_frequency")],
+        ["k_max certified, 1 / peak of the upper bound [-]", mu.cell("k_max_lower")],
+        ["k_max at most, 1 / lower bound [-]", mu.cell("k_max_upper")],
+        ["loop stable at the box's centre", mu.cell("nominal_stable")],
+    ]
+    worst = [
+        [p["name"], mu.cell("parameters", i, "low"), mu.cell("parameters", i, "high"),
+         mu.cell("worst_delta", i), mu.cell("worst_factors", p["name"])]
+        for i, p in enumerate(mu.get("parameters"))
+    ]  # fmt: skip
+    resolution = rob.get("decay_resolution_1_s")
+    sampling = [
+        ["cases drawn in the certified box (k_max × the box)", rob.cell("samples")],
+        ["unstable in the certified box", rob.cell("certified_unstable")],
+        ["largest real part in the certified box [1/s]", rob.cell("certified_max_real_1_s")],
+        ["cases drawn in the full box", rob.cell("samples")],
+        ["unstable in the full box", rob.cell("box_unstable")],
+        ["largest real part in the full box [1/s]", rob.cell("box_max_real_1_s")],
+        ["the μ worst case's largest real part [1/s]",
+         rob.cell("cases", "mu_worst", "max_real_1_s")],
+        [f"the μ worst case flown decays no faster than the sampled one (within "
+         f"{format_value(resolution)} 1/s)", rob.cell("mu_worst_decays_slowest")],
+    ]  # fmt: skip
+    names = [p["name"] for p in mu.get("parameters")]
+    labels = {"mu_worst": "μ worst case", "sampled_worst": "sampled worst case"}
+    flown = [
+        [labels.get(case, case), *(rob.cell("cases", case, "factors", n) for n in names),
+         rob.cell("cases", case, "max_real_1_s"), rob.cell("cases", case, "decay_rate_1_s")]
+        for case in rob.get("cases")
+    ]  # fmt: skip
+    rho = ", ".join(format_value(r) for r in rob.get("started_rho_deg"))
+    return "".join([
+        f"<p>The nominal slew's law ({law}) linearized about rest (the sliding-mode laws "
+        "inside their boundary layer) closed around the satellite's uncertain model, an "
+        "upper LFT in the thesis's parameters (rotation-joint target frequencies ±20 %, "
+        "damping ratio from 0 to the nominal, hub and panel inertias ±20 %; each a "
+        "normalized δ in [−1, 1], the box's centre at δ = 0), at the configuration's "
+        "SADM angle (docs/linear.md, 'Robust stability: mu'). The loop is stable for "
+        "every parameter point within k × the box for every k below the certified "
+        "k_max = 1 / peak of μ's upper bound; the lower bound is a destabilizing point "
+        "found on the box's boundary, the worst-case parameter combination.</p>",
+        _table(["quantity", "value"], bounds, f"μ bounds and k_max of the {law} loop"),
+        _table(["parameter", "factor at δ = −1", "factor at δ = +1", "worst δ",
+                "worst factor"], worst,
+               "Worst-case parameter combination (the destabilizing point)"),
+        f"<p>The sampling check, in the linear model (seed {_esc(rob.get('seed'))}): "
+        "parameter points drawn uniformly in the certified box must all be stable, and "
+        "no point of the full box may have a closed-loop pole further right than the μ "
+        "worst case. Then the μ worst case and the sampled worst case (the drawn point "
+        "with the rightmost pole) are flown in the nonlinear simulator: the law holding "
+        f"rest, no disturbance torque, {_esc(rob.get('started_panel'))} started "
+        f"{_esc(rho)} deg off about its root axes, {format_value(rob.get('flight_s'))} s; "
+        "each compared by the slowest decay of the panels' vibration, from the elastic "
+        "energy's envelope (its maximum over 10–20 s and over the last 10 s), which "
+        "resolves decay rates to about "
+        f"{format_value(resolution)} 1/s.</p>",
+        _table(["check", "value"], sampling, "Sampling check in the linear model"),
+        _table(["case", *(f"{n} factor" for n in names), "largest real part, linear [1/s]",
+                "vibration decay rate, nonlinear [1/s]"], flown,
+               "Worst cases flown in the nonlinear simulator"),
+        _figures(root, outputs["figures"]),
+    ])  # fmt: skip
+
+
 def _pointing(root: Path, outputs: dict, context: dict) -> str:
     src = _Source(root, outputs["json"])
     names, window = src.get("outputs"), src.get("window_s")
@@ -676,6 +749,7 @@ SECTIONS: list[Section] = [
     Section("openloop", _openloop, caveat=_THESIS_CAVEAT),
     Section("slew", _slew, caveat=_THESIS_CAVEAT),
     Section("frequency", _frequency),
+    Section("robust", _robust),
     Section("pointing", _pointing),
     Section("comparison", _comparison),
     Section("animation", _animation),
