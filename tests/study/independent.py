@@ -780,3 +780,88 @@ def loop_margins(plant: control.StateSpace, K: np.ndarray, axis: int) -> dict:
         ],
         "loop": L,
     }
+
+
+# -- robust stability: the thesis's parameter box, transcribed a second time ---------------
+
+THESIS_BOX = {  # factor on the nominal value at delta = -1 and +1 (thesis section 5.2.2)
+    "frequency": (0.8, 1.2),  # the rotation joints' target frequencies +-20 %
+    "damping": (0.0, 1.0),  # the damping ratio from 0 to the nominal
+    "hub_inertia": (0.8, 1.2),
+    "panel_inertia": (0.8, 1.2),  # the panel mass, so its inertia
+}
+_ROTATION_TARGETS = ("flapping", "in_plane", "torsion")
+
+
+def perturbed(config: dict, factors: dict) -> dict:
+    """The satellite with each factor applied to its nominal value: the rotation joints'
+    target frequencies, the damping ratio, the hub's inertia tensor, the plates' mass."""
+    out = json.loads(json.dumps(config))
+    hub = out["hub"]
+    J = (np.asarray(hub["inertia_kg_m2"]) if hub.get("inertia_kg_m2") is not None
+         else cylinder_inertia(hub["mass_kg"], hub["radius_m"], hub["height_m"]))  # fmt: skip
+    hub["inertia_kg_m2"] = (factors.get("hub_inertia", 1.0) * J).tolist()
+    for app in out["appendages"]:
+        for axis in _ROTATION_TARGETS:
+            app["target_frequencies_hz"][axis] *= factors.get("frequency", 1.0)
+        app["damping_ratio"] *= factors.get("damping", 1.0)
+        key = "mass_kg" if app.get("mass_kg") is not None else "surface_density_kg_m2"
+        app[key] *= factors.get("panel_inertia", 1.0)
+    return out
+
+
+def box_factors(config: dict, nominal: dict) -> dict:
+    """The factors that make ``config`` from ``nominal`` (one per parameter; asserted
+    the same on every plate and rotation joint)."""
+
+    def hub_J(c):
+        h = c["hub"]
+        return (np.asarray(h["inertia_kg_m2"]) if h.get("inertia_kg_m2") is not None
+                else cylinder_inertia(h["mass_kg"], h["radius_m"], h["height_m"]))  # fmt: skip
+
+    found = {name: [] for name in THESIS_BOX}
+    for app, ref in zip(config["appendages"], nominal["appendages"], strict=True):
+        for axis in _ROTATION_TARGETS:
+            found["frequency"].append(app["target_frequencies_hz"][axis]
+                                      / ref["target_frequencies_hz"][axis])  # fmt: skip
+        found["damping"].append(app["damping_ratio"] / ref["damping_ratio"])
+        found["panel_inertia"].append(plate(app)["mass"] / plate(ref)["mass"])
+    Jc, Jn = hub_J(config), hub_J(nominal)
+    found["hub_inertia"] = list(np.diag(Jc) / np.diag(Jn))
+    out = {}
+    for name, values in found.items():
+        assert np.ptp(values) <= 1e-12 * max(1.0, abs(values[0])), (name, values)
+        out[name] = float(values[0])
+    return out
+
+
+def box_delta(factors: dict) -> np.ndarray:
+    """Normalized delta of each parameter, in :data:`THESIS_BOX`'s order."""
+    return np.array([(factors[n] - 0.5 * (lo + hi)) / (0.5 * (hi - lo))
+                     for n, (lo, hi) in THESIS_BOX.items()])  # fmt: skip
+
+
+def box_point(delta) -> dict:
+    """The factors at a normalized delta (in :data:`THESIS_BOX`'s order)."""
+    return {n: 0.5 * (lo + hi) + 0.5 * (hi - lo) * d
+            for (n, (lo, hi)), d in zip(THESIS_BOX.items(), delta, strict=True)}  # fmt: skip
+
+
+def closed_loop_poles(config: dict, K: np.ndarray) -> np.ndarray:
+    """Poles of the satellite about rest closed by tau = -K (attitude, rate), the hub's
+    translation states left out: no force depends on them about rest (their columns of
+    A are zero), so they only add six poles at 0."""
+    plant = state_space(config)
+    A_cl = plant.A - plant.B @ K @ plant.C
+    n = A_cl.shape[0] // 2
+    keep = np.setdiff1d(np.arange(2 * n), [0, 1, 2, n, n + 1, n + 2])
+    return np.linalg.eigvals(A_cl[np.ix_(keep, keep)])
+
+
+def envelope_decay_rate(t: np.ndarray, energy: np.ndarray) -> float:
+    """Slowest vibration decay [1/s] from the elastic energy's envelope (docs/linear.md,
+    'In the study report'): its maxima over 10-20 s and over the last 10 s, E ~ exp(2
+    Re(lambda) t) between the windows' centres."""
+    early = energy[(t >= 10.0) & (t < 20.0)].max()
+    late = energy[t >= t[-1] - 10.0].max()
+    return float(np.log(late / early) / (2.0 * ((t[-1] - 5.0) - 15.0)))
