@@ -115,11 +115,15 @@ def test_flexible_step_gain_against_the_compiled_accelerations(nominal_plant, ax
 
 
 def test_nominal_flexible_term_is_the_effective_inertia_ratio(nominal_plant):
-    # About x the hub-fixed modes carry 147.3 of J_t = 189.99 kg m^2, the bare hub
-    # 41.6: the hub alone first takes the step, G_xx = J_t / J_res - 1 = 3.56.
+    # About x the hub-fixed modes carry 148.4 of J_t = 189.99 kg m^2, the bare hub
+    # 41.6: the hub alone first takes the step, G_aa = J_t,a / J_hub,a - 1 (3.56 about x).
+    # With 6-DOF joints the Schur complement is the bare hub (docs/control.md): equal to
+    # round-off of the solves (1.4e-15 measured); 1e-12 leaves room for other BLAS.
     G = flexible_step_gain(nominal_plant)
     J_t = rigid_inertia(nominal_plant)
-    assert G[0, 0] == pytest.approx(J_t[0, 0] / nominal_plant.hub_J[0, 0] - 1.0, rel=1e-6)
+    np.testing.assert_allclose(np.diag(G), np.diag(J_t) / np.diag(nominal_plant.hub_J) - 1.0,
+                               rtol=1e-12)  # fmt: skip
+    assert G[0, 0] == pytest.approx(3.564, abs=1e-3)
 
 
 def test_refusals():
