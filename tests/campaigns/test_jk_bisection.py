@@ -112,3 +112,26 @@ def test_refusals(three, tmp_path):
     flown = with_jk_min(three, 0.3)
     assert flown.base["controller"] == {"kind": "asmc", "jk_min_nm": 0.3}
     assert flown.grid == three.grid and flown.reduced == three.reduced
+
+
+def test_a_kind_registered_outside_flexsat_keeps_its_cases(tmp_path):
+    # The copy keeps the table of a kind registered by a user's module (other_kinds,
+    # which a dump of the definition leaves out): the same cases, another gain.
+    from flexsat.campaigns import load_campaign
+    from flexsat.campaigns.definition import CaseStream
+    from flexsat.campaigns.kinds import KINDS, register_kind
+    from tests.campaigns import corners_kind
+
+    register_kind(corners_kind.CORNERS)
+    try:
+        path = tmp_path / "corners.toml"
+        path.write_text('name = "corners-jk"\ninclude_nominal = false\n[corners]\nparameters = '
+                        '[{path = "hub.mass_kg", bounds = [120.0, 180.0]}]\n')  # fmt: skip
+        definition = load_campaign(path)
+        flown = with_jk_min(definition, 0.3)
+        assert flown.tables() == definition.tables() and list(flown.tables()) == ["corners"]
+        cases = list(CaseStream(flown, nominal()))
+        assert len(cases) == 2
+        assert {c.scenario["controller"]["jk_min_nm"] for c in cases} == {0.3}
+    finally:
+        KINDS.unregister("corners")

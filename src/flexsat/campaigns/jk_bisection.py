@@ -117,8 +117,10 @@ def with_jk_min(definition: CampaignDefinition, jk_min_nm: float) -> CampaignDef
         kind = controller["kind"]
         raise ConfigError(f"base.controller.kind: the bisection flies the ASMC, got {kind!r}")
     controller.update(kind="asmc", jk_min_nm=float(jk_min_nm))
-    base = {**definition.base, "controller": controller}
-    return CampaignDefinition.model_validate({**definition.model_dump(), "base": base})
+    # A copy, not a re-validation of a dump: the tables of kinds registered outside
+    # flexsat (``other_kinds``) are not in the dump. The base is validated as every
+    # campaign's is, when its cases are resolved.
+    return definition.model_copy(update={"base": {**definition.base, "controller": controller}})
 
 
 def bisect_jk_min(
