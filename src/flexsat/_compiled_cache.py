@@ -6,8 +6,11 @@ loops (``integrators.py``, ``loops.py``) inline the kernels of ``kernels.py`` an
 still run the old physics. numba has no hook for such dependencies, so flexsat
 keeps a digest of every compiled module's source next to the caches and, when it
 changes, removes the cached machine code of all of them (rebuilt on the next run,
-about 15 s). Called once, at ``import flexsat``; it costs a hash of a few hundred
-kilobytes.
+about 15 s). Called once, at ``import flexsat``. While no source file of the package
+has changed since the last check (same names, sizes and modification times: a
+``stat`` of each, no read), it reads and hashes nothing; otherwise it finds the
+compiled modules and hashes them, a few hundred kilobytes (docs/performance.md,
+'Start-up').
 """
 
 from __future__ import annotations
@@ -18,15 +21,15 @@ import re
 import warnings
 from pathlib import Path
 
-from numba.core.errors import NumbaExperimentalFeatureWarning
-
 __all__ = ["COMPILED_MODULES", "compiled_modules", "drop_stale_caches", "kernels_cached"]
 
 # Pluggable compiled pieces (laws, loop stages, appendage kernels) reach the loops as
 # numba first-class functions, which numba flags as experimental on every use; the
 # feature is relied on deliberately (typed by signature, cached), so that one warning
-# is silenced here.
-warnings.filterwarnings("ignore", category=NumbaExperimentalFeatureWarning)
+# is silenced here. By its text, not its class (numba's NumbaExperimentalFeatureWarning):
+# naming the class would import numba (0.2 s) into every process that imports flexsat,
+# ``flexsat --help`` included.
+warnings.filterwarnings("ignore", message="First-class function type feature is experimental")
 
 # A module is part of the compiled code if it compiles functions, builds numba types,
 # or holds constants that numba freezes into compiled code (marked by the comment
@@ -49,10 +52,33 @@ def compiled_modules(package: Path | None = None) -> tuple[str, ...]:
     ))  # fmt: skip
 
 
-COMPILED_MODULES = compiled_modules()
+COMPILED_MODULES: tuple[str, ...]  # assigned by __getattr__ on first use
 """The package's compiled modules (:func:`compiled_modules`)."""
 
+
+def __getattr__(name: str):
+    """``COMPILED_MODULES``: the package's compiled modules (:func:`compiled_modules`),
+    found on first use (PEP 562): finding them reads every source file."""
+    if name == "COMPILED_MODULES":
+        value = globals()["COMPILED_MODULES"] = compiled_modules()
+        return value
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
 _STAMP = "compiled_sources.sha256"
+
+
+def _fingerprint(package: Path) -> str:
+    """A digest of every source file's name, size and modification time (no read)."""
+    entries = []
+    for folder, dirs, files in os.walk(package):
+        dirs[:] = [d for d in dirs if d != "__pycache__"]
+        for name in files:
+            if name.endswith(".py"):
+                path = os.path.join(folder, name)
+                info = os.stat(path)
+                entries.append(f"{path}\0{info.st_size}\0{info.st_mtime_ns}\n")
+    return hashlib.sha256("".join(sorted(entries)).encode()).hexdigest()
 
 
 def _cache_dirs(package: Path, module: str) -> list[Path]:
@@ -79,29 +105,46 @@ def drop_stale_caches(package: Path | None = None) -> bool:
         True if caches were removed. A read-only installation is left alone (numba
         then caches elsewhere, keyed by the installed files, which do not change).
     """
-    modules = COMPILED_MODULES if package is None else compiled_modules(package)
+    default = package is None
     package = package or Path(__file__).parent
+    stamp = package / "__pycache__" / _STAMP
+    fingerprint = _fingerprint(package)
+    try:
+        known = stamp.read_text().split()
+    except OSError:
+        known = []
+    if len(known) == 2 and known[1] == fingerprint:
+        return False  # no source file changed since the digest was written
+    if default:
+        modules = globals().get("COMPILED_MODULES") or __getattr__("COMPILED_MODULES")
+    else:
+        modules = compiled_modules(package)
     digest = hashlib.sha256()
     for module in modules:
         digest.update(module.encode())
         digest.update((package / module).read_bytes())
     current = digest.hexdigest()
-    stamp = package / "__pycache__" / _STAMP
     try:
-        if stamp.exists() and stamp.read_text() == current:
+        if known[:1] == [current]:  # files touched, compiled sources unchanged
+            _write_stamp(stamp, current, fingerprint)
             return False
         for module in modules:
             stem = Path(module).stem
             for folder in _cache_dirs(package, module):
                 for cached in folder.glob(f"{stem}.*.nb[ic]"):
                     cached.unlink(missing_ok=True)
-        stamp.parent.mkdir(exist_ok=True)
-        partial = stamp.with_suffix(f".{os.getpid()}.partial")
-        partial.write_text(current)
-        partial.replace(stamp)
+        _write_stamp(stamp, current, fingerprint)
     except OSError:
         return False
     return True
+
+
+def _write_stamp(stamp: Path, digest: str, fingerprint: str) -> None:
+    """Write the compiled sources' digest and the files' fingerprint, atomically."""
+    stamp.parent.mkdir(exist_ok=True)
+    partial = stamp.with_suffix(f".{os.getpid()}.partial")
+    partial.write_text(f"{digest}\n{fingerprint}\n")
+    partial.replace(stamp)
 
 
 def kernels_cached() -> bool:

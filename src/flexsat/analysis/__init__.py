@@ -1,29 +1,19 @@
 """Analysis of plants and results: modes, open-loop metrics, spectra, requirement verdicts.
 
-The open-loop metrics and the spectra (:mod:`scipy.signal`, about 0.8 s to import) are
-imported on first use: the closed-loop stages import this package for its modal
-analysis, and a study's runs and figures other than the open loop's never need them.
+Every name is imported on first use (PEP 562): the modal analysis (:mod:`scipy.linalg`),
+the open-loop metrics (xarray) and the spectrogram (:mod:`scipy.signal`) each load
+only when asked for. A closed-loop stage that needs the modal
+analysis, or ``flexsat openloop`` its metrics, does not pay for the others
+(docs/performance.md, 'Start-up').
 """
 
 import importlib
 
-from flexsat.analysis.modal import (
-    ModalAnalysis,
-    Mode,
-    dof_names,
-    modal_analysis,
-)
-from flexsat.analysis.requirements import (
-    Requirements,
-    absolute_performance_error,
-    error_rotation_vector,
-    observation_window,
-    relative_performance_error,
-    settling_time,
-    slew_metrics,
-)
-
 _LAZY = {
+    **dict.fromkeys(("ModalAnalysis", "Mode", "dof_names", "modal_analysis"), "modal"),
+    **dict.fromkeys(("Requirements", "absolute_performance_error", "error_rotation_vector",
+                     "observation_window", "relative_performance_error", "settling_time",
+                     "slew_metrics"), "requirements"),
     "openloop_metrics": "openloop",
     "dominant_frequency": "spectral",
     **dict.fromkeys(("DEFAULT_OVERLAP", "DEFAULT_WINDOW_S", "HUB_ROTATION_DOF",
@@ -53,7 +43,7 @@ __all__ = [
 
 
 def __getattr__(name: str):
-    """The open-loop and spectral names, imported on first use (PEP 562)."""
+    """The analysis names, imported on first use (PEP 562)."""
     if name in _LAZY:
         value = getattr(importlib.import_module(f"{__name__}.{_LAZY[name]}"), name)
         globals()[name] = value

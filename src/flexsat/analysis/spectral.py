@@ -1,4 +1,10 @@
-"""Spectral analysis of recorded signals (scipy.signal)."""
+"""Spectral analysis of recorded signals: the strongest line of a periodogram.
+
+Written with NumPy's FFT rather than :mod:`scipy.signal`, the slowest import of
+``flexsat openloop``, which reports this line (docs/performance.md, 'Start-up'). The periodogram is
+scipy's ``periodogram(detrend(x), fs, window="hann")`` written out; the tests hold the
+two together to round-off.
+"""
 
 from __future__ import annotations
 
@@ -23,12 +29,8 @@ def dominant_frequency(values: np.ndarray, dt: float, min_hz: float = 0.0) -> fl
     min_hz : float
         Ignore lines below this frequency (drift) [Hz].
     """
-    # imported here: scipy.signal costs 0.6 s to import, and every campaign worker
-    # reaches this module through the slew metrics without calling it
-    from scipy import signal
-
-    values = signal.detrend(np.asarray(values, dtype=float))
-    freqs, power = signal.periodogram(values, fs=1.0 / dt, window="hann")
+    values = _detrend_linear(np.asarray(values, dtype=float))
+    freqs, power = _periodogram_hann(values, 1.0 / dt)
     power[freqs < max(min_hz, freqs[1])] = 0.0
     k = int(np.argmax(power))
     if 0 < k < power.size - 1 and np.all(power[k - 1 : k + 2] > 0):
@@ -36,3 +38,28 @@ def dominant_frequency(values: np.ndarray, dt: float, min_hz: float = 0.0) -> fl
         offset = 0.5 * (a - c) / (a - 2 * b + c)
         return float(freqs[k] + offset * (freqs[1] - freqs[0]))
     return float(freqs[k])
+
+
+def _detrend_linear(values: np.ndarray) -> np.ndarray:
+    """The signal minus its least-squares straight line (``scipy.signal.detrend``)."""
+    n = values.size
+    basis = np.ones((n, 2))
+    basis[:, 0] = np.arange(1, n + 1) / n  # scaled as scipy scales it
+    coefficients, *_ = np.linalg.lstsq(basis, values, rcond=None)
+    return values - basis @ coefficients
+
+
+def _periodogram_hann(values: np.ndarray, fs: float) -> tuple[np.ndarray, np.ndarray]:
+    """One-sided power spectral density, periodic Hann window, mean removed [u²/Hz].
+
+    As ``scipy.signal.periodogram(values, fs, window="hann")``: the window is the
+    periodic ("DFT-even") Hann window of ``scipy.signal.get_window``, the density is
+    ‖X_k‖² / (fs Σ w²), doubled on every bin but the zero and (even length) Nyquist
+    ones.
+    """
+    n = values.size
+    window = 0.5 - 0.5 * np.cos(2.0 * np.pi * np.arange(n) / n)
+    spectrum = np.fft.rfft((values - values.mean()) * window)
+    power = (spectrum.real**2 + spectrum.imag**2) / (fs * np.sum(window**2))
+    power[1 : None if n % 2 else -1] *= 2.0
+    return np.fft.rfftfreq(n, 1.0 / fs), power

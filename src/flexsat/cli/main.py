@@ -22,7 +22,6 @@ import typer
 from rich.console import Console
 from rich.markup import escape
 
-from flexsat import __version__
 from flexsat._compiled_cache import kernels_cached
 from flexsat.cli.tables import format_number, print_table
 from flexsat.errors import MAX_MESSAGE_CHARS, FlexsatError, shorten
@@ -94,6 +93,8 @@ class CampaignRunner(StrEnum):
 
 def _version(value: bool) -> None:
     if value:
+        from flexsat import __version__  # the distribution's metadata, read when asked for
+
         typer.echo(f"flexsat {__version__}")
         raise typer.Exit()
 

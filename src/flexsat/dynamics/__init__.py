@@ -2,10 +2,31 @@
 
 The compiled kernels (:mod:`flexsat.dynamics.kernels`, :mod:`flexsat.dynamics.integrators`)
 and the SymPy reference derivation (:mod:`flexsat.dynamics.symbolic`) are imported from
-their modules; the user-level names are here.
+their modules; the user-level names are here, imported on first use (PEP 562): a module
+that imports one kernel module does not load the plant, its appendage models and
+SciPy's rotations with it (docs/performance.md, 'Start-up').
 """
 
-from flexsat.dynamics.plant import Plant
-from flexsat.dynamics.rigid import gyroscopic_torque, rigid_inertia
+import importlib
+
+_LAZY = {
+    "Plant": "plant",
+    "gyroscopic_torque": "rigid",
+    "rigid_inertia": "rigid",
+}
+"""The public names imported on first use, and the submodule each comes from."""
 
 __all__ = ["Plant", "gyroscopic_torque", "rigid_inertia"]
+
+
+def __getattr__(name: str):
+    """The plant and the rigid design model, imported on first use (PEP 562)."""
+    if name in _LAZY:
+        value = getattr(importlib.import_module(f"{__name__}.{_LAZY[name]}"), name)
+        globals()[name] = value
+        return value
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+def __dir__() -> list[str]:
+    return sorted({*globals(), *__all__})

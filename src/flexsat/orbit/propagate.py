@@ -10,7 +10,6 @@ from __future__ import annotations
 from math import atan2, cos, radians, sin, sqrt
 
 import numpy as np
-from scipy.integrate import solve_ivp
 
 from flexsat.errors import ConfigError
 from flexsat.orbit.config import EARTH_J2, EARTH_MU_M3_S2, OrbitConfig
@@ -137,6 +136,11 @@ def propagate_elements(orbit: OrbitConfig, times_s: np.ndarray) -> np.ndarray:
     ndarray, shape (n, 6)
         r [m], v [m/s], ECI.
     """
+    # imported here: scipy.integrate is slow to import, and every process that loads
+    # the loop stages (any slew, the scenario models) reaches this module without
+    # propagating an orbit (docs/performance.md, 'Start-up')
+    from scipy.integrate import solve_ivp
+
     j2 = EARTH_J2 if orbit.j2 else 0.0
 
     def rhs(t: float, y: np.ndarray) -> np.ndarray:
