@@ -44,3 +44,26 @@ def test_a_batch_gives_the_records_of_each_slew_alone(nominal_plant, threads):
         for name in ("q", "qd", "tau_cmd", "tau_applied", "pointing_error_deg"):
             np.testing.assert_array_equal(together[name].values, alone[name].values)
     assert flown[4, 0] != 0 and flown[0, 0] == 0  # the diverging case failed, alone
+
+
+def test_a_slews_type_by_structure_is_numbas_typeof(nominal_plant):
+    # item_type keys numba's type on what typeof reads (arrays' dtype, dimensions,
+    # layout, writeability; tuples; kernels' declared types): exactly typeof's type
+    # for slews of other laws, chains and appendages, and for an array made read-only
+    # or non-contiguous after the first slew of that structure was typed.
+    from numba import typeof
+
+    from flexsat.simulate.batch import batch_item, item_type
+
+    plants = [nominal_plant] * len(SCENARIOS) + [Plant.from_config(one_panel())]
+    scenarios = [SlewScenario.model_validate(s) for s in SCENARIOS] + [
+        SlewScenario.model_validate(SHORT)
+    ]
+    items = [batch_item(prepare_slew(Plant.from_config(p.config), s))
+             for p, s in zip(plants, scenarios, strict=True)]  # fmt: skip
+    readonly = items[0]._replace(x=items[0].x.copy())
+    readonly.x.flags.writeable = False
+    strided = items[0]._replace(rec_t=np.zeros(2 * items[0].rec_t.size)[::2])
+    for item in [*items, readonly, strided]:
+        assert item_type(item) == typeof(item)
+    assert item_type(readonly) != item_type(items[0]) != item_type(strided)

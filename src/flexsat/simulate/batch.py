@@ -7,6 +7,12 @@ progress bar gives the same records bit for bit. :func:`fly_batch` runs a batch 
 prepared slews of one structure (same law, stage chains and appendage groups: one
 numba type) across ``numba.prange`` threads, each writing only its own arrays.
 Both release the GIL.
+
+:func:`fly_prepared` types each slew by its structure (:func:`item_type`: the numba
+type of a :class:`BatchItem`, computed once per structure) and appends it to the
+batch's typed list through the compiled overload for that type, so that a case costs
+no dispatcher typing of its hundred-odd arrays and kernels (docs/performance.md,
+"Campaign cases").
 """
 
 from __future__ import annotations
@@ -27,6 +33,7 @@ __all__ = [
     "fly",
     "fly_batch",
     "fly_prepared",
+    "item_type",
     "slew_timing",
 ]
 
@@ -222,12 +229,74 @@ def fly_batch(items, out):
         out[i, 0], out[i, 1], out[i, 2] = status, done, rows
 
 
+_INT64 = (-(2**63), 2**63)  # numba types a Python int in this range as int64
+_ITEM_TYPES: dict = {}  # structure key -> numba type of a BatchItem (one per structure)
+
+
+def _structure_key(value) -> object:
+    """What numba's ``typeof`` reads of ``value``, as a hashable key (cheap).
+
+    An array: its dtype, dimensions, layout flags, writeability and alignment (what
+    ``typeof`` makes its ``Array`` type of); a tuple: its class and its items' keys; an
+    object that declares its numba type (``_numba_type_``, a
+    :class:`~flexsat.compiled.first_class.FirstClassKernel`): that type; a float, a bool,
+    an int within int64: its class. Anything else is typed by numba itself.
+    """
+    kind = type(value)
+    if kind is np.ndarray:
+        flags = value.flags
+        return (value.dtype, value.ndim, flags.c_contiguous, flags.f_contiguous,
+                flags.writeable, flags.aligned)  # fmt: skip
+    if isinstance(value, tuple):
+        return (kind, *(_structure_key(v) for v in value))
+    numba_type = getattr(value, "_numba_type_", None)
+    if numba_type is not None:
+        return numba_type
+    if kind is float or kind is bool or (kind is int and _INT64[0] <= value < _INT64[1]):
+        return kind
+    return typeof(value)
+
+
+def item_type(item: BatchItem):
+    """The numba type of a :class:`BatchItem`, typed once per structure.
+
+    The same type as ``numba.typeof(item)``: items whose arrays, tuples and kernels
+    agree in everything ``typeof`` reads (:func:`_structure_key`) share the type the
+    first of them was given. Walking the item's ~140 leaves costs a tenth of typing
+    them (``typeof`` goes through numba's typing of each array).
+
+    Parameters
+    ----------
+    item : BatchItem
+        A prepared slew.
+
+    Returns
+    -------
+    numba.types.Type
+    """
+    key = _structure_key(item)
+    found = _ITEM_TYPES.get(key)
+    if found is None:
+        found = _ITEM_TYPES[key] = typeof(item)
+    return found
+
+
+def _overload(dispatcher, *types):
+    """The compiled entry point of ``dispatcher`` for argument types ``types``
+    (compiled, or loaded from numba's cache, on first use): called without typing
+    its arguments again."""
+    if types not in dispatcher.overloads:
+        dispatcher.compile(types)
+    return dispatcher.overloads[types].entry_point
+
+
 def fly_prepared(runs: list, threads: int = 1) -> np.ndarray:
     """Fly prepared slews to their ends, those of one structure in one compiled call.
 
     Slews are grouped by the numba type of their :class:`BatchItem` (law, stage
-    chains, appendage groups): each group is one call of :func:`fly_batch` across
-    ``threads`` numba threads (set for the calling thread only).
+    chains, appendage groups; :func:`item_type`): each group is one call of
+    :func:`fly_batch` across ``threads`` numba threads (set for the calling thread
+    only).
 
     Parameters
     ----------
@@ -244,13 +313,15 @@ def fly_prepared(runs: list, threads: int = 1) -> np.ndarray:
     groups: dict = {}
     for index, run in enumerate(runs):
         item = batch_item(run)
-        groups.setdefault(typeof(item), []).append((index, item))
+        groups.setdefault(item_type(item), []).append((index, item))
     out = np.zeros((len(runs), 3), dtype=np.int64)
     set_num_threads(max(1, min(threads, config.NUMBA_NUM_THREADS)))
-    for members in groups.values():
-        items = typed_list(members[0][1])
+    for kind, members in groups.items():
+        # the compiled list and append for this item type, called without typing
+        items = _overload(typed_list, kind)(members[0][1])
+        append = _overload(typed_append, typeof(items), kind)
         for _, item in members[1:]:
-            typed_append(items, item)
+            append(items, item)
         flown = np.zeros((len(members), 3), dtype=np.int64)
         fly_batch(items, flown)
         out[[index for index, _ in members]] = flown
