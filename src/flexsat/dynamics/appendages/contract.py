@@ -253,6 +253,11 @@ class AppendageModel(ABC):
         each locked row of ``qdd`` its constraint force lambda, which the engine
         moves to the plant's constraint forces and replaces by 0. False (default):
         the engine projects the kernels' unconstrained answer with M(q).
+    holds_drive : bool
+        True when the model's own coordinates and kernels hold a solar-array drive (its
+        config's ``drive`` key; the modal model): the plant builds it as it is, without
+        :meth:`on_drive`. False (default): a driven appendage is rewritten by
+        :meth:`on_drive`.
     work_size : int
         Columns of the scratch rows ``work`` that pass 1 may leave for pass 2 (see
         :meth:`work_columns` for a scratch that grows with the appendage).
@@ -267,6 +272,7 @@ class AppendageModel(ABC):
     kernels: ClassVar[AppendageKernels]
     transmits_inertia: ClassVar[bool] = False
     holds_locked: ClassVar[bool] = False
+    holds_drive: ClassVar[bool] = False
     modifiers: ClassVar[dict[str, DerivedPath]] = {}
     work_size: ClassVar[int] = 0
 

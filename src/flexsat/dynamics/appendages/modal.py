@@ -29,10 +29,20 @@ eta_ddot leaves the residual mass M_rr(c~) - L^T L at the interface: the articul
 inertia this model transmits to the hub. The hub receives -F_a and, about its centre
 of mass, -(N_a + r_m x F_a) at the plant's accelerations: tau_flex, the whole interface
 load (:func:`joint_wrench`). Every sum is over the modes once: cost is linear in n.
+
+On a solar-array drive (the config's ``drive`` and ``drive_axis``) the interface frame
+turns about the axis u through I by the drive angle alpha, coordinate 0 (named
+``drive_angle``): the body's equations above hold in that floating frame F with omega
+replaced by Omega = omega + alpha_dot u, the rotor (mass on the axis at I, inertia J_r)
+is part of its rigid body, and the drive equation u . N_a = tau (tau the generalized
+force on alpha, the ``sadm_drive`` motor) is eliminated as one more articulated-body
+step; the hub receives the whole wrench, the motor's reaction included (docs/model.md,
+'Modal appendage on a drive', eqs. D.1-D.8).
 """
 
 from __future__ import annotations
 
+from math import cos, sin
 from pathlib import Path
 from typing import Annotated, Any, ClassVar, Literal
 
@@ -70,7 +80,7 @@ from flexsat.compiled.linalg3 import (
 )
 from flexsat.compiled.status import STATUS_OK
 from flexsat.config.modal_data import ModalData, load_modal_data
-from flexsat.config.models import Angle, Matrix3, Name, Point3
+from flexsat.config.models import Angle, DriveConfig, Matrix3, Name, Point3
 from flexsat.dynamics.appendages.contract import (
     HUB_ACC,
     HUB_ALPHA,
@@ -92,7 +102,7 @@ from flexsat.dynamics.appendages.contract import (
     RigidBody,
 )
 
-__all__ = ["ModalAppendageConfig", "ModalModel"]
+__all__ = ["DRIVE_COORDINATE", "ModalAppendageConfig", "ModalModel"]
 
 # Packed parameter row of one modal appendage (everything in hub frame B unless noted).
 P_MOUNT = 0  # (3) r_m, interface point from the hub centre of mass [m]
@@ -104,7 +114,14 @@ P_RES = 25  # (36) M_rr - L^T L at eta = 0, about the interface, row-major 6 x 6
 P_N = 61  # (1) number of modes n
 P_DAMP_AT = 62  # (1) offset of the n x n modal damping matrix [1/s]; 0: diagonal (MODE_C)
 P_SECOND_AT = 63  # (1) offset of the (SO_SIZE n) x n matrix A (large motion); 0: none
-P_MODES = 64  # n blocks of MODE_SIZE
+# On a solar-array drive (docs/model.md, 'Modal appendage on a drive'): coordinate 0 is
+# the drive angle alpha, the modes follow; every slot above is then in the floating
+# frame F (the data's frame M turned by alpha about the axis), the rotor included in
+# P_MASS, P_J_I and P_RES, and P_R_BM is R_BM0, the mount at alpha = 0.
+P_DRIVE = 64  # (1) 1: on a drive, 0: rigidly mounted
+P_AXIS = 65  # (3) drive axis u, a unit vector, frame F (= frame M) [-]
+P_ALPHA0 = 68  # (1) the drive's initial angle alpha(0) [rad]
+P_MODES = 69  # n blocks of MODE_SIZE
 MODE_K = 0  # omega_k^2 [1/s^2]
 MODE_C = 1  # 2 zeta_k omega_k [1/s]
 MODE_LT = 2  # (3) l_t,k [sqrt(kg)]
@@ -123,6 +140,15 @@ SO_SIZE = 18
 SO_RATE = 9  # rows r < SO_RATE of A are also multiplied by eta_dot
 WORK_MODE = 7  # per mode in pass 1's scratch: L_t,k(eta) (3), h_k(eta) (3), its force (1)
 # after those n WORK_MODE columns: A eta (SO_SIZE n), then A[:SO_RATE n] eta_dot
+# On a drive, DRIVE_WORK more columns after those (at 0 for the first-order model):
+WD_R = 0  # (9) R_BF(alpha), row-major
+WD_MS = 9  # (6) M_I S = [B u; D u], frame F
+WD_CJ = 15  # (6) c_J = [w x (w x r); alpha_dot w x u], frame F
+WD_K = 21  # (1) tau - u . (M_I c_J + b)_rot [N m]
+WD_D = 22  # (1) d = u . D u [kg m^2]
+DRIVE_WORK = 23
+DRIVE_COORDINATE = "drive_angle"
+"""Name of a modal appendage's drive angle alpha [rad] (coordinate 0 on a drive)."""
 
 Scale = Annotated[float, Strict(), AllowInfNan(False), Field(gt=0.0, le=1e3)]
 
@@ -135,7 +161,11 @@ class ModalAppendageConfig(BaseModel):
     relative to that file's folder, :func:`flexsat.config.load.load_config`). The
     mount frame is the hub frame rotated by ``mount_yaw_deg`` about Z_B and then
     ``sadm_angle_deg`` about Y, as for the plate; the data's frame M is it.
-    The ``*_scale`` factors are campaign handles on every mode at once.
+    The ``*_scale`` factors are campaign handles on every mode at once. With ``drive``
+    the appendage turns about ``drive_axis`` (frame M, through the interface point)
+    by the drive angle, a generalized coordinate starting at ``sadm_angle_deg``, and the
+    mount is ``mount_yaw_deg`` (or ``mount_matrix``) alone (docs/model.md, 'Modal
+    appendage on a drive').
     """
 
     model_config = ConfigDict(frozen=True, extra="forbid", validate_default=True)
@@ -153,6 +183,14 @@ class ModalAppendageConfig(BaseModel):
     frequency_scale: Scale = Field(1.0, description="factor on every modal frequency [-]")
     damping_scale: Scale = Field(1.0, description="factor on every damping ratio [-]")
     participation_scale: Scale = Field(1.0, description="factor on every participation [-]")
+    drive: DriveConfig | None = Field(
+        None, description="put the appendage on a solar-array drive turning it about "
+        "drive_axis; sadm_angle_deg is then the drive's initial angle"
+    )  # fmt: skip
+    drive_axis: Point3 | None = Field(
+        None, description="the drive's axis through the interface point, frame M (the "
+        "data's frame), any nonzero length [-]"
+    )  # fmt: skip
 
     @model_validator(mode="before")
     @classmethod
@@ -171,6 +209,18 @@ class ModalAppendageConfig(BaseModel):
                 raise ValueError("mount_matrix must be a rotation (orthonormal, det +1)")
         if self.data is None:
             raise ValueError("give the modal data: file = '<path>' or a data table")
+        if self.drive is None and self.drive_axis is not None:
+            raise ValueError("drive_axis: only an appendage on a drive (its drive key) takes "
+                             "a drive axis")  # fmt: skip
+        if self.drive is not None:
+            if self.drive_axis is None:
+                raise ValueError(
+                    "drive_axis: a modal appendage on a drive needs its axis, a "
+                    "nonzero vector in the data's frame M (e.g. [0, 1, 0]) [-]"
+                )
+            if float(np.linalg.norm(self.drive_axis)) < 1e-9:
+                raise ValueError(f"drive_axis: the drive axis must be a nonzero vector "
+                                 f"(norm >= 1e-9, got {list(self.drive_axis)})")  # fmt: skip
         self.modal()  # the scaled data must be valid too (effective masses, damping)
         return self
 
@@ -193,11 +243,24 @@ class ModalAppendageConfig(BaseModel):
 
     def mount_rotation(self) -> np.ndarray:
         """R_BM: ``mount_matrix``, else Rz(yaw) Ry(sadm) (intrinsic Z then Y, as for the
-        plate), shape (3, 3)."""
+        plate), shape (3, 3); on a drive, R_BM0 Rot(u, alpha(0)) (:meth:`drive_mount`)."""
+        if self.drive is not None:
+            R0, u, alpha = self.drive_mount()
+            return R0 @ Rotation.from_rotvec(alpha * u).as_matrix()
         if self.mount_matrix is not None:
             return np.array(self.mount_matrix, dtype=float)
         angles = np.radians([self.mount_yaw_deg, self.sadm_angle_deg])
         return Rotation.from_euler("ZY", angles).as_matrix()
+
+    def drive_mount(self) -> tuple[np.ndarray, np.ndarray, float]:
+        """On a drive: R_BM0 (3, 3), the mount at drive angle 0 (``mount_matrix``, else
+        Rz(yaw)); the unit axis u (3,), frame M; the initial angle alpha(0) [rad]."""
+        if self.mount_matrix is not None:
+            R0 = np.array(self.mount_matrix, dtype=float)
+        else:
+            R0 = Rotation.from_euler("Z", np.radians(self.mount_yaw_deg)).as_matrix()
+        u = np.asarray(self.drive_axis, dtype=float)
+        return R0, u / np.linalg.norm(u), float(np.radians(self.sadm_angle_deg))
 
     def tip(self) -> int | None:
         """Index of the output point called 'tip', else the first one; None: no points."""
@@ -392,54 +455,300 @@ def _inertia_about_hub(p, J, r, c1):
     return _madd(_madd(J, mm(R, C), -1.0), mm(C, R), -1.0)
 
 
+_I3 = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
+
+
+@njit(cache=True, error_model="numpy")
+def _drive_rotation(p, alpha):
+    """R_BF(alpha) = R_BM0 Rot(u, alpha), Rot(u, a) = I + sin a [u]x + (1 - cos a) [u]x^2
+    (eq. D.1): the floating frame F of an appendage on a drive, F -> B."""
+    U = skew(load_seg(p, P_AXIS))
+    turn = _madd(_madd(_I3, U, sin(alpha)), mm(U, U), 1.0 - cos(alpha))
+    return mm(load_m33_at(p, P_R_BM), turn)
+
+
+@njit(cache=True, error_model="numpy")
+def _drive_work(p):
+    """First scratch column of the drive's entries (after the large-motion ones)."""
+    return (WORK_MODE + SO_SIZE + SO_RATE) * int(p[P_N]) if p[P_SECOND_AT] > 0.0 else 0
+
+
+@njit(cache=True, error_model="numpy")
+def _driven_pass1(q, qd, Q, o, p, work, j, hub, qdd, omega):
+    """Pass 1 of a member on a drive (eqs. D.2-D.6), everything in F until the wrench.
+
+    The body's equations are the rigid mount's in its floating frame F (rate
+    Omega = w + alpha_dot u, w the hub rate in F): W_a = M_I A_F + b. With A_F =
+    X A_hub + S alpha_ddot + c_J, S = [0; u], and the drive equation S^T W_a = tau,
+    alpha_ddot = (k - (M_I S) . X A_hub) / d, k = tau - S^T (M_I c_J + b), d = u . D u,
+    and the hub sees the articulated inertia M_I - (M_I S)(M_I S)^T / d and the wrench
+    M_I c_J + b + M_I S k / d, both turned to B by R_BF."""
+    o1 = o + 1
+    u, r = load_seg(p, P_AXIS), load_seg(p, P_MOUNT)
+    R = _drive_rotation(p, q[o])
+    w = mtv(R, omega)
+    Om = add(w, scale(qd[o], u))  # eq. D.2
+    s, s_dot, h_r, J, J_dot, quad_t, quad_r = _sums(q, qd, o1, p, Om, work, j, True)
+    g_t, g_r, d_tt, d_tr, d_rr = _modal_forces(q, qd, Q, o1, p, work, j, hub, qdd, Om)
+    c1 = add(load_seg(p, P_FIRST), s)
+    A, B, C, D = _interface_inertia(p, s, J, d_tt, d_tr, d_rr)
+    # b: the wrench at a_I = 0, Omega_dot = 0 (eq. D.3), then y = M_I c_J + b.
+    F = add(add(cross(Om, cross(Om, c1)), scale(2.0, cross(Om, s_dot))), add(g_t, quad_t))
+    N = add(add(cross(Om, mv(J, Om)), cross(Om, h_r)), add(g_r, quad_r))
+    N = add(N, mv(J_dot, Om))
+    c_l = mtv(R, cross(omega, cross(omega, r)))
+    c_a = scale(qd[o], cross(w, u))
+    F = add(add(F, mv(A, c_l)), mv(B, c_a))
+    N = add(add(N, mv(C, c_l)), mv(D, c_a))
+    ms_l, ms_a = mv(B, u), mv(D, u)  # M_I S
+    d = dot(u, ms_a)
+    k = Q[o] - dot(u, N)  # eq. D.5
+    F, N = add(F, scale(k / d, ms_l)), add(N, scale(k / d, ms_a))  # eq. D.6
+    A = _madd(A, _outer(ms_l, ms_l), -1.0 / d)
+    B = _madd(B, _outer(ms_l, ms_a), -1.0 / d)
+    C = _madd(C, _outer(ms_a, ms_l), -1.0 / d)
+    D = _madd(D, _outer(ms_a, ms_a), -1.0 / d)
+    F, N = mv(R, F), mv(R, N)
+    T = add(N, cross(r, F))
+    for a in range(3):
+        hub[HUB_FORCE + a] -= F[a]
+        hub[HUB_TORQUE + a] -= T[a]
+    Rt = transpose(R)
+    _add_articulated(hub, r, mm(R, mm(A, Rt)), mm(R, mm(B, Rt)), mm(R, mm(C, Rt)),
+                     mm(R, mm(D, Rt)))  # fmt: skip
+    at = _drive_work(p)
+    for a in range(3):
+        for b in range(3):
+            work[j, at + WD_R + 3 * a + b] = R[a][b]
+        work[j, at + WD_MS + a] = ms_l[a]
+        work[j, at + WD_MS + 3 + a] = ms_a[a]
+        work[j, at + WD_CJ + a] = c_l[a]
+        work[j, at + WD_CJ + 3 + a] = c_a[a]
+    work[j, at + WD_K] = k
+    work[j, at + WD_D] = d
+
+
+@njit(cache=True, error_model="numpy")
+def _driven_pass2(o, p, work, j, qdd, a_hub, alpha):
+    """alpha_ddot (eq. D.5), then eta_ddot_k = f_k - L_t,k . a_I - h_k . Omega_dot in F,
+    a_I and Omega_dot the interface's and the frame's accelerations (eq. D.4)."""
+    o1 = o + 1
+    at = _drive_work(p)
+    u, r = load_seg(p, P_AXIS), load_seg(p, P_MOUNT)
+    R = load_m33_at(work[j], at + WD_R)
+    z_l, z_a = mtv(R, add(a_hub, cross(alpha, r))), mtv(R, alpha)
+    ms_l, ms_a = load_seg(work[j], at + WD_MS), load_seg(work[j], at + WD_MS + 3)
+    acc = (work[j, at + WD_K] - dot(ms_l, z_l) - dot(ms_a, z_a)) / work[j, at + WD_D]
+    qdd[o] = acc
+    a_I = add(z_l, load_seg(work[j], at + WD_CJ))
+    Om_dot = add(add(z_a, scale(acc, u)), load_seg(work[j], at + WD_CJ + 3))
+    second = p[P_SECOND_AT] > 0.0
+    for k in range(int(p[P_N])):
+        if second:
+            w = WORK_MODE * k
+            l_t = (work[j, w], work[j, w + 1], work[j, w + 2])
+            l_r = (work[j, w + 3], work[j, w + 4], work[j, w + 5])
+        else:
+            b = P_MODES + MODE_SIZE * k
+            l_t, l_r = load_seg(p, b + MODE_LT), load_seg(p, b + MODE_LR)
+        qdd[o1 + k] -= dot(l_t, a_I) + dot(l_r, Om_dot)
+
+
+@njit(cache=True, error_model="numpy")
+def _driven_mass_matrix(q, o, p, params, j, M, R_NB, S):
+    """A driven member's share of M(q): T = 1/2 V^T M_body V + eta_dot^T L V + 1/2
+    eta_dot^T eta_dot with V = [v_I; Omega] = G q_dot in F (eq. D.7), column by column."""
+    o1, n = o + 1, int(p[P_N])
+    m, r, u = p[P_MASS], load_seg(p, P_MOUNT), load_seg(p, P_AXIS)
+    R = _drive_rotation(p, q[o])
+    s, _, _, J, _, _, _ = _sums(q, q, o1, p, _I3[0], params, j, False)
+    c1 = add(load_seg(p, P_FIRST), s)
+    E = mm(R_NB, R)  # F -> N: row i is the velocity r_dot_N,i in F
+    G_a = transpose(mtm(R, S))  # row i: R^T S e_i
+    G_l = transpose(mtm(R, mm(skew(r), S)))  # row i: R^T [r]x S e_i
+    z = (0.0, 0.0, 0.0)
+    lin = (E[0], E[1], E[2], scale(-1.0, G_l[0]), scale(-1.0, G_l[1]), scale(-1.0, G_l[2]), z)
+    ang = (z, z, z, G_a[0], G_a[1], G_a[2], u)
+    for a in range(7):
+        ia = a if a < 6 else o
+        f_l = add(scale(m, lin[a]), cross(ang[a], c1))
+        f_a = add(cross(c1, lin[a]), mv(J, ang[a]))
+        for b in range(7):
+            ib = b if b < 6 else o
+            M[ia, ib] += dot(lin[b], f_l) + dot(ang[b], f_a)
+    for k in range(n):
+        l_t, l_r, _ = _mode(q, q, o1, p, k, _I3[0])
+        for a in range(7):
+            ia = a if a < 6 else o
+            v = dot(l_t, lin[a]) + dot(l_r, ang[a])
+            M[o1 + k, ia] += v
+            M[ia, o1 + k] += v
+        M[o1 + k, o1 + k] += 1.0
+
+
+@njit(cache=True, error_model="numpy")
+def _driven_wrench(q, qd, o, p, omega, alpha, a_hub, acc, params, j, g, with_g):
+    """The wrench (F_a, N_a) on a driven member at its interface, frame F (eq. D.3 with
+    A_F of eq. D.4), the hub's omega, alpha = omega_dot and a_hub in B, acc the drive's
+    alpha_ddot; ``g`` the plant's q_ddot when ``with_g`` (else the modes' are zero);
+    also R_BF, a_I, Omega and Omega_dot (F)."""
+    o1 = o + 1
+    u, r = load_seg(p, P_AXIS), load_seg(p, P_MOUNT)
+    R = _drive_rotation(p, q[o])
+    w = mtv(R, omega)
+    Om = add(w, scale(qd[o], u))
+    a_I = mtv(R, add(add(a_hub, cross(alpha, r)), cross(omega, cross(omega, r))))
+    Om_dot = add(add(mtv(R, alpha), scale(acc, u)), scale(qd[o], cross(w, u)))
+    s, s_dot, h_r, J, J_dot, quad_t, quad_r = _sums(q, qd, o1, p, Om, params, j, False)
+    c1 = add(load_seg(p, P_FIRST), s)
+    F = add(add(scale(p[P_MASS], a_I), cross(Om_dot, c1)), cross(Om, cross(Om, c1)))
+    F = add(add(F, scale(2.0, cross(Om, s_dot))), quad_t)
+    N = add(add(cross(c1, a_I), mv(J, Om_dot)), mv(J_dot, Om))
+    N = add(add(add(N, cross(Om, mv(J, Om))), cross(Om, h_r)), quad_r)
+    if with_g:
+        for k in range(int(p[P_N])):
+            l_t, l_r, _ = _mode(q, qd, o1, p, k, Om)
+            F = add(F, scale(g[o1 + k], l_t))
+            N = add(N, scale(g[o1 + k], l_r))
+    return F, N, R, a_I, Om, Om_dot
+
+
+@njit(cache=True, error_model="numpy")
+def _driven_bias(q, qd, o, p, params, j, omega, alpha, R_NB, hub, h):
+    """A driven member's share of h(q, q_dot): its inertia forces at q_ddot = 0 (alpha =
+    S_dot Theta_dot, alpha_ddot = 0); the drive row is u . N_a (eq. D.5)."""
+    o1, r, u = o + 1, load_seg(p, P_MOUNT), load_seg(p, P_AXIS)
+    F, N, R, a_I, Om, Om_dot = _driven_wrench(q, qd, o, p, omega, alpha, (0.0, 0.0, 0.0),
+                                              0.0, params, j, h, False)  # fmt: skip
+    h[o] = dot(u, N)
+    F_B = mv(R, F)
+    F_N = mv(R_NB, F_B)
+    T = add(mv(R, N), cross(r, F_B))
+    for a in range(3):
+        hub[HUB_FORCE + a] += F_N[a]
+        hub[HUB_TORQUE + a] += T[a]
+    full_damping = p[P_DAMP_AT] > 0.0
+    for k in range(int(p[P_N])):
+        b = P_MODES + MODE_SIZE * k
+        l_t, l_r, force = _mode(q, qd, o1, p, k, Om)
+        h[o1 + k] = dot(l_t, a_I) + dot(l_r, Om_dot) - force
+        if full_damping:
+            h[o1 + k] += _damping(qd, o1, p, k) - p[b + MODE_C] * qd[o1 + k]
+
+
+@njit(cache=True, error_model="numpy")
+def _driven_observe(q, qd, o, p, params, j, omega, v_hub, r_hub, R_NB, out):
+    """A driven member's T, momentum, locked inertia, U and 2 D (eq. D.8): the rigid
+    mount's in F with Omega = w + alpha_dot u, turned to B and N."""
+    o1, m, r, u = o + 1, p[P_MASS], load_seg(p, P_MOUNT), load_seg(p, P_AXIS)
+    R = _drive_rotation(p, q[o])
+    Om = add(mtv(R, omega), scale(qd[o], u))
+    v = mtv(R, add(v_hub, cross(omega, r)))
+    s, s_dot, h_r, J, _, _, _ = _sums(q, qd, o1, p, Om, params, j, False)
+    c1 = add(load_seg(p, P_FIRST), s)
+    kinetic = 0.5 * m * dot(v, v) + dot(v, cross(Om, c1)) + 0.5 * dot(Om, mv(J, Om))
+    kinetic += dot(v, s_dot) + dot(Om, h_r)
+    for k in range(int(p[P_N])):
+        b = P_MODES + MODE_SIZE * k
+        kinetic += 0.5 * qd[o1 + k] ** 2
+        out[OBS_ELASTIC] += 0.5 * p[b + MODE_K] * q[o1 + k] ** 2
+        if p[P_DAMP_AT] > 0.0:
+            out[OBS_DISSIPATION] += _damping(qd, o1, p, k) * qd[o1 + k]
+        else:
+            out[OBS_DISSIPATION] += p[b + MODE_C] * qd[o1 + k] ** 2
+    out[OBS_KINETIC] += kinetic
+    P = add(add(scale(m, v), cross(Om, c1)), s_dot)
+    H_I = add(add(cross(c1, v), mv(J, Om)), h_r)
+    E = mm(R_NB, R)
+    H = add(cross(add(r_hub, mv(R_NB, r)), mv(E, P)), mv(E, H_I))
+    J_O = _inertia_about_hub(p, mm(R, mm(J, transpose(R))), r, mv(R, c1))
+    for a in range(3):
+        out[OBS_MOMENTUM + a] += H[a]
+        for b in range(3):
+            out[OBS_LOCKED_INERTIA + 3 * a + b] += J_O[a][b]
+
+
+@njit(cache=True, error_model="numpy")
+def _modal_forces(q, qd, Q, o, p, work, j, hub, qdd, omega):
+    """Each mode's force f_k (eq. M.4 without its acceleration terms) into ``qdd[o + k]``,
+    the damper power into ``hub``; returns g_t = sum_k f_k L_t,k(eta), g_r = sum_k f_k
+    h_k(eta) and L(eta)^T L(eta) - L^T L (zero for the first-order model), blocks tt, tr,
+    rr. ``o`` is the first mode's index in q, ``omega`` the floating frame's rate."""
+    z3 = (0.0, 0.0, 0.0)
+    second, full_damping = p[P_SECOND_AT] > 0.0, p[P_DAMP_AT] > 0.0
+    g_t, g_r = z3, z3
+    d_tt, d_tr, d_rr = (z3, z3, z3), (z3, z3, z3), (z3, z3, z3)  # L(eta)^T L(eta) - L^T L
+    for k in range(int(p[P_N])):
+        b = P_MODES + MODE_SIZE * k
+        damping = _damping(qd, o, p, k)
+        f = Q[o + k] - p[b + MODE_K] * q[o + k] - damping
+        if second:
+            w = WORK_MODE * k
+            l_t = (work[j, w], work[j, w + 1], work[j, w + 2])
+            l_r = (work[j, w + 3], work[j, w + 4], work[j, w + 5])
+            f += work[j, w + 6]
+            t0, r0 = load_seg(p, b + MODE_LT), load_seg(p, b + MODE_LR)
+            d_tt = _madd(_madd(d_tt, _outer(l_t, l_t), 1.0), _outer(t0, t0), -1.0)
+            d_tr = _madd(_madd(d_tr, _outer(l_t, l_r), 1.0), _outer(t0, r0), -1.0)
+            d_rr = _madd(_madd(d_rr, _outer(l_r, l_r), 1.0), _outer(r0, r0), -1.0)
+        else:
+            l_t, l_r = load_seg(p, b + MODE_LT), load_seg(p, b + MODE_LR)
+            f += _centrifugal(p, k, omega)
+        qdd[o + k] = f
+        g_t = add(g_t, scale(f, l_t))
+        g_r = add(g_r, scale(f, l_r))
+        if full_damping:
+            hub[HUB_DISSIPATION] += damping * qd[o + k]
+        else:
+            hub[HUB_DISSIPATION] += p[b + MODE_C] * qd[o + k] ** 2  # eq. 2.36
+    return g_t, g_r, d_tt, d_tr, d_rr
+
+
+@njit(cache=True, error_model="numpy")
+def _interface_inertia(p, s, J, d_tt, d_tr, d_rr):
+    """M_I = [[A, B], [C, D]] = M_res + [[0, -[s]x], [[s]x, J(eta) - J_I]] about I, minus
+    L(eta)^T L(eta) - L^T L when the modes' rows follow eta (large motion)."""
+    S = skew(s)
+    A = load_block33(p, P_RES, 0, 0)
+    D = _madd(_madd(load_block33(p, P_RES, 3, 3), J, 1.0), load_m33_at(p, P_J_I), -1.0)
+    B = _madd(load_block33(p, P_RES, 0, 3), S, -1.0)
+    C = _madd(load_block33(p, P_RES, 3, 0), S, 1.0)
+    if p[P_SECOND_AT] > 0.0:  # the modes' rows follow eta: M_res - (L(eta)^T L(eta) - L^T L)
+        A, B, D = _madd(A, d_tt, -1.0), _madd(B, d_tr, -1.0), _madd(D, d_rr, -1.0)
+        C = _madd(C, transpose(d_tr), -1.0)
+    return A, B, C, D
+
+
+@njit(cache=True, error_model="numpy")
+def _add_articulated(hub, r, A, B, C, D):
+    """Add X^T M_I X with X = [[I, -[r]x], [0, I]] to the hub's 6 x 6 inertia:
+    [[A, B - A R], [R A + C, R (B - A R) + D - C R]], R = [r]x."""
+    R = skew(r)
+    top_right = _madd(B, mm(A, R), -1.0)
+    _add_inertia(hub, 0, 0, A)
+    _add_inertia(hub, 0, 3, top_right)
+    _add_inertia(hub, 3, 0, _madd(C, mm(R, A), 1.0))
+    _add_inertia(hub, 3, 3, _madd(_madd(D, mm(R, top_right), 1.0), mm(C, R), -1.0))
+
+
 @njit(cache=True, error_model="numpy")  # compiled with PASS1_SIGNATURE on first use
 def pass1(q, qd, Q, members, params, work, hub, qdd):
     """Wrench on the hub at zero hub acceleration and the articulated inertia X^T M_I X.
 
-    Leaves the modal forces f_k in the member's rows of ``qdd`` for :func:`pass2`.
+    Leaves the modal forces f_k in the member's rows of ``qdd`` for :func:`pass2`; a
+    member on a drive eliminates its drive angle too (:func:`_driven_pass1`).
     """
     omega = load_seg(hub, HUB_OMEGA)
-    z3 = (0.0, 0.0, 0.0)
     for j in range(members.shape[0]):
         o, p = members[j, 1], params[j]
+        if p[P_DRIVE] > 0.0:
+            _driven_pass1(q, qd, Q, o, p, work, j, hub, qdd, omega)
+            continue
         r = load_seg(p, P_MOUNT)
-        second, full_damping = p[P_SECOND_AT] > 0.0, p[P_DAMP_AT] > 0.0
         s, s_dot, h_r, J, J_dot, quad_t, quad_r = _sums(q, qd, o, p, omega, work, j, True)
-        g_t, g_r = z3, z3
-        d_tt, d_tr, d_rr = (z3, z3, z3), (z3, z3, z3), (z3, z3, z3)  # L(eta)^T L(eta) - L^T L
-        for k in range(int(p[P_N])):
-            b = P_MODES + MODE_SIZE * k
-            damping = _damping(qd, o, p, k)
-            f = Q[o + k] - p[b + MODE_K] * q[o + k] - damping
-            if second:
-                w = WORK_MODE * k
-                l_t = (work[j, w], work[j, w + 1], work[j, w + 2])
-                l_r = (work[j, w + 3], work[j, w + 4], work[j, w + 5])
-                f += work[j, w + 6]
-                t0, r0 = load_seg(p, b + MODE_LT), load_seg(p, b + MODE_LR)
-                d_tt = _madd(_madd(d_tt, _outer(l_t, l_t), 1.0), _outer(t0, t0), -1.0)
-                d_tr = _madd(_madd(d_tr, _outer(l_t, l_r), 1.0), _outer(t0, r0), -1.0)
-                d_rr = _madd(_madd(d_rr, _outer(l_r, l_r), 1.0), _outer(r0, r0), -1.0)
-            else:
-                l_t, l_r = load_seg(p, b + MODE_LT), load_seg(p, b + MODE_LR)
-                f += _centrifugal(p, k, omega)
-            qdd[o + k] = f
-            g_t = add(g_t, scale(f, l_t))
-            g_r = add(g_r, scale(f, l_r))
-            if full_damping:
-                hub[HUB_DISSIPATION] += damping * qd[o + k]
-            else:
-                hub[HUB_DISSIPATION] += p[b + MODE_C] * qd[o + k] ** 2  # eq. 2.36
+        g_t, g_r, d_tt, d_tr, d_rr = _modal_forces(q, qd, Q, o, p, work, j, hub, qdd, omega)
         c1 = add(load_seg(p, P_FIRST), s)  # c~ = m c + L_t^T eta (+ 1/2 eta^T C eta)
-        # M_I = [[A, B], [C, D]] = M_res + [[0, -[s]x], [[s]x, J(eta) - J_I]], about I.
-        S = skew(s)
-        A = load_block33(p, P_RES, 0, 0)
-        D = _madd(_madd(load_block33(p, P_RES, 3, 3), J, 1.0), load_m33_at(p, P_J_I), -1.0)
-        B = _madd(load_block33(p, P_RES, 0, 3), S, -1.0)
-        C = _madd(load_block33(p, P_RES, 3, 0), S, 1.0)
-        if second:  # the modes' rows follow eta: M_res - (L(eta)^T L(eta) - L^T L)
-            A, B, D = _madd(A, d_tt, -1.0), _madd(B, d_tr, -1.0), _madd(D, d_rr, -1.0)
-            C = _madd(C, transpose(d_tr), -1.0)
+        A, B, C, D = _interface_inertia(p, s, J, d_tt, d_tr, d_rr)
         # Wrench on the appendage at a_hub = 0, alpha = 0: M_I [w x (w x r); 0] + b_a.
         w2r = cross(omega, cross(omega, r))
         F = add(add(cross(omega, cross(omega, c1)), scale(2.0, cross(omega, s_dot))), g_t)
@@ -450,14 +759,7 @@ def pass1(q, qd, Q, members, params, work, hub, qdd):
         for a in range(3):
             hub[HUB_FORCE + a] -= F[a]
             hub[HUB_TORQUE + a] -= T[a]
-        # X^T M_I X with X = [[I, -[r]x], [0, I]]:
-        # [[A, B - A R], [R A + C, R (B - A R) + D - C R]], R = [r]x.
-        R = skew(r)
-        top_right = _madd(B, mm(A, R), -1.0)
-        _add_inertia(hub, 0, 0, A)
-        _add_inertia(hub, 0, 3, top_right)
-        _add_inertia(hub, 3, 0, _madd(C, mm(R, A), 1.0))
-        _add_inertia(hub, 3, 3, _madd(_madd(D, mm(R, top_right), 1.0), mm(C, R), -1.0))
+        _add_articulated(hub, r, A, B, C, D)
     return STATUS_OK
 
 
@@ -469,6 +771,9 @@ def pass2(q, qd, members, params, work, hub, qdd):
     alpha = load_seg(hub, HUB_ALPHA)
     for j in range(members.shape[0]):
         o, p = members[j, 1], params[j]
+        if p[P_DRIVE] > 0.0:
+            _driven_pass2(o, p, work, j, qdd, a_hub, alpha)
+            continue
         r = load_seg(p, P_MOUNT)
         a_I = add(add(a_hub, cross(alpha, r)), cross(omega, cross(omega, r)))
         if p[P_SECOND_AT] > 0.0:  # the rows at eta, left by pass 1
@@ -493,6 +798,9 @@ def mass_matrix(q, members, params, M):
     identity = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
     for j in range(members.shape[0]):
         o, p = members[j, 1], params[j]
+        if p[P_DRIVE] > 0.0:
+            _driven_mass_matrix(q, o, p, params, j, M, R_NB, S)
+            continue
         m, r = p[P_MASS], load_seg(p, P_MOUNT)
         s, _, _, J, _, _, _ = _sums(q, q, o, p, identity[0], params, j, False)
         c1 = add(load_seg(p, P_FIRST), s)
@@ -521,6 +829,9 @@ def bias_forces(q, qd, members, params, hub, h):
     alpha = load_seg(hub, HUB_SBIAS)
     for j in range(members.shape[0]):
         o, p = members[j, 1], params[j]
+        if p[P_DRIVE] > 0.0:
+            _driven_bias(q, qd, o, p, params, j, omega, alpha, R_NB, hub, h)
+            continue
         m, r = p[P_MASS], load_seg(p, P_MOUNT)
         s, s_dot, h_r, J, J_dot, quad_t, quad_r = _sums(q, qd, o, p, omega, params, j, False)
         c1 = add(load_seg(p, P_FIRST), s)
@@ -555,6 +866,9 @@ def observe(q, qd, members, params, out):
     r_hub = load_seg(q, 0)
     for j in range(members.shape[0]):
         o, p = members[j, 1], params[j]
+        if p[P_DRIVE] > 0.0:
+            _driven_observe(q, qd, o, p, params, j, omega, v_hub, r_hub, R_NB, out)
+            continue
         m, r = p[P_MASS], load_seg(p, P_MOUNT)
         s, s_dot, h_r, J, _, _, _ = _sums(q, qd, o, p, omega, params, j, False)
         c1 = add(load_seg(p, P_FIRST), s)
@@ -633,6 +947,15 @@ def joint_wrench(q, qd, qdd, Q, members, params, out):
     for j in range(members.shape[0]):
         o, p = members[j, 1], params[j]
         r = load_seg(p, P_MOUNT)
+        if p[P_DRIVE] > 0.0:  # eq. D.3 at the plant's accelerations, turned to B
+            F, N, R, _, _, _ = _driven_wrench(q, qd, o, p, omega, alpha, a_hub, qdd[o],
+                                              params, j, qdd, True)  # fmt: skip
+            F = mv(R, F)
+            T = add(mv(R, N), cross(r, F))
+            for a in range(3):
+                out[a] -= F[a]
+                out[3 + a] -= T[a]
+            continue
         s, s_dot, h_r, J, J_dot, quad_t, quad_r = _sums(q, qd, o, p, omega, params, j, False)
         c1 = add(load_seg(p, P_FIRST), s)  # c~ = m c + L_t^T eta (+ 1/2 eta^T C eta)
         a_I = add(add(a_hub, cross(alpha, r)), cross(omega, cross(omega, r)))
@@ -657,6 +980,7 @@ def tips(q, members, params, out):
     """Tip displacement sum_k psi_tip,k eta_k, mount frame [m]."""
     for j in range(members.shape[0]):
         o, p = members[j, 1], params[j]
+        o += int(p[P_DRIVE])  # the modes follow a drive's angle
         d = (0.0, 0.0, 0.0)
         for k in range(int(p[P_N])):
             d = add(d, scale(q[o + k], load_seg(p, P_MODES + MODE_SIZE * k + MODE_TIP)))
@@ -683,27 +1007,41 @@ class ModalModel(AppendageModel):
     config_class = ModalAppendageConfig
     kernels = AppendageKernels(pass1, pass2, mass_matrix, bias_forces, observe, joint_wrench, tips)
     transmits_inertia = True
+    holds_drive = True
     modifiers: ClassVar[dict] = {
         "damping_ratio": DerivedPath(_set_damping_ratio, ops=("set",), factor=False),
     }
 
     def coordinates(self, config: ModalAppendageConfig) -> tuple[Coordinate, ...]:
-        return tuple(Coordinate(f"q{k + 1}", "kg^0.5 m") for k in range(config.data.n_modes))
+        drive = (Coordinate(DRIVE_COORDINATE, "rad"),) if config.drive is not None else ()
+        modes = tuple(Coordinate(f"q{k + 1}", "kg^0.5 m") for k in range(config.data.n_modes))
+        return drive + modes
 
     def pack(self, config: ModalAppendageConfig) -> np.ndarray:
         data = config.modal()
         n = data.n_modes
-        R = config.mount_rotation()
+        row = np.zeros(P_MODES + MODE_SIZE * n)
+        rotor_mass, rotor_inertia = 0.0, 0.0
+        if config.drive is None:
+            R = config.mount_rotation()
+            row[P_R_BM : P_R_BM + 9] = R.ravel()
+        else:  # everything in the floating frame F, the rotor part of the body (eq. D.1)
+            R0, u, alpha0 = config.drive_mount()
+            R = np.eye(3)
+            row[P_R_BM : P_R_BM + 9] = R0.ravel()
+            row[P_DRIVE], row[P_AXIS : P_AXIS + 3], row[P_ALPHA0] = 1.0, u, alpha0
+            rotor_mass = config.drive.rotor_mass_kg
+            rotor_inertia = config.drive.rotor_inertia_kg_m2
         R6 = np.kron(np.eye(2), R)
         L_M = data.participation_matrix()
-        row = np.zeros(P_MODES + MODE_SIZE * n)
         row[P_MOUNT : P_MOUNT + 3] = config.mount_point_m
-        row[P_R_BM : P_R_BM + 9] = R.ravel()
-        row[P_MASS] = data.mass_kg
+        row[P_MASS] = data.mass_kg + rotor_mass
         row[P_FIRST : P_FIRST + 3] = data.mass_kg * R @ np.asarray(data.center_of_mass_m)
-        row[P_J_I : P_J_I + 9] = (R @ np.asarray(data.inertia_interface_kg_m2) @ R.T).ravel()
+        J_I = R @ np.asarray(data.inertia_interface_kg_m2) @ R.T + rotor_inertia * np.eye(3)
+        row[P_J_I : P_J_I + 9] = J_I.ravel()
+        rotor = np.diag([rotor_mass] * 3 + [rotor_inertia] * 3)
         residual = data.rigid_mass_matrix() - L_M.T @ L_M
-        row[P_RES : P_RES + 36] = (R6 @ residual @ R6.T).ravel()
+        row[P_RES : P_RES + 36] = (R6 @ residual @ R6.T + rotor).ravel()
         row[P_N] = n
         omega = 2.0 * np.pi * np.asarray(data.frequencies_hz, dtype=float)
         modes = row[P_MODES:].reshape(n, MODE_SIZE)
@@ -737,49 +1075,91 @@ class ModalModel(AppendageModel):
         # Pass 1 leaves each mode's rows at eta for pass 2 when the large-motion terms
         # are on, after the products A eta and A eta_dot.
         n = int(params[P_N])
-        return (WORK_MODE + SO_SIZE + SO_RATE) * n if params[P_SECOND_AT] > 0.0 else 0
+        columns = (WORK_MODE + SO_SIZE + SO_RATE) * n if params[P_SECOND_AT] > 0.0 else 0
+        return columns + (DRIVE_WORK if params[P_DRIVE] > 0.0 else 0)
 
     @staticmethod
     def _modes(params: np.ndarray) -> np.ndarray:
         n = int(params[P_N])
         return params[P_MODES : P_MODES + MODE_SIZE * n].reshape(n, MODE_SIZE)
 
+    @staticmethod
+    def _frame(params: np.ndarray, alpha: float | None = None) -> np.ndarray:
+        """R_BF, the frame of the packed invariants -> B, shape (3, 3): identity when
+        rigidly mounted (they are packed in B), R_BM0 Rot(u, alpha) on a drive (eq. D.1;
+        ``alpha`` default its initial angle)."""
+        if params[P_DRIVE] == 0.0:
+            return np.eye(3)
+        alpha = params[P_ALPHA0] if alpha is None else alpha
+        turn = Rotation.from_rotvec(alpha * params[P_AXIS : P_AXIS + 3]).as_matrix()
+        return params[P_R_BM : P_R_BM + 9].reshape(3, 3) @ turn
+
     def rigid_body(self, params: np.ndarray) -> RigidBody:
         m = float(params[P_MASS])
         c = params[P_FIRST : P_FIRST + 3] / m
         C = np.array(skew(tuple(c)))
         J_cm = params[P_J_I : P_J_I + 9].reshape(3, 3) + m * C @ C
-        return RigidBody(m, params[P_MOUNT : P_MOUNT + 3] + c, J_cm)
+        R = self._frame(params)
+        return RigidBody(m, params[P_MOUNT : P_MOUNT + 3] + R @ c, R @ J_cm @ R.T)
+
+    def rigid_body_at(self, params: np.ndarray, q_block: np.ndarray) -> RigidBody:
+        drive = int(params[P_DRIVE])
+        if np.any(q_block[drive:]):
+            raise ValueError("the 'modal' model freezes only undeformed (modal coordinates 0)")
+        if not drive:
+            return self.rigid_body(params)
+        frozen = params.copy()
+        frozen[P_ALPHA0] = q_block[0]
+        return self.rigid_body(frozen)
 
     def stiffness(self, params: np.ndarray) -> np.ndarray:
-        return self._modes(params)[:, MODE_K].copy()
+        return np.concatenate([np.zeros(int(params[P_DRIVE])), self._modes(params)[:, MODE_K]])
 
     def damping(self, params: np.ndarray) -> np.ndarray:
-        return self._modes(params)[:, MODE_C].copy()
+        return np.concatenate([np.zeros(int(params[P_DRIVE])), self._modes(params)[:, MODE_C]])
 
     def with_joints(self, params: np.ndarray, stiffness: np.ndarray, damping: np.ndarray
                     ) -> np.ndarray:  # fmt: skip
+        drive = int(params[P_DRIVE])
+        stiffness, damping = np.asarray(stiffness, float), np.asarray(damping, float)
+        if drive and (stiffness[0] != 0.0 or damping[0] != 0.0):
+            raise ValueError("a modal appendage's drive angle has no stiffness or damping (its "
+                             "motor is the sadm_drive joint actuator)")  # fmt: skip
         row = params.copy()
         modes = self._modes(row)
-        modes[:, MODE_K] = stiffness
-        modes[:, MODE_C] = damping
+        modes[:, MODE_K] = stiffness[drive:]
+        modes[:, MODE_C] = damping[drive:]
         return row
+
+    def default_state(self, config: ModalAppendageConfig) -> tuple[np.ndarray, np.ndarray]:
+        q, qd = super().default_state(config)
+        if config.drive is not None:
+            q[0] = config.drive_mount()[2]
+        return q, qd
 
     def describe(self, config: ModalAppendageConfig, params: np.ndarray) -> dict:
         data = config.modal()
-        return {
+        described = {
             "mass_kg": data.mass_kg,
             "n_modes": data.n_modes,
             "frequencies_hz": list(data.frequencies_hz),
             "damping_ratios": list(data.damping_ratios),
         }
+        if config.drive is not None:
+            described["drive_axis_M"] = config.drive_mount()[1].tolist()
+        return described
 
     def shape_points(self, config: ModalAppendageConfig, params: np.ndarray,
                      q_block: np.ndarray) -> np.ndarray:  # fmt: skip
         # A segment from the interface to the tip output point (deformed), drawn as a
         # degenerate outline; without output points, from the interface to twice the
         # centre of mass.
-        R = params[P_R_BM : P_R_BM + 9].reshape(3, 3)
+        drive = int(params[P_DRIVE])
+        if drive:
+            R = self._frame(params, float(q_block[0]))
+            q_block = q_block[1:]
+        else:
+            R = params[P_R_BM : P_R_BM + 9].reshape(3, 3)
         root = params[P_MOUNT : P_MOUNT + 3]
         tip = config.tip()
         if tip is None:
@@ -799,8 +1179,11 @@ class ModalModel(AppendageModel):
 
     @staticmethod
     def mount_rotation(params: np.ndarray) -> np.ndarray:
-        """R_BM of a packed row, shape (3, 3)."""
+        """R_BM of a packed row, shape (3, 3); on a drive, at its initial angle."""
+        if params[P_DRIVE] > 0.0:
+            return ModalModel._frame(params)
         return params[P_R_BM : P_R_BM + 9].reshape(3, 3)
 
     def mode_kinds(self, config: ModalAppendageConfig) -> tuple[str, ...]:
-        return tuple(f"mode_{k + 1}" for k in range(config.data.n_modes))
+        drive = (DRIVE_COORDINATE,) if config.drive is not None else ()
+        return drive + tuple(f"mode_{k + 1}" for k in range(config.data.n_modes))

@@ -27,7 +27,8 @@ rotation about the chain's span axis, and its segments follow. A satellite TOML
 puts an appendage on a drive with its ``drive`` key
 (:class:`~flexsat.config.models.DriveConfig`); the plant builds it through
 :func:`expand_drives`, which asks each model's ``on_drive`` hook (a model without
-one refuses the key). docs/model.md, 'Driven mount coordinate (SADM)'.
+one refuses the key); a model that holds the drive in its own kernels (``holds_drive``,
+the modal model) is left as it is. docs/model.md, 'Driven mount coordinate (SADM)'.
 """
 
 from __future__ import annotations
@@ -164,10 +165,13 @@ def with_sadm(config: SatelliteConfig, rotor_inertia_kg_m2: float, rotor_mass_kg
     """``config`` with its appendages (all, or those named) on a SADM: their ``drive`` key set.
 
     Only appendages whose model takes a drive (a ``drive`` field in its config) are
-    changed. The plant builds each as its model's chain on the drive
-    (:func:`expand_drives`): the joints keep the stiffness and damping the plant
-    tunes them to (eqs. 2.14-2.15), so the driven satellite is the same satellite
-    with one more coordinate per driven appendage.
+    changed; with ``names`` not given, a modal appendage without its ``drive_axis`` is
+    left alone (it names no axis to turn about). The plant builds each plate or chain
+    as its model's chain on the drive (:func:`expand_drives`): the joints keep the
+    stiffness and damping the plant tunes them to (eqs. 2.14-2.15), so the driven
+    satellite is the same satellite with one more coordinate per driven appendage; a
+    modal appendage holds its drive angle itself (docs/model.md, 'Modal appendage on a
+    drive').
 
     Parameters
     ----------
@@ -194,7 +198,8 @@ def with_sadm(config: SatelliteConfig, rotor_inertia_kg_m2: float, rotor_mass_kg
     drive = {"rotor_inertia_kg_m2": rotor_inertia_kg_m2, "rotor_mass_kg": rotor_mass_kg}
     appendages = [
         type(app).model_validate({**dict(app), "drive": drive})
-        if "drive" in type(app).model_fields and (names is None or app.name in names) else app
+        if "drive" in type(app).model_fields and (names is None or app.name in names)
+        and (names is not None or getattr(app, "drive_axis", True) is not None) else app
         for app in config.appendages
     ]  # fmt: skip
     return config.model_copy(update={"appendages": appendages})
@@ -230,7 +235,10 @@ def expand_drives(config: SatelliteConfig,
     ConfigError
         Naming the appendage's ``drive`` when its model has no drive or refuses it.
     """
-    driven = [getattr(app, "drive", None) is not None for app in config.appendages]
+    driven = [
+        getattr(app, "drive", None) is not None and not appendage_model(app.model).holds_drive
+        for app in config.appendages
+    ]
     if not any(driven):
         return config
     fixed = [app.model_copy(update={"drive": None}) if d else app
