@@ -27,8 +27,10 @@ The first CLI run uses empty ``NUMBA_CACHE_DIR`` and ``FLEXSAT_CACHE_DIR``
 (temporary folders): it compiles every kernel it needs. The later runs reuse those
 folders: the cached start-up a user sees from the second run on. Python's own
 bytecode cache is left at its default (on). Cached rows: best of ``REPEATS``.
-Run with ``python bench/bench_startup.py [--repeats N] [--before COMMIT] [--breakdown]
-[--commands-only]``; the load average is printed with the tables.
+With ``--after COMMIT`` the "after" code is that commit's instead of this checkout's
+(a comparison of two commits, untouched by uncommitted edits).
+Run with ``python bench/bench_startup.py [--repeats N] [--before COMMIT] [--after COMMIT]
+[--breakdown] [--commands-only] [--write-docs]``; the load average is printed with the tables.
 """
 
 from __future__ import annotations
@@ -198,18 +200,31 @@ def _export(commit: str, folder: Path) -> Path:
     return folder / "src"
 
 
-def measure_commands(repeats: int = REPEATS, before: str | None = None) -> dict:
+def _trees(work: Path, before: str | None, after: str | None) -> dict[str, Path]:
+    """The ``src`` folders to time: "after" (this checkout's, or ``after``'s exported)
+    and, with a commit, "before"."""
+    trees = {"after": ROOT / "src"}
+    if after is not None:
+        (work / "after").mkdir()
+        trees["after"] = _export(after, work / "after")
+    if before is not None:
+        (work / "before").mkdir()
+        trees["before"] = _export(before, work / "before")
+    return trees
+
+
+def measure_commands(
+    repeats: int = REPEATS, before: str | None = None, after: str | None = None
+) -> dict:
     """Whole commands of :data:`COMMANDS`, warm, fresh processes: best wall and CPU [s].
 
     Returns ``{label: {"after": {"process", "cpu"}, "before": ...}}`` ("before" only
     with a commit), and the load average before and after as ``"load"``.
     """
     python = sys.executable
-    trees = {"after": ROOT / "src"}
     out: dict = {"load_start": harness.load()}
     with tempfile.TemporaryDirectory(prefix="flexsat-bench-") as work:
-        if before is not None:
-            trees["before"] = _export(before, Path(work))
+        trees = _trees(Path(work), before, after)
         envs = {}
         for name, src in trees.items():
             env = _env(os.path.join(work, f"cache-{name}"))
@@ -230,7 +245,9 @@ def measure_commands(repeats: int = REPEATS, before: str | None = None) -> dict:
     return out
 
 
-def measure_breakdown(repeats: int = REPEATS, before: str | None = None) -> dict:
+def measure_breakdown(
+    repeats: int = REPEATS, before: str | None = None, after: str | None = None
+) -> dict:
     """Phases of a warm ``flexsat openloop --json`` in one fresh process (the run with
     the shortest whole process of ``repeats``), seconds from its start; ``loads``: the
     functions numba loaded from its disk cache (name, seconds, found).
@@ -240,10 +257,7 @@ def measure_breakdown(repeats: int = REPEATS, before: str | None = None) -> dict
     """
     out = {}
     with tempfile.TemporaryDirectory(prefix="flexsat-bench-") as work:
-        trees = {"after": ROOT / "src"}
-        if before is not None:
-            trees["before"] = _export(before, Path(work))
-        for name, src in trees.items():
+        for name, src in _trees(Path(work), before, after).items():
             env = _env(os.path.join(work, f"cache-{name}"))
             env["PYTHONPATH"] = str(src)
             command = [sys.executable, "-c", _BREAKDOWN]
@@ -320,6 +334,7 @@ def main(argv: list[str] | None = None) -> dict:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeats", type=int, default=REPEATS, help="warm runs, best kept")
     parser.add_argument("--before", help="also time the commands on this commit's code")
+    parser.add_argument("--after", help="time this commit's code instead of this checkout's")
     parser.add_argument(
         "--breakdown",
         action="store_true",
@@ -341,14 +356,14 @@ def main(argv: list[str] | None = None) -> dict:
     if not args.commands_only:
         out.update(measure())
         _print_slew(console, out)
-    out["commands"] = measure_commands(args.repeats, args.before)
+    out["commands"] = measure_commands(args.repeats, args.before, args.after)
     _print_commands(console, out["commands"], args.repeats)
     if args.breakdown:
-        out["breakdown"] = measure_breakdown(args.repeats, args.before)
+        out["breakdown"] = measure_breakdown(args.repeats, args.before, args.after)
         for name, run in out["breakdown"].items():
             _print_breakdown(console, run, name)
     if args.write_docs:
-        write_docs(out, args.before)
+        write_docs(out, args.before, args.after)
         console.print(f"The start-up tables are written to {DOCS.name}, 'Start-up'.")
     return out
 
@@ -364,15 +379,16 @@ def _phases(run: dict) -> list[tuple[str, float]]:
     return rows
 
 
-def write_docs(out: dict, before: str | None) -> None:
+def write_docs(out: dict, before: str | None, after: str | None = None) -> None:
     """Replace the tables between the markers of docs/performance.md, 'Start-up'."""
     commands = out["commands"]
     trees = [name for name in ("before", "after") if name in commands["flexsat --help"]]
-    named = {"before": f"before ({before})", "after": "after"}
+    named = {"before": f"before ({before})", "after": f"after ({after})" if after else "after"}
     lines = [
         BEGIN,
         f"Measured {time.strftime('%Y-%m-%d')} by `python bench/bench_startup.py "
-        f"--commands-only --breakdown{f' --before {before}' if before else ''} "
+        f"--commands-only --breakdown{f' --before {before}' if before else ''}"
+        f"{f' --after {after}' if after else ''} "
         f"--repeats {out['repeats']} --write-docs`. {harness.machine()}. Load average "
         f"{commands['load_start']} at the start, {commands['load_end']} at the end: the "
         "machine was shared, read the CPU columns (user + system of the process) and "
