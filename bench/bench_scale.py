@@ -1,10 +1,10 @@
 """Benchmark: 1000 random Monte Carlo cases of the thesis slew, full and reduced model,
 local pool and Dask, 1 and 2 workers, against the goal.
 
-Goal (campaigns at scale): 1000 random Monte Carlo cases of the 120 s thesis slew in
-<= 30 s on 2 cores with the reduced model (root translations locked, 20 ms step and
-control period), the full model (1 ms) beside it; >= 90 % parallel efficiency from 1
-to 2 workers, local and Dask. Each configuration runs the same cases into a fresh
+Goal (campaigns at scale, issue 46; issue 18 asked 30 s): 1000 random Monte Carlo cases
+of the 120 s thesis slew in <= 15 s on 2 cores with the reduced model (root translations
+locked, 20 ms step and control period), the full model (1 ms) beside it; >= 90 % parallel
+efficiency from 1 to 2 workers, local and Dask. Each configuration runs the same cases into a fresh
 temporary store; the wall time includes starting the workers. A one-worker run is
 confined to one core, with every process and thread it starts (``sched_setaffinity``):
 one worker on two cores would have a spare core for the campaign's own process (the
@@ -16,7 +16,10 @@ each task an ensemble). The CPU time per case is that of this process (threads
 included): given for the runs that stay in it. For the local pool on two workers it
 is split into this process's (storing results, resolving cases) and the workers'
 (``RUSAGE_CHILDREN``: the cases, their start-up and the transfers), which is what
-two cores must carry: 1000 cases in 30 s allow 0.060 CPU s per case in all.
+two cores must carry: 1000 cases in 15 s allow 0.030 CPU s per case in all. Each run's
+line gives the load average before and after it; the reduced rows end with their
+verdict against 15 s and the CPU s per case against 0.030 (the CPU time, which the
+load moves less than the wall time, says whether two quiet cores would meet the goal).
 
 ``--repeat N`` runs every configuration N times, the configurations in turn each
 time, and the table gives the best run of each (the runs are printed as they end):
@@ -53,7 +56,7 @@ from flexsat.campaigns import load_campaign, run_campaign
 from flexsat.campaigns.definition import CampaignDefinition, Reduced
 from flexsat.config import nominal, validate_config
 
-GOAL_S = 30.0  # 1000 reduced-model cases on 2 cores
+GOAL_S = 15.0  # 1000 reduced-model cases on 2 cores (issue 46; issue 18 asked 30 s)
 GOAL_EFFICIENCY = 0.9
 
 
@@ -101,7 +104,7 @@ TARGETS = (
 @harness.register(
     "1000 random Monte Carlo cases of the 120 s slew, reduced and full model, local pool, "
     "ensemble runner and Dask, 1 worker (on one core) and 2: wall time, cases/s, efficiency, "
-    "against 30 s and 90 %",
+    "against 15 s and 90 %",
     targets=TARGETS,
 )
 def main(argv: list[str] | None = None) -> dict:
@@ -136,6 +139,7 @@ def main(argv: list[str] | None = None) -> dict:
                            "ensemble": {"workers": workers, "runner": "ensemble"},
                            "dask": {"dask_local": workers}}[backend]  # fmt: skip
                 cpu, children = time.process_time(), harness.children_cpu_s()
+                before = harness.load()
                 with _cores(workers):
                     run = run_campaign(campaign, nominal(), store, n_random=args.cases,
                                        progress=False, **options)  # fmt: skip
@@ -151,14 +155,16 @@ def main(argv: list[str] | None = None) -> dict:
                                     (harness.children_cpu_s() - children) / n)  # fmt: skip
                 console.print(f"  {model:7s} {backend:8s} x{workers} (run {attempt + 1}): "
                               f"{wall:.1f} s ({n / wall:.2f} cases/s)"
-                              + (f", {(time.process_time() - cpu) / n:.3f} CPU s per case"
-                                 if here else ""))  # fmt: skip
+                              + (f", {(time.process_time() - cpu) / n:.4f} CPU s per case"
+                                 if here else "")
+                              + f"; load before {before}, after {harness.load()}")  # fmt: skip
                 shutil.rmtree(store)  # about 0.24 GB per 1000 cases: not kept N times over
     table = harness.table(
         f"{n} random Monte Carlo cases ({args.duration:g} s slews), best of "
         f"{args.repeat} run{'s' * (args.repeat > 1)}",
         ("model", "backend", "x1 (s)", "x2 (s)", "cases/s x2", "efficiency", "efficiency, pairs",
-         "1000 cases x2 (s)", "CPU s/case x1", "<= 30 s", ">= 90 %"), left=2,
+         "1000 cases x2 (s)", "CPU s/case x1", "CPU s/case x2", f"<= {GOAL_S:g} s", ">= 90 %"),
+        left=2,
     )  # fmt: skip
     results = {}
     for model in models:
@@ -172,21 +178,36 @@ def main(argv: list[str] | None = None) -> dict:
             speed = ("met" if per_1000 <= GOAL_S else "not met") if model == "reduced" else "-"
             scaling = "met" if efficiency >= GOAL_EFFICIENCY else "not met"
             cpu = cpus.get((model, backend, 1), float("nan"))
+            cpu_2 = cpus.get((model, backend, 2), float("nan"))
+            if backend == "local" and model in split:  # this process's and the workers'
+                cpu_2 = sum(split[model])
             table.add_row(model, backend, f"{one:.1f}", f"{two:.1f}", f"{n / two:.2f}",
-                          f"{efficiency:.0%}", f"{pairs:.0%}", f"{per_1000:.0f}",
-                          "-" if math.isnan(cpu) else f"{cpu:.3f}",  # NaN: run elsewhere
-                          speed, scaling)  # fmt: skip
+                          f"{efficiency:.0%}", f"{pairs:.0%}", f"{per_1000:.1f}",
+                          *("-" if math.isnan(c) else f"{c:.4f}" for c in (cpu, cpu_2)),
+                          speed, scaling)  # NaN: run elsewhere (Dask's workers)  # fmt: skip
             results[f"{model} {backend}"] = {"wall_1_s": one, "wall_2_s": two,
                                              "cases_per_s_2": n / two, "efficiency": efficiency,
                                              "efficiency_pairs": pairs,
                                              "per_1000_cases_2_s": per_1000,
-                                             "cpu_per_case_1_s": cpu}  # fmt: skip
+                                             "cpu_per_case_1_s": cpu,
+                                             "cpu_per_case_2_s_all": cpu_2}  # fmt: skip
     console.print(table)
     for model, (parent, workers) in split.items():
         console.print(f"{model} local x2, CPU s per case: {parent:.4f} parent + {workers:.4f} "
-                      f"workers = {parent + workers:.4f} (two cores at 30 s per 1000 cases: "
+                      f"workers = {parent + workers:.4f} (two cores at {GOAL_S:g} s per 1000 "
+                      f"cases: "
                       f"<= {2 * GOAL_S / 1000:.3f})")  # fmt: skip
         results[f"{model} local"]["cpu_per_case_2_s"] = {"parent": parent, "workers": workers}
+    for model_backend, row in results.items():  # the goal, wall time and CPU time
+        if model_backend.startswith("reduced"):
+            per_1000, cpu_2 = row["per_1000_cases_2_s"], row["cpu_per_case_2_s_all"]
+            verdict = "met" if per_1000 <= GOAL_S else "not met"
+            budget = 2 * GOAL_S / 1000  # two cores' CPU s per case at the goal
+            console.print(f"{model_backend} x2: {per_1000:.1f} s per 1000 cases against "
+                          f"{GOAL_S:g} s: {verdict}; "
+                          + ("CPU s per case not measured here" if math.isnan(cpu_2) else
+                             f"{cpu_2:.4f} CPU s per case against {budget:.3f}: "
+                             f"{'met' if cpu_2 <= budget else 'not met'}"))  # fmt: skip
     console.print(f"load {harness.load()}")
     return {"cases": n, "duration_s": args.duration, "results": results}
 

@@ -20,7 +20,7 @@ from __future__ import annotations
 from typing import NamedTuple
 
 import numpy as np
-from numba import config, njit, prange, set_num_threads, typeof
+from numba import config, njit, prange, set_num_threads, typeof, types
 
 from flexsat.compiled.typed_call import typed_append, typed_list
 from flexsat.simulate.loops import LoopClock, LoopRecords, rk4_closed_loop
@@ -32,6 +32,7 @@ __all__ = [
     "batch_item",
     "fly",
     "fly_batch",
+    "fly_entry",
     "fly_prepared",
     "item_type",
     "slew_timing",
@@ -288,6 +289,29 @@ def _overload(dispatcher, *types):
     if types not in dispatcher.overloads:
         dispatcher.compile(types)
     return dispatcher.overloads[types].entry_point
+
+
+def fly_entry(item: BatchItem):
+    """:func:`fly`'s compiled entry point for a slew's types, found without typing it.
+
+    Called as ``fly`` is, with the slew's own arrays (:func:`batch_item`'s fields in
+    order, then ``done``, ``rows`` and ``max_chunks`` as ints): the same machine code
+    as ``fly(...)``, without the dispatcher typing every argument at each call (about
+    a millisecond for a slew's hundred-odd arrays and kernels). The arguments must be
+    of the item's types (:func:`item_type`); the entry point does not check them.
+
+    Parameters
+    ----------
+    item : BatchItem
+        The slew, as flown.
+
+    Returns
+    -------
+    callable
+        ``(x, timing, stages, d, rec_t, rec_x, rec_ctrl, rec_frame, rec_Q, rec_solved,
+        plant, frame, done, rows, max_chunks) -> (status, steps_done, rows_written)``.
+    """
+    return _overload(fly, *item_type(item).types, types.int64, types.int64, types.int64)
 
 
 def fly_prepared(runs: list, threads: int = 1) -> np.ndarray:

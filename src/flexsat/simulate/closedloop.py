@@ -20,7 +20,7 @@ from flexsat.dynamics.attitude import identity_frame
 from flexsat.dynamics.plant import Plant
 from flexsat.dynamics.rigid import design_coordinates, rigid_inertia
 from flexsat.errors import ConfigError
-from flexsat.simulate.batch import fly, slew_timing
+from flexsat.simulate.batch import batch_item, fly_entry, slew_timing
 from flexsat.simulate.layout import LoopLayout
 from flexsat.simulate.loops import LoopData, LoopStages
 from flexsat.simulate.openloop import initial_state
@@ -183,12 +183,13 @@ def run_slew(
                           "actuators: remove [reference] and [joint_actuator]")  # fmt: skip
     steps = scenario.n_steps
     show = steps >= PROGRESS_MIN_STEPS if progress is None else progress
-    if controller is None:  # compile or load the loop now (no chunk): the wall time is the run's
-        fly(*_fly_arguments(run, 0, 0, 0))
+    flight = None
+    if controller is None:  # compile or load the loop now: the wall time is the run's
+        flight = fly_entry(batch_item(run))  # typed once, called untyped (docs/performance.md)
     start = time.perf_counter()
     with progress_bar(show, scenario.duration_s) as (bar, task):
         if controller is None:
-            status, done, rows = _compiled_loop(run, bar, task, stream)
+            status, done, rows = _compiled_loop(run, bar, task, stream, flight)
         else:
             status, done, rows = python_loop(plant, scenario, run.x, run.frame, run.stages,
                                              run.data, run.rec_t, run.rec_x, run.rec_ctrl,
@@ -427,10 +428,13 @@ def _slew_block(run: PreparedSlew, rows: int, attrs: dict,
     )  # fmt: skip
 
 
-def _compiled_loop(run: PreparedSlew, bar, task,
-                   stream: RecordStream | None = None) -> tuple[int, int, int]:  # fmt: skip
+def _compiled_loop(run: PreparedSlew, bar, task, stream: RecordStream | None = None,
+                   flight=None) -> tuple[int, int, int]:  # fmt: skip
     """The whole loop, stages and law included, in compiled chunks (one call without a bar
-    or a stream); a streamed run hands each full buffer of records to ``stream``."""
+    or a stream); a streamed run hands each full buffer of records to ``stream``.
+    ``flight``: :func:`~flexsat.simulate.batch.fly`'s entry point for the run's types
+    (:func:`~flexsat.simulate.batch.fly_entry`; default found here)."""
+    flight = flight or fly_entry(batch_item(run))
     scenario = run.scenario
     per_call = 1 if (bar is not None or stream is not None) else scenario.n_steps + 1
     # records of one chunk, plus the final step's and a failed run's last good state
@@ -439,7 +443,7 @@ def _compiled_loop(run: PreparedSlew, bar, task,
     status, done, rows = 0, 0, 0
     attrs = None
     while True:
-        status, done, rows = fly(*_fly_arguments(run, done, rows, per_call))
+        status, done, rows = flight(*_fly_arguments(run, done, rows, per_call))
         if bar is not None:
             bar.update(task, completed=done * scenario.dt_s)
         if status != 0 or done == scenario.n_steps:
