@@ -69,7 +69,21 @@ def test_parts_the_satellite_cannot_run_are_not_estimated():
     from flexsat.linear.export import modal_satellite
 
     modal = modal_satellite(Plant.from_config(nominal()), n_modes=3)
-    assert "laws" not in _study(quick=True, config=modal)
+    skipped = _study(quick=True, config=modal)
+    assert "laws" not in skipped
+    assert "robust" not in skipped  # a modal appendage has no uncertain model
+
+
+def test_the_robust_part_counts_its_two_flights_and_its_larger_full_grid():
+    # Independent count: the mu worst case and the sampled worst case, each held 60 s
+    # (docs/linear.md, 'In the study report'), one after the other; the full study's
+    # mu grid costs FULL_OVERHEAD_FACTOR times the quick one's.
+    quick, full = _study(quick=True)["robust"], _study(quick=False)["robust"]
+    for work, _ in (quick, full):
+        assert (work.runs, work.simulated_s, work.parallel) == (2, 120.0, 1)
+    ratio = estimate.FULL_OVERHEAD_FACTOR["robust"]
+    assert full[0].overhead_s == pytest.approx(ratio * quick[0].overhead_s, rel=1e-12)
+    assert "2 runs of 60 s" in quick[0].what and "mu on 8 frequencies" in quick[0].what
 
 
 def test_the_estimate_is_printed_with_its_basis_before_the_parts():
