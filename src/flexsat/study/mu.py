@@ -3,7 +3,10 @@
 The satellite's uncertain model (:mod:`flexsat.linear.uncertain`, the thesis's
 parameters) closed by the scenario's law linearized about rest (or a user's
 state-space controller), analysed by :func:`flexsat.linear.mu.analyze`; see
-docs/linear.md, 'Robust stability: mu'.
+docs/linear.md, 'Robust stability: mu'. :func:`robust_study` is the study's
+robustness part (the analysis, a seeded sampling check, the worst cases flown;
+docs/linear.md, 'In the study report'); :func:`case_factors` maps a campaign case
+onto the uncertain model's factors (docs/linear.md, 'The 24 critical cases').
 """
 
 from __future__ import annotations
