@@ -245,3 +245,51 @@ def test_bad_optional_keys_name_the_field(chain, tmp_path, change, field, says):
     with pytest.raises(ConfigError, match=field) as caught:
         load_modal_data(path)
     assert says in str(caught.value)
+
+
+def test_the_packed_invariants_give_the_datas_rows(chain):
+    # The kernels read the invariants from one packed matrix (J'' by its six distinct
+    # entries, the rows that meet eta and those that meet eta_dot each in one BLAS
+    # product). Each mode's rows at a random state, from the BLAS path (pass 1) and the
+    # pair-by-pair path (the other kernels), against the sums written out with numpy
+    # from the data turned to B by an oblique mount: equal to round-off (bound 1e-13 of
+    # the largest entry; seeded).
+    from scipy.spatial.transform import Rotation
+
+    from flexsat.dynamics.appendages import modal as kernels
+
+    print(f"seed {SEED}")
+    rng = np.random.default_rng(SEED)
+    R = Rotation.from_rotvec([0.4, -0.9, 0.3]).as_matrix()
+    data = modal_satellite(chain, 6).model_dump(exclude_none=True)
+    data["appendages"][0]["mount_matrix"] = R.tolist()
+    plant = Plant.from_config(validate_config(data))
+    modal = plant.config.appendages[0].modal()
+    n, p = modal.n_modes, plant.params[0]
+    C = modal.first_moment_hessian_array() @ R.T
+    E = modal.coupling_gradient_array() @ R.T
+    J2 = R @ modal.inertia_hessian_array() @ R.T
+    q, qd = rng.normal(size=(2, n))
+    expected = (np.einsum("klc,l->kc", C, q), np.einsum("klc,l->kc", E, q),
+                np.einsum("klab,l->kab", J2, q), np.einsum("klc,l->kc", C, qd),
+                np.einsum("klc,l->kc", E, qd), np.einsum("lkc,l->kc", E, qd))  # fmt: skip
+    work = np.zeros((1, plant.models[0].work_columns(p)))
+    kernels._second_sums(q, qd, 0, p, (0.1, -0.2, 0.3), work, 0, True)
+    ye = work[0, kernels.WORK_MODE * n :]
+    yd = ye[kernels.SO_ETA * n :]
+    for k in range(n):
+        b = kernels.P_MODES + kernels.MODE_SIZE * k
+        first = (
+            p[b + kernels.MODE_LT : b + kernels.MODE_LT + 3],
+            p[b + kernels.MODE_LR : b + kernels.MODE_LR + 3],
+            p[b + kernels.MODE_DJ : b + kernels.MODE_DJ + 9].reshape(3, 3),
+            0.0,
+            0.0,
+            0.0,
+        )
+        for path in (kernels._rows_at(p, k, ye, k, n, yd, k, n),
+                     kernels._mode_rows(q, qd, 0, p, k)):  # fmt: skip
+            for got, first_order, sums in zip(path, first, expected, strict=True):
+                want = first_order + sums[k]
+                scale = np.abs(want).max()
+                assert np.abs(np.asarray(got) - want).max() <= 1e-13 * scale

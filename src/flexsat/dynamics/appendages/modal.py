@@ -130,16 +130,19 @@ MODE_TIP = 8  # (3) tip mode-shape row, frame M [m / (sqrt(kg) m)]
 MODE_DJ = 11  # (9) J'_k = dJ_I / d eta_k, B, row-major [sqrt(kg) m]
 MODE_SIZE = 20
 # The large-motion invariants, frame B, as one row-major matrix A of SO_SIZE n rows and
-# n columns: A[r n + k, l] is component r of mode pair (k, l), so that A eta and
-# A eta_dot hold every mode's sums over l (two matrix-vector products, BLAS).
-SO_C = 0  # (3) C_kl = d^2 c~ / d eta_k d eta_l [1/m]
-SO_E = 3  # (3) E_kl = d h_k / d eta_l [-]
-SO_ET = 6  # (3) E_lk [-]
-SO_J = 9  # (9) J''_kl = d^2 J_I / d eta_k d eta_l [-]
-SO_SIZE = 18
-SO_RATE = 9  # rows r < SO_RATE of A are also multiplied by eta_dot
+# n columns: A[r n + k, l] is component r of mode pair (k, l), so that the rows that
+# meet eta (J'', C, E) and those that meet eta_dot (C, E, E^T) hold every mode's sums
+# over l in two matrix-vector products (BLAS): 21 n^2 multiply-adds (docs/model.md,
+# 'Large motion').
+SO_J = 0  # (6) J''_kl = d^2 J_I / d eta_k d eta_l, symmetric: xx, yy, zz, xy, xz, yz [-]
+SO_C = 6  # (3) C_kl = d^2 c~ / d eta_k d eta_l [1/m]
+SO_E = 9  # (3) E_kl = d h_k / d eta_l [-]
+SO_ET = 12  # (3) E_lk [-]
+SO_SIZE = 15
+SO_ETA = 12  # rows r < SO_ETA of A are multiplied by eta
+SO_RATE = 9  # rows r >= SO_C of A (SO_RATE of them) are multiplied by eta_dot
 WORK_MODE = 7  # per mode in pass 1's scratch: L_t,k(eta) (3), h_k(eta) (3), its force (1)
-# after those n WORK_MODE columns: A eta (SO_SIZE n), then A[:SO_RATE n] eta_dot
+# after those n WORK_MODE columns: A[:SO_ETA n] eta, then A[SO_C n:] eta_dot
 # On a drive, DRIVE_WORK more columns after those (at 0 for the first-order model):
 WD_R = 0  # (9) R_BF(alpha), row-major
 WD_MS = 9  # (6) M_I S = [B u; D u], frame F
@@ -335,8 +338,8 @@ def _mode_rows(q, qd, o, p, k):
         E = (p[c + SO_E * nn], p[c + (SO_E + 1) * nn], p[c + (SO_E + 2) * nn])
         ET = (p[c + SO_ET * nn], p[c + (SO_ET + 1) * nn], p[c + (SO_ET + 2) * nn])
         c = at + m + SO_J * nn
-        J2 = ((p[c], p[c + nn], p[c + 2 * nn]), (p[c + 3 * nn], p[c + 4 * nn], p[c + 5 * nn]),
-              (p[c + 6 * nn], p[c + 7 * nn], p[c + 8 * nn]))  # fmt: skip
+        J2 = _symmetric(p[c], p[c + nn], p[c + 2 * nn], p[c + 3 * nn], p[c + 4 * nn],
+                        p[c + 5 * nn])  # fmt: skip
         l_t = add(l_t, scale(e, C))
         h = add(h, scale(e, E))
         c_d = add(c_d, scale(e_dot, C))
@@ -347,19 +350,27 @@ def _mode_rows(q, qd, o, p, k):
 
 
 @njit(cache=True, error_model="numpy")
+def _symmetric(xx, yy, zz, xy, xz, yz):
+    """The symmetric 3 x 3 matrix of six distinct entries."""
+    return ((xx, xy, xz), (xy, yy, yz), (xz, yz, zz))
+
+
+@njit(cache=True, error_model="numpy")
 def _rows_at(p, k, ye, e0, es, yd, d0, ds):
-    """Mode k's rows from the products y_e = A eta (entry r at ye[e0 + r es]) and
-    y_d = A eta_dot (yd[d0 + r ds]): see :func:`_mode_rows`."""
+    """Mode k's rows from the products y_e = A[:SO_ETA n] eta (entry r at ye[e0 + r es])
+    and y_d = A[SO_C n:] eta_dot (entry r at yd[d0 + (r - SO_C) ds]): see
+    :func:`_mode_rows`."""
     b = P_MODES + MODE_SIZE * k
     l_t, h, J_k = load_seg(p, b + MODE_LT), load_seg(p, b + MODE_LR), load_m33_at(p, b + MODE_DJ)
-    c_d = (yd[d0 + SO_C * ds], yd[d0 + (SO_C + 1) * ds], yd[d0 + (SO_C + 2) * ds])
-    e_d = (yd[d0 + SO_E * ds], yd[d0 + (SO_E + 1) * ds], yd[d0 + (SO_E + 2) * ds])
-    et_d = (yd[d0 + SO_ET * ds], yd[d0 + (SO_ET + 1) * ds], yd[d0 + (SO_ET + 2) * ds])
+    c, e, t = d0, d0 + (SO_E - SO_C) * ds, d0 + (SO_ET - SO_C) * ds
+    c_d = (yd[c], yd[c + ds], yd[c + 2 * ds])
+    e_d = (yd[e], yd[e + ds], yd[e + 2 * ds])
+    et_d = (yd[t], yd[t + ds], yd[t + 2 * ds])
     l_t = add(l_t, (ye[e0 + SO_C * es], ye[e0 + (SO_C + 1) * es], ye[e0 + (SO_C + 2) * es]))
     h = add(h, (ye[e0 + SO_E * es], ye[e0 + (SO_E + 1) * es], ye[e0 + (SO_E + 2) * es]))
     j = e0 + SO_J * es
-    J2 = ((ye[j], ye[j + es], ye[j + 2 * es]), (ye[j + 3 * es], ye[j + 4 * es], ye[j + 5 * es]),
-          (ye[j + 6 * es], ye[j + 7 * es], ye[j + 8 * es]))  # fmt: skip
+    J2 = _symmetric(ye[j], ye[j + es], ye[j + 2 * es], ye[j + 3 * es], ye[j + 4 * es],
+                    ye[j + 5 * es])  # fmt: skip
     return l_t, h, _madd(J_k, J2, 1.0), c_d, e_d, et_d
 
 
@@ -377,13 +388,13 @@ def _second_sums(q, qd, o, p, omega, work, j, store):
     J, J_dot = load_m33_at(p, P_J_I), (z, z, z)
     n = int(p[P_N])
     w0 = WORK_MODE * n
-    ye = work[j, w0 : w0 + SO_SIZE * n]
-    yd = work[j, w0 + SO_SIZE * n : w0 + (SO_SIZE + SO_RATE) * n]
-    if store:  # A eta and A[:SO_RATE n] eta_dot into the scratch, by BLAS
+    ye = work[j, w0 : w0 + SO_ETA * n]
+    yd = work[j, w0 + SO_ETA * n : w0 + (SO_ETA + SO_RATE) * n]
+    if store:  # A[:SO_ETA n] eta and A[SO_C n:] eta_dot into the scratch, by BLAS
         at = int(p[P_SECOND_AT])
         A = p[at : at + SO_SIZE * n * n].reshape((SO_SIZE * n, n))
-        np.dot(A, q[o : o + n], ye)
-        np.dot(A[: SO_RATE * n], qd[o : o + n], yd)
+        np.dot(A[: SO_ETA * n], q[o : o + n], ye)
+        np.dot(A[SO_C * n :], qd[o : o + n], yd)
     for k in range(n):
         b = P_MODES + MODE_SIZE * k
         if store:
@@ -470,7 +481,7 @@ def _drive_rotation(p, alpha):
 @njit(cache=True, error_model="numpy")
 def _drive_work(p):
     """First scratch column of the drive's entries (after the large-motion ones)."""
-    return (WORK_MODE + SO_SIZE + SO_RATE) * int(p[P_N]) if p[P_SECOND_AT] > 0.0 else 0
+    return (WORK_MODE + SO_ETA + SO_RATE) * int(p[P_N]) if p[P_SECOND_AT] > 0.0 else 0
 
 
 @njit(cache=True, error_model="numpy")
@@ -1067,7 +1078,9 @@ class ModalModel(AppendageModel):
             pairs[:, :, SO_E : SO_E + 3] = E @ R.T
             pairs[:, :, SO_ET : SO_ET + 3] = (E @ R.T).transpose(1, 0, 2)
             J2 = R @ data.inertia_hessian_array() @ R.T
-            pairs[:, :, SO_J : SO_J + 9] = J2.reshape(n, n, 9)
+            J2 = 0.5 * (J2 + J2.transpose(0, 1, 3, 2))  # symmetric: its six entries
+            rows, cols = (0, 1, 2, 0, 0, 1), (0, 1, 2, 1, 2, 2)  # xx, yy, zz, xy, xz, yz
+            pairs[:, :, SO_J : SO_J + 6] = J2[:, :, rows, cols]
             blocks.append(pairs.transpose(2, 0, 1).ravel())
         return np.concatenate(blocks) if len(blocks) > 1 else row
 
@@ -1075,7 +1088,7 @@ class ModalModel(AppendageModel):
         # Pass 1 leaves each mode's rows at eta for pass 2 when the large-motion terms
         # are on, after the products A eta and A eta_dot.
         n = int(params[P_N])
-        columns = (WORK_MODE + SO_SIZE + SO_RATE) * n if params[P_SECOND_AT] > 0.0 else 0
+        columns = (WORK_MODE + SO_ETA + SO_RATE) * n if params[P_SECOND_AT] > 0.0 else 0
         return columns + (DRIVE_WORK if params[P_DRIVE] > 0.0 else 0)
 
     @staticmethod
