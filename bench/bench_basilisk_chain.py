@@ -13,6 +13,9 @@ comparison times it: for each engine and N, a discarded warm-up of
   ``spinningBodyNDOFStateEffector`` and, if the wheel ships it, MuJoCo, without
   recorders; building and ``InitializeSimulation`` are not timed.
 
+``--trials K --best``: the shortest of K trials instead, for every engine alike (on a
+loaded machine interference only adds time, and the median of 5 moves by 2x).
+
 Goal: at every N at least twice as fast as the fastest Basilisk engine (the goal of
 the hinge-specialized recursion; the earlier 10x was not reached by any chain version),
 and a cost linear in N (least-squares line of the per-step time against N: slope,
@@ -22,6 +25,7 @@ Run ``python bench/bench_basilisk_chain.py`` (Basilisk: ``pip install -e '.[benc
 
 from __future__ import annotations
 
+import argparse
 import sys
 
 import numpy as np
@@ -37,8 +41,9 @@ GOAL_RATIO = 2.0
 RECORD_EVERY = 10
 
 
-def time_flexsat(n: int) -> float:
-    """Median wall time of the fixed step budget [s] (integration only)."""
+def time_flexsat(n: int, trials: int = fp.TIMING_TRIALS, pick=np.median) -> float:
+    """Median (or ``pick``) wall time of the fixed step budget over ``trials`` [s]
+    (integration only)."""
     plant = Plant.from_config(validate_config(fp.flexsat_config(n)))
     dt = fp.time_step(n)
 
@@ -50,23 +55,24 @@ def time_flexsat(n: int) -> float:
     run_openloop(plant, scenario(fp.TIMING_WARMUP_STEPS), progress=False)
     budget = scenario(fp.TIMING_STEPS)
     walls = [run_openloop(plant, budget, progress=False).dataset.attrs["wall_time_s"]
-             for _ in range(fp.TIMING_TRIALS)]  # fmt: skip
-    return float(np.median(walls))
+             for _ in range(trials)]  # fmt: skip
+    return float(pick(walls))
 
 
-def time_basilisk(bsk, build, n: int) -> float:
-    """Median ``ExecuteSimulation`` time of the fixed step budget [s], as Basilisk's
-    comparison measures it (fresh model per trial, warm-up discarded)."""
+def time_basilisk(bsk, build, n: int, trials: int = fp.TIMING_TRIALS, pick=np.median) -> float:
+    """Median (or ``pick``) ``ExecuteSimulation`` time of the fixed step budget over
+    ``trials`` [s], as Basilisk's comparison measures it (fresh model per trial,
+    warm-up discarded)."""
     dt = fp.time_step(n)
     warm = build(bsk, n, dt, False)
     warm.sim.ConfigureStopTime(bsk.macros.sec2nano(fp.TIMING_WARMUP_STEPS * dt))
     warm.sim.ExecuteSimulation()
     walls = []
-    for _ in range(fp.TIMING_TRIALS):
+    for _ in range(trials):
         model = build(bsk, n, dt, False)
         model.sim.ConfigureStopTime(bsk.macros.sec2nano(fp.TIMING_STEPS * dt))
         walls.append(harness.stopwatch(model.sim.ExecuteSimulation).wall_s)
-    return float(np.median(walls))
+    return float(pick(walls))
 
 
 def linear_fit(n: np.ndarray, us: np.ndarray) -> tuple[float, float, float]:
@@ -77,16 +83,17 @@ def linear_fit(n: np.ndarray, us: np.ndarray) -> tuple[float, float, float]:
     return float(b), float(a), r2
 
 
-def compare(counts: tuple[int, ...] = fp.SEGMENT_COUNTS) -> dict:
+def compare(counts: tuple[int, ...] = fp.SEGMENT_COUNTS, trials: int = fp.TIMING_TRIALS,
+            pick=np.median) -> dict:  # fmt: skip
     """Per-step times [us] of flexsat and each Basilisk engine for each N."""
     bsk = fp.import_basilisk()
     engines = fp.engines(bsk)
     rows = []
     for n in counts:
         row = {"N": n, "dof": 6 + 4 * n, "dt_s": fp.time_step(n),
-               "flexsat": 1e6 * time_flexsat(n) / fp.TIMING_STEPS}  # fmt: skip
+               "flexsat": 1e6 * time_flexsat(n, trials, pick) / fp.TIMING_STEPS}  # fmt: skip
         for name, build in engines.items():
-            row[name] = 1e6 * time_basilisk(bsk, build, n) / fp.TIMING_STEPS
+            row[name] = 1e6 * time_basilisk(bsk, build, n, trials, pick) / fp.TIMING_STEPS
         row["fastest"] = min(engines, key=lambda e: row[e])
         row["ratio"] = row[row["fastest"]] / row["flexsat"]
         rows.append(row)
@@ -101,7 +108,14 @@ def compare(counts: tuple[int, ...] = fp.SEGMENT_COUNTS) -> dict:
     "spinningBodyNDOFStateEffector and MuJoCo; ratio against the 2x goal",
     optional=True,
 )
-def main() -> int:
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--trials", type=int, default=fp.TIMING_TRIALS,
+                        help="trials per engine and N (default: the comparison's)")  # fmt: skip
+    parser.add_argument("--best", action="store_true",
+                        help="the shortest trial instead of the median (a loaded machine "
+                        "only adds time), for every engine alike")  # fmt: skip
+    args = parser.parse_args(argv)
     console = harness.console(200)
     try:
         fp.import_basilisk()
@@ -109,11 +123,12 @@ def main() -> int:
         print(INSTALL_HINT)
         return 0
     console.print(f"{harness.machine()}; load average {harness.load()} (1, 5, 15 min)")
-    out = compare()
+    out = compare(trials=args.trials, pick=np.min if args.best else np.median)
     engines = out["engines"]
     table = harness.table(
         f"Hinged flexible panels (Basilisk's comparison scenario), µs per RK4 step: "
-        f"median of {fp.TIMING_TRIALS} x {fp.TIMING_STEPS} steps, Basilisk {out['version']}",
+        f"{'best' if args.best else 'median'} of {args.trials} x {fp.TIMING_STEPS} steps, "
+        f"Basilisk {out['version']}",
         ("N", "DOF", "dt ms", "flexsat", *engines, "ratio", "goal"), left=0, no_wrap=True,
         caption=f"ratio: fastest Basilisk engine / flexsat; goal >= {GOAL_RATIO:g}x",
     )  # fmt: skip
