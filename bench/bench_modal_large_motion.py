@@ -9,9 +9,11 @@ plant from a compiled loop (best of 5), which is what an RK4 step costs four tim
 
 Target: at 24 modes the terms cost at most 1.5 times the first-order step. The
 large-motion sums run over every pair of modes (n^2 per step, where the first-order
-model is linear in n): two matrix-vector products (BLAS) of the invariants' 18 n x n
-matrix with eta and of its first 9 n rows with eta_dot, 27 n^2 multiply-adds, against
-a first-order step of some hundred per mode. The table's last column is the growth,
+model is linear in n): two matrix-vector products (BLAS) of the invariants' packed
+15 n x n matrix (J'' by its six distinct entries), its 12 n rows J'', C, E with eta and
+its 9 n rows C, E, E^T with eta_dot, 21 n^2 multiply-adds (27 n^2 before J'' was
+stored symmetric and the rows E^T stopped meeting eta), against a first-order step
+of some hundred per mode. The table's last column is the growth,
 the fit of the extra cost against n^2 states it; the target is not met at 24 modes
 (the n^2 products alone are several first-order steps there). Run with
 ``python bench/bench_modal_large_motion.py`` (``--quick``: 6 and 24 modes).
