@@ -368,6 +368,13 @@ def robust_analyze(
     points: Annotated[int, typer.Option(help="Log-spaced frequencies, 1e-3 ... 200 Hz.")] = 60,
     json_output: JsonOption = False,
     out: Annotated[Path | None, typer.Option(help="Write mu.json and mu.png here.")] = None,
+    bound: Annotated[
+        str,
+        typer.Option(
+            help="mu upper bound: diagonal (D, G diagonal, fast) or lmi (full D, G "
+            "blocks at the peak frequencies; needs cvxpy)."
+        ),
+    ] = "diagonal",
 ) -> None:
     """mu-analysis of the loop over the thesis's parameter box: bounds, k_max, worst case.
 
@@ -379,7 +386,7 @@ def robust_analyze(
 
     slew_scenario = None if scenario is None else load_slew(scenario)
     cfg = load_config(config)
-    summary = robust_analysis(cfg, slew_scenario, controller, sadm_angle, points, out)
+    summary = robust_analysis(cfg, slew_scenario, controller, sadm_angle, points, out, bound)
     if json_output:
         typer.echo(dumps(summary))
         return
@@ -387,7 +394,11 @@ def robust_analyze(
     print_table(_console, f"Uncertain parameters — {summary['config_name']}",
                 ("parameter", "low [-]", "high [-]", "channels"), rows)  # fmt: skip
     rows = [
-        ["mu upper bound (peak)", summary["peak_upper"], summary["peak_frequency_hz"]],
+        [
+            f"mu upper bound (peak, {summary['bound']})",
+            summary["peak_upper"],
+            summary["peak_frequency_hz"],
+        ],
         ["mu lower bound", summary["lower"], summary["lower_frequency_hz"]],
         ["k_max, certified (1/upper)", summary["k_max_lower"], ""],
         ["k_max, not above (1/lower)", summary["k_max_upper"], ""],
@@ -415,8 +426,18 @@ def robust_synthesize(
         float, typer.Option(help="Control period it is discretized at [s] (the loop's).")
     ] = 1e-3,
     json_output: JsonOption = False,
+    method: Annotated[
+        str,
+        typer.Option(
+            help="hinf (H-infinity mixed sensitivity) or dk (mu-synthesis by D-K "
+            "iteration against the parameter box's inertia range; needs dkpy)."
+        ),
+    ] = "hinf",
+    iterations: Annotated[
+        int, typer.Option(help="--method dk: D-K steps after the first design, 1 ... 10.")
+    ] = 3,
 ) -> None:
-    """H-infinity mixed-sensitivity design of an attitude controller for the statespace law.
+    """H-infinity or mu (D-K) design of an attitude controller for the statespace law.
 
     Weights from the requirements (R1 and R2 bands, the torque limit, the first mode's
     damping: docs/control.md); reduced by balanced truncation, discretized (Tustin).
@@ -428,6 +449,10 @@ def robust_synthesize(
     from flexsat.linear import linearize
     from flexsat.linear.hinf import synthesize
 
+    if method not in ("hinf", "dk"):
+        raise ConfigError(f"--method: hinf or dk, got {method!r}")
+    if not 1 <= iterations <= 10:
+        raise ConfigError(f"--iterations: must be in 1 ... 10, got {iterations}")
     if out.suffix.lower() not in (".npz", ".mat"):
         raise ConfigError(f"--out: the suffix must be .npz or .mat, got {out.suffix or 'none'!r}")
     if not out.parent.is_dir():
@@ -439,25 +464,39 @@ def robust_synthesize(
     if not (math.isfinite(control_dt) and 0.0 < control_dt <= 10.0):
         raise ConfigError(f"--control-dt: must be in (0, 10] s, got {control_dt:g}")
     cfg = load_config(config)
-    design = synthesize(linearize(Plant.from_config(cfg)), control_dt, order, modes)
+    model = linearize(Plant.from_config(cfg))
+    if method == "dk":
+        from flexsat.linear.dk import synthesize_dk
+        from flexsat.linear.uncertain import uncertain_model
+
+        dk = synthesize_dk(model, uncertain_model(cfg), control_dt, order, modes,
+                           n_iterations=iterations)  # fmt: skip
+        design, gamma, full = dk, dk.result.gammas[-1], dk.result.controller.nstates
+        extra = {"mu_history": list(dk.result.mu_history), "mu": dk.result.mu,
+                 "input_uncertainty": dk.r0, "stopped": dk.result.stopped}  # fmt: skip
+    else:
+        design = synthesize(model, control_dt, order, modes)
+        gamma, full, extra = design.gamma, design.controller.nstates, {}
     save_controller(design.discrete, out)
     summary = {
-        "config_name": cfg.name, "gamma": design.gamma,
-        "full_order": int(design.controller.nstates), "order": int(design.reduced.nstates),
+        "config_name": cfg.name, "method": method, "gamma": gamma,
+        "full_order": int(full), "order": int(design.reduced.nstates),
         "reduction_bound": design.reduction_bound, "control_dt_s": control_dt,
-        "modes": modes, "file": str(out),
+        "modes": modes, "file": str(out), **extra,
     }  # fmt: skip
     if json_output:
         typer.echo(dumps(summary))
         return
-    rows = [
+    rows = [[f"mu after D-K step {i}", m] for i, m in enumerate(extra.get("mu_history", []))]
+    rows += [
         ["gamma = ||T_zw||_inf bound", summary["gamma"]],
         ["full controller order", summary["full_order"]],
         ["reduced order (balanced truncation)", summary["order"]],
         ["reduction error bound [N m per unit input]", summary["reduction_bound"]],
         ["control period [s]", control_dt],
     ]
-    print_table(_console, f"H-infinity controller — {cfg.name}", ("quantity", "value"), rows)
+    title = "mu (D-K) controller" if method == "dk" else "H-infinity controller"
+    print_table(_console, f"{title} — {cfg.name}", ("quantity", "value"), rows)
     _console.print(f'wrote {out} (kind = "statespace", file = "{out.name}")')
 
 

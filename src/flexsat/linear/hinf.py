@@ -181,7 +181,7 @@ def design_plant(model: LinearModel, n_modes: int) -> LinearModel:
     )  # fmt: skip
 
 
-def generalized_plant(plant: LinearModel, weights: HinfWeights):
+def generalized_plant(plant: LinearModel, weights: HinfWeights, input_uncertainty: float = 0.0):
     """The generalized plant P of the module docstring as a ``control.StateSpace``.
 
     Parameters
@@ -190,12 +190,18 @@ def generalized_plant(plant: LinearModel, weights: HinfWeights):
         From :func:`design_plant` (6 outputs theta, omega; 3 torque inputs).
     weights : HinfWeights
         The weights.
+    input_uncertainty : float
+        r0 >= 0 [-]: when positive, an input multiplicative uncertainty channel is
+        added first, ``z_I = r0 u`` and ``w_I`` summed into the torque the plant
+        receives, so that ``w_I = Delta_I z_I`` makes ``u_in = (I + r0 Delta_I) u``
+        (the D-K design of :mod:`flexsat.linear.dk`).
 
     Returns
     -------
     control.StateSpace
         Inputs ``d[0..2], n[0..5], u[0..2]``; outputs ``z1[0..2]`` (W_p theta),
-        ``z2[0..2]`` (W_u u), ``z3[0..2]`` (W_r omega), ``y[0..5]``.
+        ``z2[0..2]`` (W_u u), ``z3[0..2]`` (W_r omega), ``y[0..5]``; with
+        ``input_uncertainty`` > 0, inputs ``wI[0..2]`` and outputs ``zI[0..2]`` first.
     """
     import control
 
@@ -204,7 +210,9 @@ def generalized_plant(plant: LinearModel, weights: HinfWeights):
     G = control.ss(plant.A, plant.B, plant.C, plant.D, name="G",
                    inputs=[f"uin[{i}]" for i in idx3],
                    outputs=[f"th[{i}]" for i in idx3] + [f"w[{i}]" for i in idx3])  # fmt: skip
-    add = control.summing_junction(inputs=["u", "dd"], output="uin", dimension=3, name="add")
+    uncertain = input_uncertainty > 0.0
+    add = control.summing_junction(inputs=["u", "dd", "wI"] if uncertain else ["u", "dd"],
+                                   output="uin", dimension=3, name="add")  # fmt: skip
     d_in, d_out = [f"d[{i}]" for i in idx3], [f"dd[{i}]" for i in idx3]
     dscale = control.ss([], [], [], weights.disturbance_nm * I3, name="dscale",
                         inputs=d_in, outputs=d_out)  # fmt: skip
@@ -223,12 +231,17 @@ def generalized_plant(plant: LinearModel, weights: HinfWeights):
     meas = control.ss([], [], [], np.hstack([np.eye(6), noise]), name="meas",
                       inputs=[f"th[{i}]" for i in idx3] + [f"w[{i}]" for i in idx3]
                       + [f"n[{i}]" for i in idx6], outputs=[f"y[{i}]" for i in idx6])  # fmt: skip
-    return control.interconnect(
-        [G, add, dscale, Wp, Wu, Wr, meas],
-        inputs=[f"d[{i}]" for i in idx3] + [f"n[{i}]" for i in idx6] + [f"u[{i}]" for i in idx3],
-        outputs=[f"z1[{i}]" for i in idx3] + [f"z2[{i}]" for i in idx3]
-        + [f"z3[{i}]" for i in idx3] + [f"y[{i}]" for i in idx6],
-    )  # fmt: skip
+    systems = [G, add, dscale, Wp, Wu, Wr, meas]
+    inputs = [f"d[{i}]" for i in idx3] + [f"n[{i}]" for i in idx6] + [f"u[{i}]" for i in idx3]
+    outputs = ([f"z1[{i}]" for i in idx3] + [f"z2[{i}]" for i in idx3]
+               + [f"z3[{i}]" for i in idx3] + [f"y[{i}]" for i in idx6])  # fmt: skip
+    if uncertain:
+        systems.append(control.ss([], [], [], input_uncertainty * I3, name="WI",
+                                  inputs=[f"u[{i}]" for i in idx3],
+                                  outputs=[f"zI[{i}]" for i in idx3]))  # fmt: skip
+        inputs = [f"wI[{i}]" for i in idx3] + inputs
+        outputs = [f"zI[{i}]" for i in idx3] + outputs
+    return control.interconnect(systems, inputs=inputs, outputs=outputs)
 
 
 def _as_model(K) -> LinearModel:

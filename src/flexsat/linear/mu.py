@@ -26,6 +26,7 @@ can grow (or must shrink) before the loop can lose stability.
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 
@@ -40,7 +41,9 @@ __all__ = [
     "MuAnalysis",
     "analyze",
     "closed_loop",
+    "lmi_certificate",
     "mu_upper_bound",
+    "mu_upper_bound_lmi",
     "stability_boundary",
 ]
 
@@ -198,6 +201,167 @@ def mu_upper_bound(
     return float(np.sqrt(max(lam, 0.0))), best[:n], best[n:] * real
 
 
+def _require_cvxpy():
+    """Import cvxpy or raise one ConfigError naming the extra that brings it."""
+    try:
+        import cvxpy
+    except ImportError:
+        raise ConfigError(
+            "the LMI mu bound (full D, G scalings) needs cvxpy: pip install 'flexsat[robust]'"
+        ) from None
+    return cvxpy
+
+
+def lmi_certificate(N: np.ndarray, D: np.ndarray, G: np.ndarray) -> float:
+    """The mu upper bound that given scalings D, G certify (Fan, Tits and Doyle 1991).
+
+    If ``N^H D N + j (G N - N^H G) <= beta^2 D`` then ``mu(N) <= beta``; the least such
+    beta is the largest generalized eigenvalue of the pencil, computed here with
+    ``D = L L^H``: ``beta^2 = lambda_max(L^-1 (N^H D N + j (G N - N^H G)) L^-H)``.
+
+    Parameters
+    ----------
+    N : ndarray, shape (n, n)
+        The complex matrix seen by Delta [-].
+    D : ndarray, shape (n, n)
+        Hermitian positive definite, block diagonal in Delta's structure [-].
+    G : ndarray, shape (n, n)
+        Hermitian, block diagonal, zero on complex blocks [-].
+
+    Returns
+    -------
+    float
+        The certified bound beta [-] (``inf`` if D is not positive definite).
+    """
+    D = 0.5 * (D + D.conj().T)
+    G = 0.5 * (G + G.conj().T)
+    try:
+        L = np.linalg.cholesky(D)
+    except np.linalg.LinAlgError:
+        return float("inf")
+    H = N.conj().T @ D @ N + 1j * (G @ N - N.conj().T @ G)
+    X = np.linalg.solve(L, np.linalg.solve(L, H.conj().T).conj().T)  # L^-1 H L^-H
+    lam = np.linalg.eigvalsh(0.5 * (X + X.conj().T))[-1]
+    return float(np.sqrt(max(lam, 0.0)))
+
+
+def mu_upper_bound_lmi(
+    N: np.ndarray,
+    blocks: np.ndarray,
+    real: np.ndarray,
+    beta0: float | None = None,
+    rtol: float = 1e-3,
+    max_steps: int = 30,
+    solver: str | None = None,
+) -> tuple[float, np.ndarray, np.ndarray]:
+    """mu upper bound with full D and G blocks for repeated scalar blocks (an LMI).
+
+    For ``Delta = diag(delta_i I_{r_i})`` the scalings commuting with Delta are
+    ``D = diag(D_i)``, D_i Hermitian positive definite r_i x r_i, and on the real
+    blocks ``G = diag(G_i)``, G_i Hermitian (zero on complex ones); then
+    ``mu(N) <= beta`` whenever ``N^H D N + j (G N - N^H G) - beta^2 D <= 0`` (Fan, Tits
+    and Doyle 1991; Young, "Robustness analysis with real parametric and dynamic
+    uncertainty", PhD thesis, Caltech 1993). The least beta is a generalized
+    eigenvalue problem, solved by bisection on beta: at each beta the SDP ``min t``
+    s.t. ``N^H D N + j (G N - N^H G) - beta^2 D <= t I``, ``sum tr D_i = n``,
+    ``D_i >= 1e-6 I`` (cvxpy); its D, G certify :func:`lmi_certificate` (computed
+    exactly, whatever the solver's accuracy), which lowers the upper end when it is
+    at most beta; otherwise beta is the new lower end. The upper end starts at the
+    diagonal bound (D, G diagonal, :func:`mu_upper_bound`), which is always valid.
+
+    Parameters
+    ----------
+    N : ndarray, shape (n, n)
+        Complex matrix seen by Delta [-].
+    blocks : ndarray of int, shape (n,)
+        The block (parameter) of each channel; channels of one block share delta [-].
+    real : ndarray of bool, shape (n_blocks,)
+        True for a real parameter (it gets a G block) [-].
+    beta0 : float, optional
+        The first beta tried (a neighbouring frequency's bound) [-]; default half the
+        diagonal D-G bound (:func:`mu_upper_bound`).
+    rtol : float
+        Stop when the bisection's interval is below this, relative to its upper end
+        [-].
+    max_steps : int
+        At most this many SDPs.
+    solver : str, optional
+        cvxpy's solver name; default Clarabel (interior point).
+
+    Returns
+    -------
+    bound : float
+        The certified bound [-]: never above ``beta0`` nor the diagonal bound.
+    D, G : ndarray, shape (n, n)
+        The certifying scalings (``lmi_certificate(N, D, G) == bound``) [-].
+
+    Raises
+    ------
+    ConfigError
+        cvxpy missing (the ``robust`` extra).
+    """
+    cp = _require_cvxpy()
+    n = N.shape[0]
+    blocks = np.asarray(blocks, dtype=int)
+    real = np.asarray(real, dtype=bool)
+    real_ch = real[blocks]
+    b_diag, x, g = mu_upper_bound(N, real_ch)
+    best = (b_diag, np.diag(np.exp(x)).astype(complex), np.diag(g).astype(complex))
+    beta = b_diag if beta0 is None else min(float(beta0), b_diag)
+    if beta <= 0.0:
+        return best
+    terms_h, terms_d, Ds, Gs = [], [], [], []
+    for i in np.unique(blocks):
+        idx = np.flatnonzero(blocks == i)
+        r = idx.size
+        E = np.zeros((r, n))
+        E[np.arange(r), idx] = 1.0
+        Ni = N[idx]
+        Di = cp.Variable((r, r), hermitian=True)
+        Ds.append((idx, Di))
+        terms_h.append(Ni.conj().T @ Di @ Ni)
+        terms_d.append(E.T @ Di @ E)
+        if real[i]:
+            Gi = cp.Variable((r, r), hermitian=True)
+            Gs.append((idx, Gi))
+            terms_h.append(1j * (E.T @ Gi @ Ni - Ni.conj().T @ Gi @ E))
+    beta2 = cp.Parameter(nonneg=True)
+    t = cp.Variable()
+    lmi = sum(terms_h[1:], terms_h[0]) - beta2 * sum(terms_d[1:], terms_d[0])
+    cons = [lmi << t * np.eye(n), sum(cp.real(cp.trace(Di)) for _, Di in Ds) == n]
+    cons += [Di >> 1e-6 * np.eye(Di.shape[0]) for _, Di in Ds]
+    problem = cp.Problem(cp.Minimize(t), cons)
+    lo, hi = 0.0, beta
+    beta = 0.5 * hi if beta0 is None else beta  # a given beta0 is tried first
+    for _ in range(max_steps):
+        beta2.value = beta**2
+        try:
+            with warnings.catch_warnings():  # an inaccurate solve still gives D, G to check
+                warnings.simplefilter("ignore")
+                problem.solve(solver=solver or cp.CLARABEL)
+            ok = problem.status in ("optimal", "optimal_inaccurate") and t.value is not None
+        except cp.SolverError:
+            ok = False
+        b_new = float("inf")
+        if ok:
+            D = np.zeros((n, n), complex)
+            G = np.zeros((n, n), complex)
+            for idx, Di in Ds:
+                D[np.ix_(idx, idx)] = Di.value
+            for idx, Gi in Gs:
+                G[np.ix_(idx, idx)] = Gi.value
+            b_new = lmi_certificate(N, D, G)  # exact, whatever the solver's accuracy
+            if b_new < best[0]:
+                best = (b_new, D, G)
+        hi = min(hi, best[0])
+        if b_new > beta:  # not certified at beta: mu's bound lies above
+            lo = beta
+        if hi - lo <= rtol * hi:
+            break
+        beta = 0.5 * (lo + hi)
+    return best
+
+
 def _poles_max_real(model: UncertainModel, loop, delta: np.ndarray) -> tuple[float, float]:
     """(max Re, ‖Im‖ of that pole) of the closed loop at the parameter point delta."""
     A, B, C, D = loop
@@ -276,6 +440,11 @@ class MuAnalysis:
         Each parameter's factor on its nominal value there [-].
     nominal_stable : bool
         Whether the loop at Delta = 0 (the box's centre) is stable.
+    bound : str
+        ``"diagonal"`` (D, G diagonal) or ``"lmi"`` (full D, G blocks at the
+        frequencies ``lmi_frequencies_hz``, the diagonal bound elsewhere).
+    lmi_frequencies_hz : ndarray
+        Where the LMI bound was computed [Hz].
     """
 
     frequencies_hz: np.ndarray
@@ -288,6 +457,8 @@ class MuAnalysis:
     worst_delta: np.ndarray
     worst_factors: dict = field(default_factory=dict)
     nominal_stable: bool = True
+    bound: str = "diagonal"
+    lmi_frequencies_hz: np.ndarray = field(default_factory=lambda: np.zeros(0))
 
     def to_dict(self) -> dict:
         """Plain data for JSON."""
@@ -303,6 +474,8 @@ class MuAnalysis:
             "worst_delta": self.worst_delta.tolist(),
             "worst_factors": self.worst_factors,
             "nominal_stable": self.nominal_stable,
+            "bound": self.bound,
+            "lmi_frequencies_hz": self.lmi_frequencies_hz.tolist(),
         }
 
 
@@ -342,6 +515,8 @@ def analyze(
     refine: bool = True,
     maxiter: int = 200,
     add_modes: bool = True,
+    bound: str = "diagonal",
+    lmi_points: int = 3,
 ) -> MuAnalysis:
     """Robust stability of a loop: mu bounds, k_max and the worst parameter point.
 
@@ -360,11 +535,23 @@ def analyze(
     add_modes : bool
         Add the closed loop's modal frequencies at the box's centre (within the
         grid's span) to the grid.
+    bound : str
+        ``"diagonal"``: the D-G bound with diagonal scalings everywhere (fast);
+        ``"lmi"``: then the full-block LMI bound (:func:`mu_upper_bound_lmi`) at the
+        grid's highest frequencies, in decreasing order of the diagonal bound, until
+        the next diagonal value is below the largest LMI value (the peak is then
+        settled) or ``lmi_points`` are done.
+    lmi_points : int
+        At most this many LMI frequencies (each costs an SDP bisection).
 
     Returns
     -------
     MuAnalysis
     """
+    if bound not in ("diagonal", "lmi"):
+        raise ConfigError(f"bound: 'diagonal' or 'lmi', got {bound!r}")
+    if bound == "lmi":
+        _require_cvxpy()
     loop = closed_loop(model, controller)
     poles = np.linalg.eigvals(loop[0])
     nominal_stable = bool(np.max(poles.real) < 0.0)
@@ -397,6 +584,21 @@ def analyze(
             peak, f_peak = float(-res.fun), float(10**res.x)
             j = int(np.searchsorted(f, f_peak))
             f, upper = np.insert(f, j, f_peak), np.insert(upper, j, peak)
+    lmi_f: list[float] = []
+    if bound == "lmi":
+        upper = upper.copy()
+        real_blocks = np.ones(len(model.parameters), dtype=bool)
+        settled = 0.0  # the largest LMI value so far
+        for k in np.argsort(upper)[::-1][:lmi_points]:
+            if upper[k] <= settled:
+                break
+            b = mu_upper_bound_lmi(_response(loop, 2 * np.pi * f[k]), model.channel_parameter,
+                                   real_blocks, beta0=None)[0]  # fmt: skip
+            upper[k] = min(upper[k], b)
+            settled = max(settled, upper[k])
+            lmi_f.append(float(f[k]))
+        k = int(np.argmax(upper))
+        peak, f_peak = float(upper[k]), float(f[k])
     n_p = len(model.parameters)
     vertices = np.array(np.meshgrid(*[[-1.0, 1.0]] * n_p)).reshape(n_p, -1).T
     axes = np.vstack([np.eye(n_p), -np.eye(n_p)])
@@ -409,5 +611,6 @@ def analyze(
         frequencies_hz=f, upper=upper, peak_upper=peak, peak_frequency_hz=f_peak,
         lower=lower, lower_frequency_hz=float(w_cross / (2 * np.pi)) if lower else float("nan"),
         k_max=(1.0 / peak if peak > 0 else float("inf"), alpha), worst_delta=worst,
-        worst_factors=factors, nominal_stable=nominal_stable,
+        worst_factors=factors, nominal_stable=nominal_stable, bound=bound,
+        lmi_frequencies_hz=np.array(sorted(lmi_f)),
     )  # fmt: skip

@@ -20,6 +20,7 @@ from flexsat.errors import ConfigError
 from flexsat.study.outputs import prepare_output_dir, write_json
 
 __all__ = [
+    "BOUNDS",
     "POINTS_RANGE",
     "case_factors",
     "decay_rate",
@@ -30,6 +31,8 @@ __all__ = [
     "robust_study",
 ]
 
+BOUNDS = ("diagonal", "lmi")
+"""The mu upper bounds ``--bound`` selects (docs/linear.md, 'Robust stability: mu')."""
 POINTS_RANGE = (8, 2000)
 """Allowed number of log-spaced frequencies of the grid (the modal frequencies are added)."""
 _BAND_HZ = (1e-3, 200.0)
@@ -146,6 +149,7 @@ def robust_analysis(
     sadm_angle_deg: float | None = None,
     points: int = 60,
     out: str | Path | None = None,
+    bound: str = "diagonal",
 ) -> dict:
     """mu-analysis of the satellite's loop over the thesis's parameter box.
 
@@ -164,6 +168,9 @@ def robust_analysis(
         Log-spaced frequencies over 1e-3 ... 200 Hz, within :data:`POINTS_RANGE`.
     out : str or Path, optional
         Folder for ``mu.json`` and ``mu.png``.
+    bound : str
+        ``"diagonal"`` or ``"lmi"`` (full D, G blocks at the peak frequencies; needs
+        cvxpy): :func:`flexsat.linear.mu.analyze`.
 
     Returns
     -------
@@ -178,6 +185,8 @@ def robust_analysis(
         ``points`` out of range, a bad controller file, a satellite the uncertain
         model cannot be built for.
     """
+    if bound not in BOUNDS:
+        raise ConfigError(f"--bound: one of {', '.join(BOUNDS)}, got {bound!r}")
     lo, hi = POINTS_RANGE
     if not lo <= points <= hi:
         raise ConfigError(f"--points: the frequency grid needs {lo} ... {hi} points, got {points}")
