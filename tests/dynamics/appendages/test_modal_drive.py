@@ -348,6 +348,32 @@ def test_the_drive_is_a_named_coordinate_the_stage_drives_and_records(driven):
     assert np.all(analysis.frequencies_hz[:8] == 0.0) and analysis.frequencies_hz[8] > 0.0
 
 
+def test_the_measured_design_model_follows_a_modal_drive(chain):
+    # The sadm_drive stage's design_model = "measured" freezes the appendage at its
+    # drive angle (ModalModel.rigid_body_at, from the packed row in numpy): J_tot there
+    # equals the kernels' locked inertia (observe, eq. D.8) at that angle, and the
+    # degree-2 trigonometric polynomial of docs/control.md holds it at any angle, both
+    # to round-off (measured 3e-14 kg m^2 of 190; bound 1e-12 relative), about an
+    # oblique axis.
+    from flexsat.control.stages.sadm_drive import design_coefficients
+    from flexsat.dynamics.rigid import rigid_inertia
+
+    plant = Plant.from_config(validate_config(_driven(chain, 3, axis=[0.3, 1.0, -0.2])))
+    names = plant.layout.dof_names()
+    drives = [names.index(f"panel_{k}.{DRIVE_COORDINATE}") for k in (1, 2)]
+    q = np.zeros(plant.n_dof)
+    q[drives] = [0.7, -1.1]
+    scale = np.abs(plant.locked_inertia(q)).max()
+    assert np.abs(rigid_inertia(plant, q) - plant.locked_inertia(q)).max() <= 1e-12 * scale
+    P = design_coefficients(plant, drives, np.zeros(plant.n_dof))[0]
+    a = 0.9  # [rad]
+    J = rigid_inertia(plant, np.zeros(plant.n_dof)) + P[0] * (np.cos(a) - 1.0) + P[1] * np.sin(
+        a) + P[2] * (np.cos(2.0 * a) - 1.0) + P[3] * np.sin(2.0 * a)  # fmt: skip
+    q = np.zeros(plant.n_dof)
+    q[drives[0]] = a
+    assert np.abs(J - rigid_inertia(plant, q)).max() <= 1e-12 * scale
+
+
 def test_the_driven_modal_satellite_linearizes(chain):
     # About rest, the analytic Jacobian (M(0), K, C) against Richardson differences of
     # the accelerations, the drive angle's rows and its motor's input column included
