@@ -367,8 +367,8 @@ def test_the_measured_design_model_follows_a_modal_drive(chain):
     assert np.abs(rigid_inertia(plant, q) - plant.locked_inertia(q)).max() <= 1e-12 * scale
     P = design_coefficients(plant, drives, np.zeros(plant.n_dof))[0]
     a = 0.9  # [rad]
-    J = rigid_inertia(plant, np.zeros(plant.n_dof)) + P[0] * (np.cos(a) - 1.0) + P[1] * np.sin(
-        a) + P[2] * (np.cos(2.0 * a) - 1.0) + P[3] * np.sin(2.0 * a)  # fmt: skip
+    change = (np.cos(a) - 1.0, np.sin(a), np.cos(2.0 * a) - 1.0, np.sin(2.0 * a))
+    J = rigid_inertia(plant, np.zeros(plant.n_dof)) + np.tensordot(change, P, axes=1)
     q = np.zeros(plant.n_dof)
     q[drives[0]] = a
     assert np.abs(J - rigid_inertia(plant, q)).max() <= 1e-12 * scale
