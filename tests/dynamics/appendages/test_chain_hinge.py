@@ -46,8 +46,8 @@ SEED = 20261207
 # Relative to the largest entry of each compared quantity. Both steps evaluate the same
 # formulas in float64 in a different order (elementary rotations instead of 3 x 3
 # products, a scalar 1 / D instead of a Gauss-Jordan inverse), so they differ by
-# round-off amplified by the chain's conditioning. Measured (printed): at most 6.2e-14
-# on the hinge chains N = 1 ... 32, 4.9e-13 on the mixed chain of N = 32, whose q_ddot
+# round-off amplified by the chain's conditioning. Measured (printed): at most 1.3e-13
+# on the hinge chains N = 1 ... 32, 5.0e-13 on the mixed chain of N = 32, whose q_ddot
 # the general step alone moves by 4e-13 when q changes by 1e-16 relative (the same
 # order: conditioning, not an error of either step). 1e-12 is the acceptance bound.
 RTOL = 1e-12

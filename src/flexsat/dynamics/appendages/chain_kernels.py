@@ -279,11 +279,15 @@ def _add_congruence(src, s, R, pos, dst, d, swap):
     inertia, symmetric: its lower-left block is the transposed upper-right one and is
     never rotated.
     """
+    _congruence_blocks(_block(src, s, 0, 0), _block(src, s, 0, 3), _block(src, s, 3, 3),
+                       R, pos, dst, d, swap)  # fmt: skip
+
+
+@njit(cache=True, error_model="numpy")
+def _congruence_blocks(A, B, D, R, pos, dst, d, swap):
+    """:func:`_add_congruence` of the spatial inertia [[A, B], [B^T, D]] given by blocks."""
     Rt = transpose(R)
-    A = mm(R, mm(_block(src, s, 0, 0), Rt))
-    B = mm(R, mm(_block(src, s, 0, 3), Rt))
-    D = mm(R, mm(_block(src, s, 3, 3), Rt))
-    _shift_add(A, B, D, pos, dst, d, swap)
+    _shift_add(mm(R, mm(A, Rt)), mm(R, mm(B, Rt)), mm(R, mm(D, Rt)), pos, dst, d, swap)
 
 
 # -- hinges: elementary rotations -------------------------------------------------------
@@ -540,33 +544,39 @@ def _hinge_outward(q, qd, Q, o, p, g, w, b, first, axis, va, vl, hub):
 def _hinge_inward(w, b, k, axis, hub):
     """Pass 1's inward step (eqs. C.3, C.4) for a hinge about axis a: U = I^A e_a (a
     column of I^A), D = I^A_aa (a scalar, no inverse), u = tau - p^A_a; then
-    I^a = I^A - U U^T / D on its 21 distinct entries, p^a = p^A + I^a c + U u / D,
-    and both moved to the parent (X^T I^a X by elementary rotations, or to the hub).
-    Leaves U, 1 / D and u for pass 2 at W_U, W_DI and W_TAU.
+    I^a = I^A - U U^T / D, p^a = p^A + I^a c + U u / D, and both moved to the parent
+    (X^T I^a X by elementary rotations, or to the hub). I^a is symmetric: it is kept
+    in registers as its blocks [[A, B], [B^T, D]], never stored. Leaves U, 1 / D and u
+    for pass 2 at W_U, W_DI and W_TAU.
     """
     ia = b + W_IA
     d_inv = 1.0 / w[ia + 7 * axis]
     u = w[b + W_TAU] - w[b + W_PA + axis]
     w[b + W_DI], w[b + W_TAU] = d_inv, u
-    for r in range(6):
-        w[b + W_U + r] = w[ia + 6 * r + axis]
+    un = (w[ia + axis], w[ia + 6 + axis], w[ia + 12 + axis])
+    uf = (w[ia + 18 + axis], w[ia + 24 + axis], w[ia + 30 + axis])
+    _put3(w, b + W_U, un)
+    _put3(w, b + W_U + 3, uf)
+    # I^a = I^A - U D^-1 U^T by blocks
+    vn = scale(d_inv, un)
+    A0, B0, D0 = _block(w, ia, 0, 0), _block(w, ia, 0, 3), _block(w, ia, 3, 3)
+    A = (sub(A0[0], scale(vn[0], un)), sub(A0[1], scale(vn[1], un)),
+         sub(A0[2], scale(vn[2], un)))  # fmt: skip
+    B = (sub(B0[0], scale(vn[0], uf)), sub(B0[1], scale(vn[1], uf)),
+         sub(B0[2], scale(vn[2], uf)))  # fmt: skip
+    vf = scale(d_inv, uf)
+    D = (sub(D0[0], scale(vf[0], uf)), sub(D0[1], scale(vf[1], uf)),
+         sub(D0[2], scale(vf[2], uf)))  # fmt: skip
+    # p^a = p^A + I^a c + U D^-1 u
     y = d_inv * u
-    for r in range(6):
-        w[b + W_PA + r] += w[b + W_U + r] * y
-    for r in range(6):  # I^a = I^A - U D^-1 U^T, upper triangle mirrored
-        v = d_inv * w[b + W_U + r]
-        for e in range(r, 6):
-            x = w[ia + 6 * r + e] - v * w[b + W_U + e]
-            w[ia + 6 * r + e] = x
-            w[ia + 6 * e + r] = x
-    ia_n, ia_f = _mul6(w, ia, load_seg(w, b + W_CA), load_seg(w, b + W_CA + 3))
-    pn, pf = add(load_seg(w, b + W_PA), ia_n), add(load_seg(w, b + W_PA + 3), ia_f)
+    ca, cl = load_seg(w, b + W_CA), load_seg(w, b + W_CA + 3)
+    pn = add(add(load_seg(w, b + W_PA), scale(y, un)), add(mv(A, ca), mv(B, cl)))
+    pf = add(add(load_seg(w, b + W_PA + 3), scale(y, uf)), add(mtv(B, ca), mv(D, cl)))
     if k > 0:
         up = b - WSEG
         c, s, pos = w[b + W_CS], w[b + W_CS + 1], load_seg(w, b + W_POS)
-        _shift_add(_sandwich(axis, c, s, _block(w, ia, 0, 0)),
-                   _sandwich(axis, c, s, _block(w, ia, 0, 3)),
-                   _sandwich(axis, c, s, _block(w, ia, 3, 3)), pos, w, up + W_IA, 0)  # fmt: skip
+        _shift_add(_sandwich(axis, c, s, A), _sandwich(axis, c, s, B),
+                   _sandwich(axis, c, s, D), pos, w, up + W_IA, 0)  # fmt: skip
         Rf = _rot_axis(axis, c, s, pf)
         pn = add(_rot_axis(axis, c, s, pn), cross(pos, Rf))
         for r in range(3):
@@ -574,7 +584,7 @@ def _hinge_inward(w, b, k, axis, hub):
             w[up + W_PA + 3 + r] += Rf[r]
     else:
         R, pos = _pose_of(w, b)
-        _add_congruence(w, ia, R, pos, hub, HUB_INERTIA, 3)
+        _congruence_blocks(A, B, D, R, pos, hub, HUB_INERTIA, 3)
         pn, pf = _xft(R, pos, pn, pf)
         for r in range(3):
             hub[HUB_FORCE + r] -= pf[r]
