@@ -10,11 +10,15 @@ from flexsat.linear.frequency import law_gains
 from flexsat.linear.mu import (
     LinearController,
     _dg_bound,
+    _response,
     analyze,
     closed_loop,
+    lmi_certificate,
     mu_upper_bound,
+    mu_upper_bound_lmi,
+    stability_boundary,
 )
-from flexsat.linear.uncertain import uncertain_model
+from flexsat.linear.uncertain import thesis_parameters, uncertain_model
 
 SEED = 20261207  # fixed, printed by the randomized tests
 # The grid of the PD test: the rigid and the flexible closed-loop modes (0.8 Hz is the
@@ -37,6 +41,48 @@ def test_skogestad_postlethwaite_matrix():
         # The reported scalings are a certificate: the bound recomputed from them.
         assert abs(np.sqrt(_dg_bound(np.r_[x, g], M, real)[0]) - bound) <= 1e-12
     assert abs(np.linalg.det(np.eye(2) - M @ np.diag([1.0, -1.0]) / 3.0)) <= 1e-15
+
+
+def test_lmi_bound_skogestad_postlethwaite_matrix():
+    """The full-block LMI bound on the same matrix: mu = 3, real or complex channels."""
+    pytest.importorskip("cvxpy")
+    M = np.array([[2.0, 2.0], [-1.0, -1.0]], dtype=complex)
+    for real in (False, True):
+        bound, D, G = mu_upper_bound_lmi(M, np.array([0, 1]), np.array([real, real]))
+        # Valid (round-off aside) and within the bisection's relative 1e-3.
+        assert 3.0 * (1 - 1e-12) <= bound <= 3.0 * (1 + 1e-3)
+        assert lmi_certificate(M, D, G) == bound
+
+
+def test_lmi_bound_single_repeated_real_scalar():
+    """One repeated real scalar delta I_n: mu is the real spectral radius of N.
+
+    det(I - delta N) = 0 for a real delta iff 1/delta is a real eigenvalue of N, so
+    mu = max{‖lambda‖ : lambda a real eigenvalue of N}. For a diagonalizable
+    N = T Lambda T^-1 the full-block scalings D = T^-H diag(d) T^-1, G = T^-H diag(g)
+    T^-1 make the LMI diagonal, ``(‖lambda_k‖^2 - beta^2) d_k - 2 g_k Im lambda_k <= 0``,
+    so the bound reaches mu exactly (a complex pair is removed by its g_k); diagonal
+    D, G (the fast bound) cannot, as T mixes the channels.
+    """
+    pytest.importorskip("cvxpy")
+    rng = np.random.default_rng(SEED)
+    print(f"seed {SEED}")
+    for n in (5, 6, 8):
+        T = rng.normal(size=(n, n))
+        lam = rng.normal(size=n)
+        L = np.diag(lam)
+        L[:2, :2] = [[lam[0], 3.0], [-3.0, lam[0]]]  # two complex pairs, the rest real
+        L[2:4, 2:4] = [[lam[2], 2.0], [-2.0, lam[2]]]
+        N = (T @ L @ np.linalg.inv(T)).astype(complex)
+        exact = float(np.max(np.abs(lam[4:])))
+        bound, D, G = mu_upper_bound_lmi(N, np.zeros(n, int), np.array([True]), rtol=1e-7)
+        diagonal = mu_upper_bound(N, np.ones(n, bool))[0]
+        print(n, exact, bound, diagonal)
+        # Valid (never below mu, round-off aside: cond(T) ~ 1e2 loses ~1e-12) and
+        # within the bisection's 1e-7 plus the solver's 1e-8 feasibility: 1e-6.
+        assert exact * (1 - 1e-9) <= bound <= exact * (1 + 1e-6), (n, bound, exact)
+        assert diagonal > 1.5 * bound  # the fast bound is loose here
+        assert lmi_certificate(N, D, G) == bound
 
 
 def test_rank_one_complex_matrices():
@@ -116,6 +162,29 @@ def test_pd_sampling_check(pd_analysis):
     # boundary (the bisection stops 1e-6 past it in alpha).
     assert max(box) < 0.0
     assert worst >= max(box)
+
+
+def test_lmi_bound_at_the_damping_loops_crossing():
+    """The PD loop against the damping alone (12 channels), where zeta = 0 crosses.
+
+    Along delta = -1 (zeta = 0) a pole reaches the axis at alpha = 1 (known answer,
+    test_pd_loop_bounds), at i w*: det(I - N(i w*) Delta) = 0 there, so mu(N(i w*)) >= 1.
+    The LMI bound at w* must stay valid (>= 1) and not exceed the diagonal bound.
+    """
+    pytest.importorskip("cvxpy")
+    config = nominal()
+    params = [p for p in thesis_parameters() if p.name == "damping"]
+    lft = uncertain_model(config, parameters=params)
+    loop = closed_loop(lft, LinearController.static(law_gains(Plant.from_config(config))))
+    alpha, w = stability_boundary(lft, loop, np.array([-1.0]))
+    assert abs(alpha - 1.0) <= 1e-5  # the bisection's 1e-6 in alpha
+    N = _response(loop, w)
+    diagonal = mu_upper_bound(N, np.ones(lft.n_channels, bool))[0]
+    bound = mu_upper_bound_lmi(N, lft.channel_parameter, np.array([True]), rtol=1e-3)[0]
+    print(f"damping only at {w / (2 * np.pi):.4f} Hz: diagonal {diagonal:.4f}, lmi {bound:.4f}")
+    # Valid: mu >= 1/alpha; alpha is 1e-6 past the boundary (bisection), the N(i w*)
+    # of that pole's frequency to ~1e-6 as well: 1e-4 covers both.
+    assert 1.0 / alpha * (1 - 1e-4) <= bound <= diagonal * (1 + 1e-12)
 
 
 def test_user_controller_matches_the_static_law(pd_analysis):
