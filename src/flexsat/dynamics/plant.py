@@ -281,8 +281,17 @@ class Plant:
         return np.diag(np.concatenate([np.zeros(6), self.stiffness]))
 
     def damping_matrix(self) -> np.ndarray:
-        """C_damp = diag(0_6, C_1, ..., C_n), shape (n_dof, n_dof) (eq. 2.47)."""
-        return np.diag(np.concatenate([np.zeros(6), self.damping]))
+        """C_damp = blockdiag(0_6, C_1, ..., C_n), shape (n_dof, n_dof) (eq. 2.47).
+
+        Each appendage's block is its model's ``damping_block``: diagonal, or a modal
+        appendage's full modal damping matrix. The kernels apply the diagonal
+        (:meth:`damping_forces`) and the rest of a full block in the bias forces h, so
+        about rest dh/dq_dot holds that rest and C_damp is the whole damping.
+        """
+        C = np.zeros((self.n_dof, self.n_dof))
+        for model, row, block in zip(self.models, self.params, self.layout.blocks, strict=True):
+            C[block.slice, block.slice] = model.damping_block(row)
+        return C
 
     def elastic_forces(self, q: np.ndarray) -> np.ndarray:
         """k_el(q) = K_sys q, shape (n_dof,) (eq. 2.46)."""
@@ -290,7 +299,8 @@ class Plant:
         return np.concatenate([np.zeros(6), self.stiffness * q[6:]])
 
     def damping_forces(self, qd: np.ndarray) -> np.ndarray:
-        """C_damp q_dot, shape (n_dof,) (eq. 2.47)."""
+        """diag(C_damp) q_dot, shape (n_dof,) (eq. 2.47): the damping the kernels apply
+        with the joints (a full modal block's off-diagonal rest is in the bias forces)."""
         qd = self._state(qd)
         return np.concatenate([np.zeros(6), self.damping * qd[6:]])
 

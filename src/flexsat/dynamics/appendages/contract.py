@@ -316,6 +316,12 @@ class AppendageModel(ABC):
         """Diagonal of its block of C_damp (eq. 2.47), shape (count,). Default: none."""
         return np.zeros(0)
 
+    def damping_block(self, params: np.ndarray) -> np.ndarray:
+        """Its whole block of C_damp (eq. 2.47), shape (count, count). Default:
+        ``diag(damping(params))``; a model with coupled damping gives the full block (its
+        kernels apply the diagonal with the joints, the rest in their bias forces h)."""
+        return np.diag(self.damping(params))
+
     def with_joints(self, params: np.ndarray, stiffness: np.ndarray, damping: np.ndarray
                     ) -> np.ndarray:  # fmt: skip
         """The parameter row with other stiffness and damping diagonals, each (count,)."""

@@ -1131,6 +1131,13 @@ class ModalModel(AppendageModel):
     def damping(self, params: np.ndarray) -> np.ndarray:
         return np.concatenate([np.zeros(int(params[P_DRIVE])), self._modes(params)[:, MODE_C]])
 
+    def damping_block(self, params: np.ndarray) -> np.ndarray:
+        block = np.diag(self.damping(params))
+        at, n, drive = int(params[P_DAMP_AT]), int(params[P_N]), int(params[P_DRIVE])
+        if at:  # the full modal damping matrix (its off-diagonal terms are in _damping)
+            block[drive:, drive:] = params[at : at + n * n].reshape(n, n)
+        return block
+
     def with_joints(self, params: np.ndarray, stiffness: np.ndarray, damping: np.ndarray
                     ) -> np.ndarray:  # fmt: skip
         drive = int(params[P_DRIVE])
