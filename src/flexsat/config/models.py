@@ -135,10 +135,12 @@ def _check_inertia(j: np.ndarray) -> None:
 class DriveConfig(_Frozen):
     """A solar-array drive (SADM) turning an appendage about its SADM axis.
 
-    The appendage becomes a chain whose first segment is the rotor, its drive angle
-    alpha_sadm a generalized coordinate (``eta_ry_0``) starting at the appendage's
-    ``sadm_angle_deg`` (``docs/model.md``, "Driven mount coordinate (SADM)"). A
-    ``[joint_actuator] kind = "sadm_drive"`` is its motor.
+    Its drive angle alpha_sadm becomes a generalized coordinate starting at the
+    appendage's ``sadm_angle_deg``. A plate or a chain becomes a chain whose first
+    segment is the rotor (coordinate ``eta_ry_0``; ``docs/model.md``, "Driven mount
+    coordinate (SADM)"); a modal appendage keeps its modes on a frame the drive turns
+    about its ``drive_axis`` (coordinate ``drive_angle``; ``docs/model.md``, "Modal
+    appendage on a drive"). A ``[joint_actuator] kind = "sadm_drive"`` is its motor.
     """
 
     rotor_inertia_kg_m2: Annotated[
