@@ -1,5 +1,7 @@
 """mu bounds: a textbook matrix with a known mu, then flexsat's PD loop on its LFT."""
 
+import sys
+
 import numpy as np
 import pytest
 
@@ -203,3 +205,11 @@ def test_user_controller_matches_the_static_law(pd_analysis):
         LinearController.from_arrays(-np.eye(3), np.zeros((3, 5)), np.zeros((3, 3)), -K)
     with pytest.raises(ConfigError, match="controller: a static gain is 3 x 6"):
         LinearController.static(np.zeros((3, 3)))
+
+
+def test_lmi_bound_without_cvxpy_is_one_message(monkeypatch):
+    """The core install has no cvxpy: the LMI bound says which extra brings it."""
+    monkeypatch.setitem(sys.modules, "cvxpy", None)  # import cvxpy now raises ImportError
+    M = np.array([[2.0, 2.0], [-1.0, -1.0]], dtype=complex)
+    with pytest.raises(ConfigError, match=r"needs cvxpy: pip install 'flexsat\[robust\]'"):
+        mu_upper_bound_lmi(M, np.array([0, 1]), np.array([True, True]))

@@ -14,6 +14,12 @@ can grow (or must shrink) before the loop can lose stability.
   bound is minimized over (log D, G) with scipy's L-BFGS-B and an exact gradient.
   Any D, G give a valid bound, so the optimizer's result is a certificate. With G = 0
   it is the complex (D-scaled, Osborne's) bound.
+- **Full-block upper bound** (:func:`mu_upper_bound_lmi`): D_i Hermitian positive
+  definite and G_i Hermitian on each repeated scalar block, the LMI
+  ``N^H D N + j (G N - N^H G) - beta^2 D <= 0`` (Young 1993) solved by bisection on
+  beta with cvxpy; never looser than the diagonal bound, much costlier with many
+  channels (docs/linear.md, 'Robust stability: mu'), so :func:`analyze` uses it only
+  at the diagonal bound's peak frequencies when asked (``bound="lmi"``).
 - **Lower bound**: a real perturbation that destabilizes the loop. For purely real
   blocks the power iteration of Young and Doyle often does not converge (their
   paper says so), so the lower bound is found directly: along a direction of the
