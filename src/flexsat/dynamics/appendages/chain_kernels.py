@@ -19,7 +19,10 @@ Articulated-body algorithm per chain (eqs. of docs/model.md, 'Chain appendages')
 pass 1 runs outward for the velocities v_k = X_k v_{k-1} + S_k qd_k and bias
 accelerations c_k, then inward for the articulated inertias I^A_k and bias forces
 p^A_k, handing the hub X_0^T I^a_0 X_0 and X_0^T p^a_0; pass 2 runs outward for
-q_ddot_k = D_k^-1 (u_k - U_k^T (X_k a_{k-1} + c_k)). Cost is linear in N. M(q) and
+q_ddot_k = D_k^-1 (u_k - U_k^T (X_k a_{k-1} + c_k)). A hinge (one free rotation,
+slot G_KIND) takes a specialized step of both passes (``_hinge_outward``,
+``_hinge_inward``, the hinge branch of pass 2): scalar D_k, elementary rotations,
+I^a in registers; every other joint the general one. Cost is linear in N. M(q) and
 h(q, q_dot) (analysis only, not in the integration loop) are the composite-rigid-body
 and recursive Newton-Euler algorithms and allocate one scratch row per chain. The
 root's wrench on the hub (tau_flex, :func:`joint_wrench`) is the Newton-Euler sum of
