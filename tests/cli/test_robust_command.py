@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 
 import numpy as np
+import pytest
 
 from flexsat.cli.tables import format_number
 from tests.cli.harness import flexsat
@@ -33,3 +34,20 @@ def test_robust_analyze_tables_and_files(capsys, tmp_path):
     for text in ("Robust stability, PD loop", "k_max, certified", "Worst case", "damping"):
         assert text in outcome.stdout
     assert format_number(float(summary["peak_upper"])) in outcome.stdout
+
+
+def test_unknown_bound_is_refused_with_one_message(capsys):
+    outcome = flexsat(["robust", "analyze", "--bound", "full"], capsys)
+    assert outcome.code != 0
+    assert "--bound: one of diagonal, lmi, got 'full'" in outcome.stderr
+    assert "Traceback" not in outcome.stderr
+
+
+def test_lmi_bound_on_the_69_channel_loop_is_refused_with_one_message(capsys):
+    """The nominal box's LFT has 69 channels: the LMI bound refuses it (docs/linear.md)."""
+    pytest.importorskip("cvxpy")
+    outcome = flexsat(["robust", "analyze", "--bound", "lmi", "--points", "8"], capsys,
+                      timeout_s=300)  # fmt: skip
+    assert outcome.code != 0
+    assert "bound: the LMI bound takes at most 40 channels, this model has 69" in outcome.stderr
+    assert "Traceback" not in outcome.stderr

@@ -43,6 +43,7 @@ from flexsat.errors import ConfigError
 from flexsat.linear.uncertain import UncertainModel
 
 __all__ = [
+    "LMI_MAX_CHANNELS",
     "LinearController",
     "MuAnalysis",
     "analyze",
@@ -53,6 +54,8 @@ __all__ = [
     "stability_boundary",
 ]
 
+LMI_MAX_CHANNELS = 40
+"""Most channels :func:`analyze` gives the LMI bound (30 cost 29 s an SDP, 69 over 30 min)."""
 _X_BOUND = 40.0  # |log d| of the D scaling kept below this (no overflow)
 _ALPHA_MAX = 4.0  # the destabilizing search looks up to 4x the parameter box
 _STABLE_MARGIN = 0.0  # a pole with Re > 0 is unstable
@@ -546,7 +549,8 @@ def analyze(
         ``"lmi"``: then the full-block LMI bound (:func:`mu_upper_bound_lmi`) at the
         grid's highest frequencies, in decreasing order of the diagonal bound, until
         the next diagonal value is below the largest LMI value (the peak is then
-        settled) or ``lmi_points`` are done.
+        settled) or ``lmi_points`` are done; at most :data:`LMI_MAX_CHANNELS`
+        channels.
     lmi_points : int
         At most this many LMI frequencies (each costs an SDP bisection).
 
@@ -558,6 +562,13 @@ def analyze(
         raise ConfigError(f"bound: 'diagonal' or 'lmi', got {bound!r}")
     if bound == "lmi":
         _require_cvxpy()
+        if model.n_channels > LMI_MAX_CHANNELS:
+            raise ConfigError(
+                f"bound: the LMI bound takes at most {LMI_MAX_CHANNELS} channels, this model "
+                f"has {model.n_channels} (one SDP would take tens of minutes and GBs: "
+                "docs/linear.md, 'Robust stability: mu'); use the diagonal bound or fewer "
+                "parameters"
+            )
     loop = closed_loop(model, controller)
     poles = np.linalg.eigvals(loop[0])
     nominal_stable = bool(np.max(poles.real) < 0.0)

@@ -194,7 +194,7 @@ def robust_analysis(
     from flexsat.linear.mu import analyze
 
     config, model, controller, law = _loop(config, scenario, controller_path, sadm_angle_deg)
-    result = analyze(model, controller, frequencies_hz=_grid(points))
+    result = analyze(model, controller, frequencies_hz=_grid(points), bound=bound)
     summary = _summary(config, model, law, result)
     if out_dir is not None:
         _write_mu(out_dir, summary, result)
