@@ -213,3 +213,26 @@ def test_lmi_bound_without_cvxpy_is_one_message(monkeypatch):
     M = np.array([[2.0, 2.0], [-1.0, -1.0]], dtype=complex)
     with pytest.raises(ConfigError, match=r"needs cvxpy: pip install 'flexsat\[robust\]'"):
         mu_upper_bound_lmi(M, np.array([0, 1]), np.array([True, True]))
+
+
+def test_lmi_bound_tightens_the_frequency_and_damping_loop():
+    """The PD loop against frequency and damping (30 channels), at 0.80 Hz.
+
+    Known answer for this box too: k_max = 1 at zeta = 0 (test_pd_loop_bounds' argument
+    holds for any box whose damping reaches 0), so max over w of mu = 1 and a tight
+    bound at 0.80 Hz is at most about 1. Measured: diagonal 1.66, LMI 1.003.
+    """
+    pytest.importorskip("cvxpy")
+    config = nominal()
+    params = [p for p in thesis_parameters() if p.name in ("frequency", "damping")]
+    lft = uncertain_model(config, parameters=params)
+    loop = closed_loop(lft, LinearController.static(law_gains(Plant.from_config(config))))
+    N = _response(loop, 2 * np.pi * 0.8)
+    diagonal = mu_upper_bound(N, np.ones(lft.n_channels, bool))[0]
+    bound, D, G = mu_upper_bound_lmi(N, lft.channel_parameter, np.ones(2, bool), rtol=1e-2)
+    print(f"frequency and damping at 0.80 Hz: diagonal {diagonal:.4f}, lmi {bound:.4f}")
+    assert diagonal > 1.5
+    # mu(N(0.80 Hz)) <= 1 (the peak); the bisection stops within 1e-2 of the bound's
+    # optimum and the full-block bound's own gap to mu was measured at 0.3 %: 1.05
+    # leaves margin. The value is the exact numpy certificate, not the solver's beta.
+    assert bound <= 1.05 and lmi_certificate(N, D, G) == bound
