@@ -414,6 +414,59 @@ def robust_analyze(
         _console.print(f"wrote {path}", soft_wrap=True)
 
 
+@robust_app.command("jk-min")
+def robust_jk_min(
+    config: ConfigOption = None,
+    scenario: Annotated[
+        Path | None,
+        typer.Option(help="Slew scenario (TOML) with an ASMC. Default: the thesis's slew."),
+    ] = None,
+    campaign: Annotated[
+        str | None,
+        typer.Option(
+            help="The truth plants the law must hold: a campaign's cases (a preset name "
+            "or a TOML, e.g. montecarlo-critical). Default: the design satellite alone."
+        ),
+    ] = None,
+    margin: Annotated[
+        float, typer.Option(help="eta as a fraction of the bound, 0 ... 1 (the thesis: 0.05).")
+    ] = 0.05,
+    json_output: JsonOption = False,
+) -> None:
+    """The analytical estimate of the ASMC's minimum robustness gain JK_min, term by term.
+
+    Each term of the lumped disturbance bounded from the model (docs/control.md, 'The
+    minimum robustness gain JK_min'): actuator, sloshing, environment and residual
+    torques, the inertia mismatch and gyroscopic terms over the truth plants, and the
+    flexible torque of a torque step from rest.
+    """
+    from flexsat.campaigns import load_campaign, resolve_cases
+    from flexsat.config import load_config, validate_config
+    from flexsat.config.models import SatelliteConfig
+    from flexsat.simulate.robustness_gain import jk_min_estimate
+    from flexsat.simulate.scenario import load_slew
+
+    cfg = load_config(config)
+    truth = ()
+    if campaign is not None:
+        cases = resolve_cases(load_campaign(campaign), cfg)
+        truth = tuple(validate_config(c.plant, model=SatelliteConfig) for c in cases)
+    estimate = jk_min_estimate(cfg, load_slew(scenario), truth, margin)
+    summary = {"config_name": cfg.name, "campaign": campaign, "truth_plants": len(truth) or 1,
+               **estimate.to_dict()}  # fmt: skip
+    if json_output:
+        typer.echo(dumps(summary))
+        return
+    names = ("actuator", "sloshing", "environment", "residual", "inertia", "gyroscopic",
+             "flexible", "disturbance", "jk_min")  # fmt: skip
+    rows = [[name, *summary[f"{name}_nm"]] for name in names]
+    title = f"JK_min estimate — {cfg.name}, {summary['truth_plants']} truth plant(s) [N m]"
+    print_table(_console, title, ("term", "x", "y", "z"), rows)
+    verdict = "fits" if summary["feasible"] else "does not fit"
+    _console.print(f"JK_min {verdict} within the law's budget RF T_max = "
+                   f"{format_number(summary['budget_nm'])} N m on every axis")  # fmt: skip
+
+
 @robust_app.command("synthesize")
 def robust_synthesize(
     out: Annotated[Path, typer.Option(help="The controller file to write (.npz or .mat).")],
