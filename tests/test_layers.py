@@ -42,8 +42,8 @@ LAYERS: tuple[tuple[str, tuple[str, ...]], ...] = (
     ("physics", ("flexsat.dynamics",)),
     ("configuration", ("flexsat.config",)),
     ("compiled toolkit", ("flexsat.compiled",)),
-    ("shared", ("flexsat.errors", "flexsat.files", "flexsat.parallel", "flexsat.pool",
-                "flexsat.processes", "flexsat.strict_json", "flexsat._version")),
+    ("shared", ("flexsat._lazy", "flexsat.errors", "flexsat.files", "flexsat.parallel",
+                "flexsat.pool", "flexsat.processes", "flexsat.strict_json", "flexsat._version")),
 )  # fmt: skip
 
 

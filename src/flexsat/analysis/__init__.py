@@ -7,7 +7,7 @@ analysis, or ``flexsat openloop`` its metrics, does not pay for the others
 (docs/performance.md, 'Start-up').
 """
 
-import importlib
+from flexsat._lazy import lazy_attributes
 
 _LAZY = {
     **dict.fromkeys(("ModalAnalysis", "Mode", "dof_names", "modal_analysis"), "modal"),
@@ -42,14 +42,4 @@ __all__ = [
 ]
 
 
-def __getattr__(name: str):
-    """The analysis names, imported on first use (PEP 562)."""
-    if name in _LAZY:
-        value = getattr(importlib.import_module(f"{__name__}.{_LAZY[name]}"), name)
-        globals()[name] = value
-        return value
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-
-
-def __dir__() -> list[str]:
-    return sorted({*globals(), *__all__})
+__getattr__, __dir__ = lazy_attributes(__name__, _LAZY)

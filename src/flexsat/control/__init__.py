@@ -7,7 +7,7 @@ a module that needs the disturbance model alone does not load every law and stag
 (docs/performance.md, 'Start-up').
 """
 
-import importlib
+from flexsat._lazy import lazy_attributes
 
 _LAZY = {
     "DisturbanceConfig": "disturbances",
@@ -35,14 +35,4 @@ __all__ = [
 ]
 
 
-def __getattr__(name: str):
-    """The control names, imported on first use (PEP 562)."""
-    if name in _LAZY:
-        value = getattr(importlib.import_module(f"{__name__}.{_LAZY[name]}"), name)
-        globals()[name] = value
-        return value
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-
-
-def __dir__() -> list[str]:
-    return sorted({*globals(), *__all__})
+__getattr__, __dir__ = lazy_attributes(__name__, _LAZY)

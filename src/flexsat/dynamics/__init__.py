@@ -7,7 +7,7 @@ that imports one kernel module does not load the plant, its appendage models and
 SciPy's rotations with it (docs/performance.md, 'Start-up').
 """
 
-import importlib
+from flexsat._lazy import lazy_attributes
 
 _LAZY = {
     "Plant": "plant",
@@ -19,14 +19,4 @@ _LAZY = {
 __all__ = ["Plant", "gyroscopic_torque", "rigid_inertia"]
 
 
-def __getattr__(name: str):
-    """The plant and the rigid design model, imported on first use (PEP 562)."""
-    if name in _LAZY:
-        value = getattr(importlib.import_module(f"{__name__}.{_LAZY[name]}"), name)
-        globals()[name] = value
-        return value
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-
-
-def __dir__() -> list[str]:
-    return sorted({*globals(), *__all__})
+__getattr__, __dir__ = lazy_attributes(__name__, _LAZY)

@@ -6,7 +6,7 @@ control laws, loop stages, orbit and environment models (docs/performance.md,
 'Start-up').
 """
 
-import importlib
+from flexsat._lazy import lazy_attributes
 
 _LAZY = {
     **dict.fromkeys(("design_inertia", "run_slew", "slew_design_inertia"), "closedloop"),
@@ -37,14 +37,4 @@ __all__ = [
 ]
 
 
-def __getattr__(name: str):
-    """The drivers, scenarios and the result, imported on first use (PEP 562)."""
-    if name in _LAZY:
-        value = getattr(importlib.import_module(f"{__name__}.{_LAZY[name]}"), name)
-        globals()[name] = value
-        return value
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-
-
-def __dir__() -> list[str]:
-    return sorted({*globals(), *__all__})
+__getattr__, __dir__ = lazy_attributes(__name__, _LAZY)

@@ -5,7 +5,7 @@ files (:mod:`flexsat.study.outputs`) does not load the study's pipeline, campaig
 report (docs/performance.md, 'Start-up').
 """
 
-import importlib
+from flexsat._lazy import lazy_attributes
 
 _LAZY = {
     **dict.fromkeys(("CAMPAIGNS", "PARTS", "run_study"), "pipeline"),
@@ -16,14 +16,4 @@ _LAZY = {
 __all__ = ["CAMPAIGNS", "PARTS", "format_value", "run_study", "write_report"]
 
 
-def __getattr__(name: str):
-    """The study's pipeline and report, imported on first use (PEP 562)."""
-    if name in _LAZY:
-        value = getattr(importlib.import_module(f"{__name__}.{_LAZY[name]}"), name)
-        globals()[name] = value
-        return value
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-
-
-def __dir__() -> list[str]:
-    return sorted({*globals(), *__all__})
+__getattr__, __dir__ = lazy_attributes(__name__, _LAZY)
