@@ -22,9 +22,7 @@ import time
 import numpy as np
 
 import harness
-from flexsat.campaigns.modifiers import Modifier, apply_modifiers
 from flexsat.config import nominal
-from flexsat.config.load import validate_config
 from flexsat.control.disturbances import DisturbanceConfig
 from flexsat.control.laws.pd import PDConfig
 from flexsat.dynamics.plant import Plant
@@ -33,6 +31,7 @@ from flexsat.linear.mu import LinearController, analyze, closed_loop
 from flexsat.linear.uncertain import uncertain_model
 from flexsat.simulate.closedloop import run_slew
 from flexsat.simulate.scenario import AppendageInitialState, InitialState, SlewScenario
+from flexsat.study.mu import perturbed_config
 
 SEED = 20261207
 SAMPLES = 1000
@@ -42,17 +41,7 @@ EARLY_S = (10.0, 20.0)
 
 def _plant(factors: dict) -> Plant:
     """The satellite the campaign modifiers make from the factors on the nominal values."""
-    mods = [
-        Modifier(path=f"appendages[*].target_frequencies_hz.{k}", op="scale",
-                 value=factors["frequency"])
-        for k in ("flapping", "in_plane", "torsion")
-    ] + [
-        Modifier(path="appendages[*].damping_ratio", op="scale", value=factors["damping"]),
-        Modifier(path="hub.inertia", value=factors["hub_inertia"]),
-        Modifier(path="appendages[*].inertia", value=factors["panel_inertia"]),
-    ]  # fmt: skip
-    data = apply_modifiers(nominal().model_dump(), mods, np.random.default_rng(0), {})
-    return Plant.from_config(validate_config(data))
+    return Plant.from_config(perturbed_config(nominal(), factors))
 
 
 def _max_real(lft, loop, delta) -> float:

@@ -3,13 +3,12 @@
 import numpy as np
 import pytest
 
-from flexsat.campaigns.modifiers import Modifier, apply_modifiers
 from flexsat.config import nominal
-from flexsat.config.load import validate_config
 from flexsat.dynamics.plant import Plant
 from flexsat.errors import ConfigError
 from flexsat.linear import linearize
 from flexsat.linear.uncertain import UncertainParameter, uncertain_model, with_sadm_angle
+from flexsat.study.mu import perturbed_config
 
 SEED = 20261207  # fixed, printed by the sampled test
 
@@ -21,17 +20,7 @@ def lft():
 
 def _perturbed(config, factors):
     """The satellite the campaign modifiers make from the same factors."""
-    mods = [
-        Modifier(path=f"appendages[*].target_frequencies_hz.{k}", op="scale",
-                 value=factors["frequency"])
-        for k in ("flapping", "in_plane", "torsion")
-    ] + [
-        Modifier(path="appendages[*].damping_ratio", op="scale", value=factors["damping"]),
-        Modifier(path="hub.inertia", value=factors["hub_inertia"]),
-        Modifier(path="appendages[*].inertia", value=factors["panel_inertia"]),
-    ]  # fmt: skip
-    data = apply_modifiers(config.model_dump(), mods, np.random.default_rng(0), {})
-    return Plant.from_config(validate_config(data))
+    return Plant.from_config(perturbed_config(config, factors))
 
 
 def test_nominal_point_is_the_linearized_model(lft):
