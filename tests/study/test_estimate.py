@@ -26,16 +26,24 @@ def test_the_campaigns_are_counted_case_by_case():
     # satellite, each of its base scenario's duration (120 s); the law comparison of
     # the full study flies them again for each variant but the default law's (its
     # stores are the campaigns part's): the other registered laws and the ASMC with
-    # hybrid damping.
+    # hybrid damping; the campaigns of slews from rest fly every variant, the default
+    # law's too, on the reduced model, each case REDUCED_SHARE of a full one.
     from flexsat.campaigns import load_campaign, resolve_cases
+    from flexsat.study.laws import REDUCED_CAMPAIGNS
 
-    cases = sum(len(resolve_cases(load_campaign(name), nominal())) for name in pipeline.CAMPAIGNS)
+    count = {name: len(resolve_cases(load_campaign(name), nominal()))
+             for name in pipeline.CAMPAIGNS}  # fmt: skip
+    cases = sum(count.values())
     full = _study(quick=False)
     campaigns, _ = full["campaigns"]
     assert (campaigns.runs, campaigns.simulated_s) == (cases, 120.0 * cases)
     variants = len(law_names())  # the other laws (n - 1) and the damped ASMC
+    reduced = sum(count[name] for name in REDUCED_CAMPAIGNS)
     laws, _ = full["laws"]
-    assert (laws.runs, laws.simulated_s) == (variants * cases, variants * 120.0 * cases)
+    assert laws.runs == variants * (cases - reduced) + (variants + 1) * reduced
+    simulated = 120.0 * (variants * (cases - reduced)
+                         + (variants + 1) * reduced * estimate.REDUCED_SHARE)  # fmt: skip
+    assert laws.simulated_s == pytest.approx(simulated, rel=1e-12)
     # The rate: each case at the calibrated rate times CASE_FACTOR, on two workers
     # (exact: the same product in the same order).
     expected = estimate.CASE_FACTOR * 120.0 * cases * REFERENCE.wall_per_sim_s / 2

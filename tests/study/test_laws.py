@@ -56,3 +56,33 @@ def test_the_study_compares_every_law_and_the_damped_asmc(quick_study):
     assert shock[DAMPED]["r2_pass_rate"] == 1.0
     text = (out / "report.html").read_text()
     assert '<section id="laws">' in text and "Laws over the deployment-shock campaign" in text
+    # the quick study flies the full model everywhere, and the section says so
+    assert data["models"] == dict.fromkeys(CAMPAIGNS, "full")
+    assert "<h3>deployment-shock</h3><p>Flown on the full model.</p>" in text
+
+
+def test_the_full_comparison_flies_slews_from_rest_on_the_reduced_model(tmp_path, monkeypatch):
+    """The sensitivity campaign (12 slews from rest) with the PD law and the damped ASMC:
+    on the reduced model, into stores of their own, with the full model's verdicts
+    (docs/campaigns.md, 'Reduced models': every R1-R3 verdict kept on the thesis's
+    cases) and its peak tau_flex within 6 % (measured there: 5.1 % at most)."""
+    import flexsat.study.laws as laws
+    from flexsat.config import nominal
+
+    options = {"quick": False, "workers": 1, "progress": False, "campaigns": ("sensitivity",)}
+    reduced = laws.law_comparison(nominal(), tmp_path / "reduced", ("pd",), **options)
+    assert reduced["models"] == {"sensitivity": "reduced"}
+    stores = sorted(p.name for p in (tmp_path / "reduced" / "campaigns").iterdir())
+    assert stores == ["sensitivity-asmc+damping-reduced", "sensitivity-pd-reduced"]
+    monkeypatch.setattr(laws, "REDUCED_CAMPAIGNS", ())
+    full = laws.law_comparison(nominal(), tmp_path / "full", ("pd",), **options)
+    assert full["models"] == {"sensitivity": "full"}
+    for variant in ("pd", DAMPED):
+        r, f = (
+            reduced["campaigns"]["sensitivity"][variant],
+            full["campaigns"]["sensitivity"][variant],
+        )
+        assert r["cases"] == f["cases"] == 12 and r["failed"] == f["failed"] == 0
+        for key in ("r1_pass_rate", "r2_pass_rate", "r3_pass_rate"):
+            assert r[key] == f[key], (variant, key)
+        assert r["peak_flex_torque_nm"] == pytest.approx(f["peak_flex_torque_nm"], rel=0.06)

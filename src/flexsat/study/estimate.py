@@ -25,6 +25,7 @@ from dataclasses import dataclass
 __all__ = [
     "CASE_FACTOR",
     "QUICK_OVERHEAD_S",
+    "REDUCED_SHARE",
     "REFERENCE_WALL_PER_SIM_S",
     "Basis",
     "PartWork",
@@ -43,6 +44,10 @@ CASE_FACTOR = 1.26
 its records, metrics and stored files besides the run. On the reference machine the
 full study's 414 cases beyond the quick study (4 min 29 s against 18.5 s) took 1.21 s
 a case on each of the two cores, against 0.96 s for 120 s at the calibrated rate."""
+REDUCED_SHARE = 0.06
+"""A reduced-model campaign case's wall time against a full-model one's [-]: 0.067-0.069
+CPU-s in ``run_case`` (docs/campaigns.md, 'Reduced models') against the 1.21 s a case
+of :data:`CASE_FACTOR`."""
 QUICK_OVERHEAD_S = {
     "configuration": 0.0, "modal": 5.7, "openloop": 2.9, "slew": 3.0, "frequency": 4.8,
     "comparison": 2.0, "animation": 1.8, "avionics": 4.5, "laws": 1.5, "pointing": 1.7,
@@ -239,10 +244,18 @@ def part_work(name: str, ctx, side_by_side: int = 2) -> PartWork:
             first = max(d for _, d in cases.values())
             what = f"{n} cases ({variants} variants, the first case of each campaign)"
             return PartWork(n, n * first, side_by_side, overhead, what, CASE_FACTOR)
-        extra = variants - 1  # the default law's stores are the campaigns part's own
-        what = f"{extra * every} cases ({extra} variants besides the default law)"
-        return PartWork(extra * every, extra * flown, ctx.workers or side_by_side, overhead,
-                        what, CASE_FACTOR)  # fmt: skip
+        # a full-model default law's stores are the campaigns part's own; a reduced
+        # campaign flies every variant on the reduced model (laws.REDUCED_CAMPAIGNS)
+        n = simulated = 0.0
+        for campaign, (count, duration) in cases.items():
+            reduced = campaign in laws.REDUCED_CAMPAIGNS
+            flown_variants = variants if reduced else variants - 1
+            n += flown_variants * count
+            simulated += flown_variants * count * duration * (REDUCED_SHARE if reduced else 1.0)
+        what = (f"{int(n)} cases ({variants - 1} variants besides the default law; "
+                f"{', '.join(laws.REDUCED_CAMPAIGNS)} on the reduced model)")  # fmt: skip
+        return PartWork(int(n), simulated, ctx.workers or side_by_side, overhead, what,
+                        CASE_FACTOR)  # fmt: skip
     return PartWork(overhead_s=overhead, what="figures and analysis" if overhead else "no run")
 
 

@@ -20,7 +20,14 @@ from pathlib import Path
 
 import numpy as np
 
-__all__ = ["DAMPED", "HYBRID_DAMPING", "QUICK_CASES", "law_comparison", "law_statistics"]
+__all__ = [
+    "DAMPED",
+    "HYBRID_DAMPING",
+    "QUICK_CASES",
+    "REDUCED_CAMPAIGNS",
+    "law_comparison",
+    "law_statistics",
+]
 
 HYBRID_DAMPING = {
     "kind": "rate_feedback",
@@ -37,6 +44,13 @@ DAMPED = "asmc+damping"
 
 QUICK_CASES = 1
 """Cases per campaign and variant in the quick study."""
+
+REDUCED_CAMPAIGNS = ("sensitivity", "montecarlo-critical")
+"""The campaigns whose law comparison the full study flies on the reduced model (root
+translations locked, 20 ms step): slews from rest, on which the reduced model keeps
+every R1-R3 verdict and the peak tau_flex within 5.1 % (docs/campaigns.md, 'Reduced
+models'). The deployment shock rings the panels' 50 Hz root modes, whose peak loads
+need the full model: it flies the full one."""
 
 _QUANTILES = {"min": 0.0, "median": 0.5, "p90": 0.9, "max": 1.0}
 
@@ -106,14 +120,16 @@ def law_statistics(rows: list[dict]) -> dict:
     }
 
 
-def _with_base(definition, overrides: dict):
-    from flexsat.campaigns.definition import CampaignDefinition
+def _with_base(definition, overrides: dict, reduced: bool = False):
+    from flexsat.campaigns.definition import CampaignDefinition, Reduced
     from flexsat.config import validate_config
 
-    if not overrides:
+    if not overrides and not reduced:
         return definition
     data = definition.model_dump(mode="json")
     data["base"] = {**data["base"], **overrides}
+    if reduced:
+        data["reduced"] = Reduced().model_dump(mode="json")
     return validate_config(data, source="law comparison", model=CampaignDefinition)
 
 
@@ -169,26 +185,35 @@ def law_comparison(
     Returns
     -------
     dict
-        ``quick``, ``variants`` (names, in order), ``campaigns``: per campaign, per
-        variant, :func:`law_statistics`; also written to ``out/laws/laws.json``.
+        ``quick``, ``variants`` (names, in order), ``models``: per campaign, "full" or
+        "reduced" (:data:`REDUCED_CAMPAIGNS`, full study only), ``campaigns``: per
+        campaign, per variant, :func:`law_statistics`; also written to
+        ``out/laws/laws.json``.
     """
     from flexsat.campaigns import load_campaign
     from flexsat.study.outputs import write_json
     from flexsat.study.thesis import CAMPAIGNS
 
     variants = _variants(laws, default_law)
-    payload: dict = {"quick": quick, "variants": list(variants), "campaigns": {}}
+    names = campaigns or CAMPAIGNS
+    reduced = {name: not quick and name in REDUCED_CAMPAIGNS for name in names}
+    payload: dict = {"quick": quick, "variants": list(variants),
+                     "models": {n: "reduced" if reduced[n] else "full" for n in names},
+                     "campaigns": {}}  # fmt: skip
     definitions = {}
-    for name in campaigns or CAMPAIGNS:
+    for name in names:
         base = load_campaign(name)
         for variant, overrides in variants.items():
-            definitions[name, variant] = _with_base(base, overrides)
+            definitions[name, variant] = _with_base(base, overrides, reduced[name])
     if quick:
         rows = _quick_rows(definitions, config)
-    else:  # the default law's folder is the campaigns part's own store
+    else:  # a full-model default law's folder is the campaigns part's own store
         rows = {}
         for (name, variant), definition in definitions.items():
-            folder = name if not variants[variant] else f"{name}-{variant}"
+            if reduced[name]:
+                folder = f"{name}-{variant}-reduced"
+            else:
+                folder = f"{name}-{variant}" if variants[variant] else name
             rows[name, variant] = _stored_rows(definition, config, out / "campaigns" / folder,
                                                workers, progress)  # fmt: skip
     for (name, variant), chosen in rows.items():
