@@ -41,6 +41,7 @@ from flexsat.control.stages.sadm_drive import SADM_DRIVE
 from flexsat.control.stages.star_tracker import STAR_TRACKER
 from flexsat.control.stages.static_actuator import STATIC_ACTUATOR
 from flexsat.control.stages.step_reference import STEP_REFERENCE
+from flexsat.control.stages.strain_feedback import STRAIN_FEEDBACK
 from flexsat.control.stages.sun_reference import SUN_REFERENCE
 from flexsat.control.stages.wheels import WHEELS
 
@@ -75,6 +76,7 @@ register_stage(NADIR_REFERENCE)
 register_stage(SUN_REFERENCE)
 register_stage(NO_JOINT_ACTUATOR, default=True)
 register_stage(JOINT_RATE_FEEDBACK)
+register_stage(STRAIN_FEEDBACK)
 register_stage(SADM_DRIVE)
 register_stage(WHEELS)
 register_stage(DELAY)
