@@ -4,7 +4,8 @@ Built in: the thesis's ideal sensor and static actuator; the reference generator
 (the thesis's ``step``, the shaped ``eigenaxis`` slew, and ``nadir`` and ``sun``
 pointing along an orbit) and the joint actuators
 (``none``, the thesis's hub-only control, ``rate_feedback``, hybrid active
-damping, and ``sadm_drive``, the solar-array drive). Write your own stage in your
+damping, ``strain_feedback``, the same through noisy root strain gauges, and
+``sadm_drive``, the solar-array drive). Write your own stage in your
 own file (see ``docs/control.md``): a parameter model, a compiled step of its role's
 signature and one registration line.
 """
