@@ -2,8 +2,19 @@
 
 from __future__ import annotations
 
-import copy
 import os
+
+# One BLAS thread per test process. Two pytest-xdist workers on two cores, each running
+# OpenBLAS's threads on the mu analyses' small matrices (69 x 69), oversubscribe the
+# cores: under load the upper bound's optimiser slowed 15x or more (docs/performance.md,
+# "The test suite"). The workers `make test` starts inherit these variables and load
+# numpy after them; a single-process pytest has loaded numpy already (pytest imports
+# numba for the warning filter of pyproject.toml), so set them by hand there. A
+# variable already set is kept.
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+os.environ.setdefault("OMP_NUM_THREADS", "1")
+
+import copy
 import tomllib
 
 import numpy as np
