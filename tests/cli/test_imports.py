@@ -83,6 +83,10 @@ def test_openloop_json_loads_neither_figures_spectra_nor_the_closed_loop():
     assert heavy(modules, ("matplotlib", "scipy.signal", "flexsat.plots",
                            "flexsat.simulate.closedloop", "flexsat.study.pipeline",
                            "scipy.integrate")) == []  # fmt: skip
+    # SciPy's rotations (scipy.spatial): the plate packs its mount with flexsat's own
+    # (bit for bit SciPy's); a satellite of plates does not load the chain's kernels.
+    assert heavy(modules, ("scipy.spatial", "flexsat.dynamics.appendages.chain",
+                           "flexsat.dynamics.appendages.chain_kernels")) == []  # fmt: skip
 
 
 def test_slew_json_loads_neither_figures_nor_spectra(tmp_path):

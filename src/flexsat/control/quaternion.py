@@ -7,7 +7,6 @@ from math import asin, cos, sin, sqrt
 
 import numpy as np
 from numba import njit
-from scipy.spatial.transform import Rotation
 
 __all__ = [
     "euler_zyx_to_quaternion",
@@ -105,6 +104,8 @@ def target_quaternion(euler_deg: tuple[float, float, float]) -> np.ndarray:
     ndarray, shape (4,)
         Unit quaternion, scalar first [-].
     """
+    from scipy.spatial.transform import Rotation  # here: scipy.spatial costs 0.25 s to import
+
     roll, pitch, yaw = euler_deg
     x, y, z, w = Rotation.from_euler("ZYX", [yaw, pitch, roll], degrees=True).as_quat()
     return np.array([w, x, y, z])

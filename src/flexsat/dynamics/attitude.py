@@ -31,7 +31,6 @@ from math import atan2, hypot, pi
 
 import numpy as np
 from numba import njit
-from scipy.spatial.transform import Rotation
 
 from flexsat.compiled.linalg3 import (
     copy_into,
@@ -209,6 +208,8 @@ def inertial_records(
     moved = _moved(frames)
     if not moved.any():
         return q_N, qd_N
+    from scipy.spatial.transform import Rotation  # here: scipy.spatial costs 0.25 s to import
+
     R_NF = frames[moved].reshape(-1, 3, 3)
     R_FB = Rotation.from_euler("ZYX", q[moved, 5:2:-1])  # Rz(psi) Ry(theta) Rx(phi)
     with warnings.catch_warnings():  # at pitch +-90 deg only phi -+ psi is defined

@@ -3,10 +3,13 @@
 The thesis's plate on its 6-DOF root joint (:mod:`.plate`), the chain of rigid
 segments (:mod:`.chain`) and the modal (hybrid-coordinate) appendage (:mod:`.modal`)
 are registered here; a user's model is registered the same way, from the user's own
-file.
+file. The chain's module (its kernels) is imported on its first use
+(:class:`~flexsat.dynamics.appendages.deferred.DeferredModel`): a satellite without
+chains does not load it; ``ChainModel`` is imported on first use too (PEP 562).
 """
 
-from flexsat.dynamics.appendages.chain import ChainModel
+from flexsat._lazy import lazy_attributes
+from flexsat.dynamics.appendages.chain_config import ChainConfig
 from flexsat.dynamics.appendages.contract import (
     AppendageKernels,
     AppendageModel,
@@ -14,6 +17,7 @@ from flexsat.dynamics.appendages.contract import (
     DerivedPath,
     RigidBody,
 )
+from flexsat.dynamics.appendages.deferred import DeferredModel
 from flexsat.dynamics.appendages.modal import ModalModel
 from flexsat.dynamics.appendages.plate import PlateModel
 from flexsat.dynamics.appendages.registry import (
@@ -23,7 +27,7 @@ from flexsat.dynamics.appendages.registry import (
 )
 
 register_appendage_model(PlateModel())
-register_appendage_model(ChainModel())
+register_appendage_model(DeferredModel(f"{__name__}.chain:ChainModel", "chain", ChainConfig))
 register_appendage_model(ModalModel())
 
 __all__ = [
@@ -31,6 +35,7 @@ __all__ = [
     "AppendageModel",
     "ChainModel",
     "Coordinate",
+    "DeferredModel",
     "DerivedPath",
     "ModalModel",
     "PlateModel",
@@ -39,3 +44,5 @@ __all__ = [
     "appendage_model_names",
     "register_appendage_model",
 ]
+
+__getattr__, __dir__ = lazy_attributes(__name__, {"ChainModel": "chain"})

@@ -19,7 +19,6 @@ from __future__ import annotations
 from typing import ClassVar
 
 import numpy as np
-from scipy.spatial.transform import Rotation
 
 from flexsat.dynamics.appendages.chain_config import (
     AXES,
@@ -71,6 +70,8 @@ __all__ = ["ChainModel"]
 
 def _rotation(angles_xyz: np.ndarray) -> np.ndarray:
     """Rz(rz) Ry(ry) Rx(rx) of a joint's (rx, ry, rz) [rad]."""
+    from scipy.spatial.transform import Rotation  # here: scipy.spatial costs 0.25 s to import
+
     return Rotation.from_euler("ZYX", angles_xyz[::-1]).as_matrix()
 
 

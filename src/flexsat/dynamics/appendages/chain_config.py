@@ -24,7 +24,6 @@ from typing import Annotated, Literal
 
 import numpy as np
 from pydantic import AllowInfNan, Field, Strict, model_validator
-from scipy.spatial.transform import Rotation
 
 from flexsat.config.models import (
     Angle,
@@ -401,6 +400,8 @@ class ChainConfig(_Frozen):
     def mount_rotation(self) -> np.ndarray:
         """R_BM (mount frame -> hub frame), shape (3, 3): ``mount_matrix`` or
         Rz(``mount_yaw_deg``), then turned by ``sadm_angle_deg`` about the span axis."""
+        from scipy.spatial.transform import Rotation  # here: scipy.spatial costs 0.25 s to import
+
         if self.mount_matrix is not None:
             base = np.array(self.mount_matrix, dtype=float)
         else:
@@ -468,6 +469,8 @@ def renamed_mount(value):
         The table without ``mount_zyx_deg``.
     """
     import warnings
+
+    from scipy.spatial.transform import Rotation  # here: scipy.spatial costs 0.25 s to import
 
     if not isinstance(value, dict) or "mount_zyx_deg" not in value:
         return value

@@ -56,7 +56,6 @@ from pydantic import (
     Strict,
     model_validator,
 )
-from scipy.spatial.transform import Rotation
 
 from flexsat.compiled.linalg3 import (
     add,
@@ -247,6 +246,8 @@ class ModalAppendageConfig(BaseModel):
     def mount_rotation(self) -> np.ndarray:
         """R_BM: ``mount_matrix``, else Rz(yaw) Ry(sadm) (intrinsic Z then Y, as for the
         plate), shape (3, 3); on a drive, R_BM0 Rot(u, alpha(0)) (:meth:`drive_mount`)."""
+        from scipy.spatial.transform import Rotation  # here: scipy.spatial costs 0.25 s to import
+
         if self.drive is not None:
             R0, u, alpha = self.drive_mount()
             return R0 @ Rotation.from_rotvec(alpha * u).as_matrix()
@@ -258,6 +259,8 @@ class ModalAppendageConfig(BaseModel):
     def drive_mount(self) -> tuple[np.ndarray, np.ndarray, float]:
         """On a drive: R_BM0 (3, 3), the mount at drive angle 0 (``mount_matrix``, else
         Rz(yaw)); the unit axis u (3,), frame M; the initial angle alpha(0) [rad]."""
+        from scipy.spatial.transform import Rotation  # here: scipy.spatial costs 0.25 s to import
+
         if self.mount_matrix is not None:
             R0 = np.array(self.mount_matrix, dtype=float)
         else:
@@ -1101,6 +1104,8 @@ class ModalModel(AppendageModel):
         """R_BF, the frame of the packed invariants -> B, shape (3, 3): identity when
         rigidly mounted (they are packed in B), R_BM0 Rot(u, alpha) on a drive (eq. D.1;
         ``alpha`` default its initial angle)."""
+        from scipy.spatial.transform import Rotation  # here: scipy.spatial costs 0.25 s to import
+
         if params[P_DRIVE] == 0.0:
             return np.eye(3)
         alpha = params[P_ALPHA0] if alpha is None else alpha

@@ -33,7 +33,6 @@ from typing import ClassVar
 
 import numpy as np
 from numba import njit
-from scipy.spatial.transform import Rotation
 
 from flexsat.compiled.linalg3 import (
     add,
@@ -82,6 +81,7 @@ from flexsat.dynamics.appendages.contract import (
 )
 from flexsat.dynamics.appendages.plate_config import PlateConfig
 from flexsat.dynamics.appendages.sadm import driven_plate
+from flexsat.dynamics.rotation import EulerRotation as Rotation
 from flexsat.dynamics.tuning import tune_joints
 
 __all__ = ["JOINT_DOFS", "PlateModel"]
