@@ -8,11 +8,12 @@ full model (1 ms, controller every step) and the reduced one (root translations 
 20 ms step and control period) interleaved case by case, and prints the median CPU
 time (``time.process_time``) per case of each part: the config validated and the plant
 built (``case_inputs``), the loop's arrays prepared (``prepare_slew``), the compiled
-loop, the derived records (compiled), the rest of the result dataset (xarray, attitude
-conversions), the metrics, the decimated history and what remains (the row, the
-dataset's attributes). Timings only: CPU time does
-not depend on the machine's load as much as wall time, but a loaded machine still
-inflates it (shared caches); the load average is printed beside the table.
+loop (``fly_whole``), the derived records (compiled), the rest of the records (numpy:
+attitude conversions, quaternions, root motion, errors; no xarray dataset is built),
+the metrics, the decimated history and what remains (the row, the run's attributes).
+Timings only: CPU time does not depend on the machine's load as much as wall time, but
+a loaded machine still inflates it (shared caches); the load average is printed beside
+the table.
 
 ``--cases N`` (default 5 per model), ``--duration S`` (default 120). Run with
 ``python bench/bench_case_cost.py``.
@@ -26,6 +27,7 @@ from collections import defaultdict
 
 import flexsat.analysis.effort as effort
 import flexsat.analysis.requirements as requirements
+import flexsat.simulate.batch as batch
 import flexsat.simulate.closedloop as closedloop
 import flexsat.simulate.result as result
 import harness  # the benchmarks run with bench/ on sys.path
@@ -38,9 +40,9 @@ GOAL_S = 0.03  # CPU-s per reduced-model case: 1000 cases in 15 s on 2 cores (is
 PARTS = (
     ("config + plant", cases, "case_inputs"),
     ("prepare", closedloop, "prepare_slew"),
-    ("compiled loop", closedloop, "_compiled_loop"),  # the entry point found, the steps
+    ("compiled loop", batch, "fly_whole"),  # the entry point found, the steps
     ("derived records", result, "derive_records"),
-    ("dataset", closedloop, "build_dataset"),
+    ("records", closedloop, "build_records"),  # the rest of the records (numpy)
     ("metrics", requirements, "slew_metrics"),
     ("metrics", effort, "effort_metrics"),
     ("history", cases, "case_history"),
@@ -75,7 +77,7 @@ def _instrument(spent: dict[str, float]) -> None:
 
 @harness.register(
     "CPU time of one campaign case (120 s thesis slew), full and reduced model, part by part "
-    "(config + plant, prepare, compiled loop, derived records, dataset, metrics, history, rest) "
+    "(config + plant, prepare, compiled loop, derived records, records, metrics, history, rest) "
     "against 0.03 CPU-s per reduced case",
     targets=[harness.Target(
         f"one reduced campaign case <= {GOAL_S} CPU-s", GOAL_S, "CPU-s",
@@ -103,14 +105,14 @@ def main(argv: list[str] | None = None) -> dict:
         timed = harness.stopwatch(lambda: cases.run_case(next(remaining[m])))
         assert timed.value["status"] == "ok", timed.value["error"]
         parts = dict(spent)
-        parts["dataset"] -= parts["derived records"]  # derive_records runs inside it
+        parts["records"] -= parts["derived records"]  # derive_records runs inside it
         parts["other"] = timed.cpu_s - sum(parts.values())
         return {**parts, "total": timed.cpu_s}
 
     # interleaved: both models see the same load
     rounds = harness.interleave({m: lambda m=m: case(m) for m in models}, args.cases)
     load = harness.load()
-    names = ["config + plant", "prepare", "compiled loop", "derived records", "dataset",
+    names = ["config + plant", "prepare", "compiled loop", "derived records", "records",
              "metrics", "history", "other", "total"]  # fmt: skip
     table = harness.table(f"CPU-s per case, median of {args.cases} ({args.duration:g} s slews, "
                           f"load {load})", ("model", *names, f"<= {GOAL_S} s"))  # fmt: skip

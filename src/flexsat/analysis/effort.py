@@ -11,8 +11,14 @@ slowest coupled mode of the nominal satellite, 0.26 Hz).
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
-import xarray as xr
+
+if TYPE_CHECKING:
+    import xarray as xr
+
+    from flexsat.analysis.run_records import RunRecords
 
 __all__ = ["RESIDUAL_WINDOW_S", "effort_metrics"]
 
@@ -20,14 +26,15 @@ RESIDUAL_WINDOW_S = 10.0
 """Length of the run's final window the residual elastic energy is taken over [s]."""
 
 
-def effort_metrics(ds: xr.Dataset) -> dict[str, float]:
+def effort_metrics(ds: xr.Dataset | RunRecords) -> dict[str, float]:
     """Control energy [J] and residual elastic energy [J] of a closed-loop run.
 
     Parameters
     ----------
-    ds : xarray.Dataset
-        A closed-loop result (``tau_applied`` and ``omega`` (time, axis), frame B;
-        ``elastic_energy`` (time,)).
+    ds : xarray.Dataset or RunRecords
+        A closed-loop result, or its records
+        (:class:`~flexsat.analysis.run_records.RunRecords`: read alike):
+        ``tau_applied`` and ``omega`` (time, axis), frame B; ``elastic_energy`` (time,).
 
     Returns
     -------
@@ -36,7 +43,7 @@ def effort_metrics(ds: xr.Dataset) -> dict[str, float]:
         records); ``residual_elastic_energy_j``: max U over the last
         :data:`RESIDUAL_WINDOW_S` [J].
     """
-    v = ds.variables  # the arrays, without building a DataArray per lookup
+    v = ds.variables  # the arrays (a dataset's: without building a DataArray per lookup)
     t = np.asarray(v["time"].values, dtype=float)
     power = np.abs(np.sum(v["tau_applied"].values * v["omega"].values, axis=1))
     elastic = np.asarray(v["elastic_energy"].values, dtype=float)

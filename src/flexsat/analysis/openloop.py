@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 import xarray as xr
 
+from flexsat.analysis.run_records import RunRecords
 from flexsat.analysis.spectral import dominant_frequency
 
 __all__ = ["finite_part", "openloop_metrics"]
@@ -68,7 +69,7 @@ def openloop_metrics(ds: xr.Dataset) -> dict:
     }
 
 
-def finite_part(ds: xr.Dataset) -> xr.Dataset:
+def finite_part(ds: xr.Dataset | RunRecords) -> xr.Dataset | RunRecords:
     """The records before the first one where any time-dependent variable is not finite.
 
     A diverging run's last records can overflow (energies, momenta of a state that
@@ -78,14 +79,17 @@ def finite_part(ds: xr.Dataset) -> xr.Dataset:
 
     Parameters
     ----------
-    ds : xarray.Dataset
-        A run's dataset.
+    ds : xarray.Dataset or RunRecords
+        A run's dataset, or its records.
 
     Returns
     -------
-    xarray.Dataset
-        Its finite leading records.
+    xarray.Dataset or RunRecords
+        Its finite leading records (a :class:`~flexsat.analysis.run_records.RunRecords`
+        given: its own, :meth:`~flexsat.analysis.run_records.RunRecords.finite_part`).
     """
+    if isinstance(ds, RunRecords):  # a campaign case's records, no dataset built
+        return ds.finite_part()
     bad = np.zeros(ds.sizes["time"], dtype=bool)
     # the variables themselves: ds.data_vars.values() builds a DataArray for each
     for var in ds.data_vars.variables.values():

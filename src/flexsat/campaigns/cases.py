@@ -46,8 +46,9 @@ def case_history(ds, dt: float = HISTORY_DT_S) -> dict:
 
     Parameters
     ----------
-    ds : xarray.Dataset
-        The slew's dataset (:class:`~flexsat.simulate.result.Result`'s).
+    ds : xarray.Dataset or RunRecords
+        The slew's dataset (:class:`~flexsat.simulate.result.Result`'s), or its
+        records (:class:`~flexsat.analysis.run_records.RunRecords`, read alike).
     dt : float
         Sampling interval [s].
 
@@ -59,12 +60,15 @@ def case_history(ds, dt: float = HISTORY_DT_S) -> dict:
     """
     import numpy as np
 
-    # ds.variables: the arrays, without building a DataArray per lookup (tens of us)
+    # ds.variables: the arrays (a dataset's: without building a DataArray per lookup)
     t = np.asarray(ds.variables["time"].values, dtype=float)
     if t.size == 0:
         return {"time": t}
     grid = np.arange(t[0], t[-1] + 0.5 * dt, dt)
-    index = np.unique(np.clip(np.searchsorted(t, grid - 1e-9 * dt), 0, t.size - 1))
+    index = np.clip(np.searchsorted(t, grid - 1e-9 * dt), 0, t.size - 1)
+    # the grid increases, so the indices never decrease: their distinct values are
+    # those that differ from the one before (np.unique's, without its sort)
+    index = index[np.flatnonzero(np.diff(index, prepend=-1))]
     history = {"time": t[index]}
     for name in ("pointing_error_deg", "rate_error_deg_s", "tau_cmd", "total_energy"):
         if name in ds:
@@ -130,23 +134,25 @@ def case_inputs(case: ResolvedCase):
     return plant, SlewScenario.model_validate(case.scenario)
 
 
-def finish_row(row: dict, result) -> None:
-    """Fill a row from its slew's :class:`~flexsat.simulate.result.Result`: history,
-    status and metrics (the stored scenario's requirements, control effort).
+def finish_row(row: dict, records) -> None:
+    """Fill a row from its slew's records: history, status and metrics (the stored
+    scenario's requirements, control effort).
 
     Parameters
     ----------
     row : dict
         The case's row (from :func:`case_row`), filled in place.
-    result : Result
-        The finished slew.
+    records : RunRecords or xarray.Dataset
+        The finished slew's records
+        (:func:`~flexsat.simulate.closedloop.finish_slew` with ``as_records=True``: no
+        dataset built), or its result's dataset: the same row.
     """
     from flexsat.analysis.effort import effort_metrics
     from flexsat.analysis.requirements import slew_metrics
 
-    row[HISTORY_KEY] = case_history(result.dataset)
-    metrics = slew_metrics(result.dataset)
-    metrics.update(effort_metrics(result.dataset))
+    row[HISTORY_KEY] = case_history(records)
+    metrics = slew_metrics(records)
+    metrics.update(effort_metrics(records))
     metrics.pop("wall_time_s")
     status, message = metrics.pop("status"), metrics.pop("message")
     row.update(status=status, error=message, metrics=metrics)
@@ -186,7 +192,8 @@ def run_case(case: ResolvedCase) -> dict:
         key's unit), ``case_wall_time_s`` and ``case_cpu_time_s`` (the case's own
         wall and CPU time [s]).
     """
-    from flexsat.simulate import run_slew
+    from flexsat.simulate.batch import fly_whole
+    from flexsat.simulate.closedloop import finish_slew, prepare_slew
 
     row = case_row(case)
     start, cpu = time.perf_counter(), time.process_time()
@@ -194,9 +201,12 @@ def run_case(case: ResolvedCase) -> dict:
         row.update(status="failed", error=case.error, metrics={}, case_wall_time_s=0.0,
                    case_cpu_time_s=0.0)  # fmt: skip
         return row
-    try:
-        plant, scenario = case_inputs(case)
-        finish_row(row, run_slew(plant, scenario, progress=False))
+    try:  # run_slew's steps, its result kept as records (no xarray dataset)
+        run = prepare_slew(*case_inputs(case))
+        flight = time.perf_counter()
+        status, done, rows = fly_whole(run)
+        wall = time.perf_counter() - flight
+        finish_row(row, finish_slew(run, status, done, rows, wall, as_records=True))
     except Exception as exc:  # a failed case is data, not a crash of the campaign
         fail_row(row, exc)
     row["case_wall_time_s"] = time.perf_counter() - start

@@ -132,7 +132,7 @@ def _finish(chunk: list[_Case], future) -> Iterator[dict]:
         start, cpu = time.perf_counter(), time.thread_time()
         status, done, rows = (int(v) for v in flown[k])
         try:
-            finish_row(c.row, finish_slew(c.run, status, done, rows, share))
+            finish_row(c.row, finish_slew(c.run, status, done, rows, share, as_records=True))
         except Exception as exc:  # a failed case is data, not a crash of the campaign
             fail_row(c.row, exc)
         c.wall += share + time.perf_counter() - start

@@ -34,6 +34,7 @@ __all__ = [
     "fly_batch",
     "fly_entry",
     "fly_prepared",
+    "fly_whole",
     "item_type",
     "slew_timing",
 ]
@@ -312,6 +313,29 @@ def fly_entry(item: BatchItem):
         plant, frame, done, rows, max_chunks) -> (status, steps_done, rows_written)``.
     """
     return _overload(fly, *item_type(item).types, types.int64, types.int64, types.int64)
+
+
+def fly_whole(run) -> tuple[int, int, int]:
+    """Fly a prepared slew to its end in one compiled call, in this thread.
+
+    The call :func:`~flexsat.simulate.closedloop.run_slew` makes for a slew without a
+    progress bar or a record stream (:func:`fly_entry`, every chunk in one call): the
+    same records bit for bit.
+
+    Parameters
+    ----------
+    run : PreparedSlew
+        The slew (:func:`flexsat.simulate.closedloop.prepare_slew`), flown in place.
+
+    Returns
+    -------
+    tuple of int
+        Status (0: finished; else :mod:`flexsat.compiled.status`), steps done and
+        record rows written [-].
+    """
+    item = batch_item(run)
+    status, done, rows = fly_entry(item)(*item, 0, 0, item.timing.n_steps + 1)
+    return int(status), int(done), int(rows)
 
 
 def fly_prepared(runs: list, threads: int = 1) -> np.ndarray:

@@ -11,6 +11,7 @@ from typing import NamedTuple, Protocol
 import numpy as np
 import xarray as xr
 
+from flexsat.analysis.run_records import RunRecords
 from flexsat.config import nominal
 from flexsat.config.models import SatelliteConfig
 from flexsat.control.laws import get_law
@@ -25,7 +26,7 @@ from flexsat.simulate.layout import LoopLayout
 from flexsat.simulate.loops import LoopData, LoopStages
 from flexsat.simulate.openloop import initial_state
 from flexsat.simulate.python_loop import python_loop
-from flexsat.simulate.result import Result, build_dataset
+from flexsat.simulate.result import Result, build_dataset, build_records
 from flexsat.simulate.run_setup import (
     PROGRESS_MIN_STEPS,
     check_run_size,
@@ -312,8 +313,8 @@ def prepare_slew(plant: Plant, scenario: SlewScenario, design_J: np.ndarray | No
 
 
 def finish_slew(run: PreparedSlew, status: int, done: int, rows: int, wall: float,
-                compiled_law: bool = True,
-                stream: RecordStream | None = None) -> Result:  # fmt: skip
+                compiled_law: bool = True, stream: RecordStream | None = None, *,
+                as_records: bool = False) -> Result | RunRecords:  # fmt: skip
     """The :class:`~flexsat.simulate.result.Result` of a slew the loop has flown.
 
     Parameters
@@ -333,10 +334,13 @@ def finish_slew(run: PreparedSlew, status: int, done: int, rows: int, wall: floa
     stream : RecordStream, optional
         Where the run's earlier blocks of records went: the buffers' ``rows`` are
         its last block.
+    as_records : bool
+        Return what the result's dataset would hold as plain arrays instead, without
+        building the dataset (a campaign case's row; a run without ``stream``).
 
     Returns
     -------
-    Result
+    Result or RunRecords
     """
     scenario, x, frame, data = run.scenario, run.x, run.frame, run.data
     records = run.rec_t, run.rec_x, run.rec_ctrl, run.rec_frame, run.rec_Q, run.rec_solved
@@ -348,6 +352,8 @@ def finish_slew(run: PreparedSlew, status: int, done: int, rows: int, wall: floa
         rows += 1
     attrs = _slew_attributes(run, status, t_fail, wall, done, compiled_law)
     if stream is None:
+        if as_records:  # no xarray dataset (docs/performance.md, "Campaign cases")
+            return _slew_block(run, rows, attrs, build=build_records)
         return Result(_slew_block(run, rows, attrs))
     if rows:
         stream.append(_slew_block(run, rows, attrs, stream.energy0))
@@ -376,9 +382,10 @@ def _slew_attributes(run: PreparedSlew, status: int, t_fail: float, wall: float,
     return attrs
 
 
-def _slew_block(run: PreparedSlew, rows: int, attrs: dict,
-                energy0: float | None = None) -> xr.Dataset:  # fmt: skip
-    """The dataset of the first ``rows`` records of the buffers (a run's, or a block)."""
+def _slew_block(run: PreparedSlew, rows: int, attrs: dict, energy0: float | None = None,
+                build=build_dataset) -> xr.Dataset | RunRecords:  # fmt: skip
+    """The dataset of the first ``rows`` records of the buffers (a run's, or a block);
+    ``build``: :func:`~flexsat.simulate.result.build_records` for the plain arrays."""
     plant, scenario, _, layout = run[:4]
     data = run.data
     records = run.rec_t, run.rec_x, run.rec_ctrl, run.rec_frame, run.rec_Q, run.rec_solved
@@ -420,7 +427,7 @@ def _slew_block(run: PreparedSlew, rows: int, attrs: dict,
         )  # fmt: skip
         return more
 
-    return build_dataset(
+    return build(
         plant, rec_t, rec_x[:, at.q], rec_x[:, at.qd], rec_x[:, at.work_in],
         rec_x[:, at.dissipated], rec_ctrl[:, layout.tau_cmd], rec_ctrl[:, layout.tau_applied],
         dict(attrs), energy0, frames=rec_frame, joint_force=rec_Q, solved=rec_solved,

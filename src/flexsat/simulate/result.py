@@ -27,13 +27,14 @@ import pandas as pd
 import xarray as xr
 from xarray.indexes import PandasIndex
 
+from flexsat.analysis.run_records import Record, RunRecords
 from flexsat.dynamics.attitude import inertial_records, vectors_to_inertial
 from flexsat.dynamics.plant import Plant
 from flexsat.dynamics.records import derive_records
 from flexsat.errors import SimulationError
 
-__all__ = ["FIGURE_PROVIDER", "Result", "ResultFigures", "build_dataset", "register_result_figures",
-           "result_figures"]  # fmt: skip
+__all__ = ["FIGURE_PROVIDER", "Result", "ResultFigures", "build_dataset", "build_records",
+           "dataset_of", "register_result_figures", "result_figures"]  # fmt: skip
 
 AXES = ("x", "y", "z")
 
@@ -289,7 +290,7 @@ class Result:
             return cls(ds.load())
 
 
-def build_dataset(
+def build_records(
     plant: Plant,
     t: np.ndarray,
     q: np.ndarray,
@@ -304,8 +305,12 @@ def build_dataset(
     joint_force: np.ndarray | None = None,
     solved: np.ndarray | None = None,
     more: Callable[[dict], dict] | None = None,
-) -> xr.Dataset:
-    """Derive every recorded quantity from the recorded states.
+) -> RunRecords:
+    """Derive every recorded quantity from the recorded states, as plain arrays.
+
+    What :func:`build_dataset` puts in a run's dataset, without building it: a
+    campaign case's metrics and history read these (docs/performance.md, "Campaign
+    cases").
 
     Parameters
     ----------
@@ -341,8 +346,13 @@ def build_dataset(
         into it. Default: all solved for.
     more : callable, optional
         Given the data variables (name -> (dims, values, attributes)), returns more
-        of them, added before the dataset is built: one construction instead of a
-        merge per call of ``Dataset.assign`` (about 2 ms on a 6000-record slew).
+        of them, added to the records.
+
+    Returns
+    -------
+    RunRecords
+        Every variable (the dimension coordinates ``time`` [s], ``axis``, ``euler``,
+        ``quat``, ``appendage`` and ``dof`` included) and ``attrs``.
     """
     m, n = q.shape
     names = [a.name for a in plant.config.appendages]
@@ -430,7 +440,68 @@ def build_dataset(
         "appendage": (names, {}),
         "dof": (plant.dof_names(), {}),
     }
-    return _dataset(data_vars, coords, attrs)
+    variables = {name: Record((dims,) if isinstance(dims, str) else tuple(dims), values, attributes)
+                 for name, (dims, values, attributes) in data_vars.items()}  # fmt: skip
+    for name, (values, attributes) in coords.items():
+        variables[name] = Record((name,), np.asarray(values), attributes)
+    return RunRecords(variables, attrs)
+
+
+def build_dataset(
+    plant: Plant,
+    t: np.ndarray,
+    q: np.ndarray,
+    qd: np.ndarray,
+    work_in: np.ndarray,
+    dissipated: np.ndarray,
+    tau_cmd: np.ndarray,
+    tau_applied: np.ndarray,
+    attrs: dict,
+    energy0: float | None = None,
+    frames: np.ndarray | None = None,
+    joint_force: np.ndarray | None = None,
+    solved: np.ndarray | None = None,
+    more: Callable[[dict], dict] | None = None,
+) -> xr.Dataset:
+    """Derive every recorded quantity from the recorded states, as a run's dataset.
+
+    Parameters
+    ----------
+    plant, t, q, qd, work_in, dissipated, tau_cmd, tau_applied, attrs : as in :func:`build_records`
+        The plant, the records and the attributes.
+    energy0, frames, joint_force, solved, more : as in :func:`build_records`
+        The optional records.
+
+    Returns
+    -------
+    xarray.Dataset
+        :func:`build_records`' variables and attributes (:func:`dataset_of`).
+    """
+    return dataset_of(build_records(plant, t, q, qd, work_in, dissipated, tau_cmd, tau_applied,
+                                    attrs, energy0, frames, joint_force, solved, more))  # fmt: skip
+
+
+def dataset_of(records: RunRecords) -> xr.Dataset:
+    """The ``xarray.Dataset`` of a run's records (the arrays themselves, not copies).
+
+    Parameters
+    ----------
+    records : RunRecords
+        The records (:func:`build_records`): each record whose only dimension bears
+        its name becomes an index coordinate, every other one a data variable.
+
+    Returns
+    -------
+    xarray.Dataset
+        With the records' attributes.
+    """
+    data_vars, coords = {}, {}
+    for name, var in records.variables.items():
+        if var.dims == (name,):
+            coords[name] = (var.values, var.attrs)
+        else:
+            data_vars[name] = (var.dims, var.values, var.attrs)
+    return _dataset(data_vars, coords, dict(records.attrs))
 
 
 def _dataset(data_vars: dict, coords: dict, attrs: dict) -> xr.Dataset:
