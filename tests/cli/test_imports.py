@@ -89,6 +89,12 @@ def test_openloop_json_loads_neither_figures_spectra_nor_the_closed_loop():
                            "flexsat.dynamics.appendages.chain_kernels")) == []  # fmt: skip
 
 
+def test_openloop_with_out_still_builds_the_dataset(tmp_path):
+    modules = loaded("openloop", "--json", "--duration", "2", "--out", str(tmp_path / "run"))
+    assert "xarray" in modules  # result.nc is the dataset's
+    assert (tmp_path / "run" / "result.nc").is_file()
+
+
 def test_slew_json_loads_neither_figures_nor_spectra(tmp_path):
     scenario = tmp_path / "short.toml"  # a 0.1 s slew whose observation window fits in it
     scenario.write_text("duration_s = 0.1\n[requirements]\nsettling_deadline_s = 0.05\n")

@@ -594,13 +594,15 @@ def openloop(
             source=_options(given),
             model=OpenLoopScenario,
         )
-    result, metrics = fly_openloop(plant, chosen, out, progress=None if not json_output else False)
+    # Without --out only the metrics are printed: no dataset is built (no xarray).
+    _, metrics = fly_openloop(plant, chosen, out, progress=None if not json_output else False,
+                              dataset=out is not None)  # fmt: skip
     if json_output:
         typer.echo(dumps(metrics))
     else:
         _print_metrics(metrics)
-    if not result.ok:
-        _print_error(result.message)
+    if metrics["status"] != "ok":  # the run's status and message, as its result has them
+        _print_error(metrics["message"])
         raise typer.Exit(1)
 
 

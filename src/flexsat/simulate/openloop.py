@@ -7,9 +7,9 @@ import os
 import tempfile
 import time
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
-import xarray as xr
 from numba import njit
 
 from flexsat.compiled.status import STATUS_STEP_BUDGET, STATUS_STEP_TOO_SMALL
@@ -24,7 +24,6 @@ from flexsat.dynamics.integrators import (
 )
 from flexsat.dynamics.kernels import STATUS_OK, hub_cs
 from flexsat.dynamics.plant import Plant
-from flexsat.simulate.result import Result, build_dataset
 from flexsat.simulate.run_setup import (
     PROGRESS_MIN_STEPS,
     check_run_size,
@@ -33,7 +32,12 @@ from flexsat.simulate.run_setup import (
     run_attributes,
 )
 from flexsat.simulate.scenario import OpenLoopScenario, thesis_openloop
-from flexsat.simulate.stream import RecordStream, check_disk_space
+
+if TYPE_CHECKING:  # xarray (0.4 s to import) loads only when a dataset is built
+    import xarray as xr
+
+    from flexsat.analysis.run_records import RunRecords
+    from flexsat.simulate.result import Result
 
 __all__ = [
     "DOP853_MIN_STEP_FRACTION",
@@ -64,7 +68,8 @@ def run_openloop(
     *,
     record_path: str | Path | None = None,
     record_budget_bytes: float | None = None,
-) -> Result:
+    records: bool = False,
+) -> Result | RunRecords:
     """Simulate the plant under the scenario's torque profile.
 
     Parameters
@@ -82,10 +87,17 @@ def run_openloop(
     record_budget_bytes : float, optional
         Memory the records may use before they are streamed [bytes]; default: half the
         machine's memory (:func:`flexsat.simulate.run_setup.check_run_size`).
+    records : bool
+        Return the records as plain arrays
+        (:class:`~flexsat.analysis.run_records.RunRecords`, what the dataset would
+        hold, bit for bit) instead of a :class:`Result`: no ``xarray.Dataset`` is built
+        and xarray is not imported (what ``flexsat openloop`` without ``--out`` needs,
+        docs/performance.md, 'Start-up'). A run that is streamed still returns a
+        :class:`Result`.
 
     Returns
     -------
-    Result
+    Result or RunRecords
         Recorded every ``record_dt_s``. A diverging run stops at the failing step and
         returns its history up to there with ``status = "failed"`` and a message
         that names the time; it does not raise. A streamed run's dataset reads its
@@ -102,6 +114,8 @@ def run_openloop(
     estimate = check_run_size(plant.n_dof, scenario, record_budget_bytes, can_stream=rk4)
     stream = None
     if rk4 and (record_path is not None or not estimate.fits_in_memory):
+        from flexsat.simulate.stream import RecordStream, check_disk_space
+
         path = Path(record_path) if record_path is not None else _temporary_record_file()
         check_disk_space(path.parent, estimate.record_bytes * estimate.records)
         stream = RecordStream(path)
@@ -109,12 +123,13 @@ def run_openloop(
     profile = _profile(scenario)
     attrs = run_attributes(plant, scenario, "open-loop", 0, -1.0, 0.0, 0)
     attrs["solver"] = scenario.solver
-    blocks: list[xr.Dataset] = []
+    blocks: list[xr.Dataset | RunRecords] = []
+    as_records = records and stream is None
     building = [0.0]  # seconds spent building record blocks, not integrating
 
     def keep(t, X, tau, F) -> None:
         begin = time.perf_counter()
-        block = _block(plant, t, X, tau, F, profile, attrs, stream)
+        block = _block(plant, t, X, tau, F, profile, attrs, stream, as_records)
         if stream is None:
             blocks.append(block)
         else:
@@ -138,6 +153,12 @@ def run_openloop(
         keep(t, X, tau, F)
     wall = time.perf_counter() - start - building[0]
     final = run_attributes(plant, scenario, "open-loop", status, t_fail, wall, steps)
+    if as_records:
+        (held,) = blocks  # one block of every record
+        held.attrs.update(final)
+        return held
+    from flexsat.simulate.result import Result
+
     if stream is not None:
         return Result(stream.finish(final), stream.path)
     (dataset,) = blocks  # held in memory: one block of every record
@@ -151,15 +172,19 @@ def _temporary_record_file() -> Path:
     return Path(name)
 
 
-def _block(plant, t, X, tau, F, profile, attrs, stream) -> xr.Dataset:
-    """The dataset of consecutive records (all of a run's, or one streamed block)."""
+def _block(plant, t, X, tau, F, profile, attrs, stream,
+           records: bool = False) -> xr.Dataset | RunRecords:  # fmt: skip
+    """The dataset of consecutive records (all of a run's, or one streamed block); with
+    ``records``, the same as plain arrays (no dataset)."""
+    from flexsat.simulate.result import build_dataset, build_records
+
     lay = plant.layout
     seg_start, seg_end, seg_torque, _ = profile
     tau_cmd = np.array(
         [applied_torque(tk, seg_start, seg_end, seg_torque, np.zeros(3)) for tk in t]
     ).reshape(-1, 3)
     energy0 = None if stream is None else stream.energy0
-    return build_dataset(
+    return (build_records if records else build_dataset)(
         plant, t, X[:, lay.q], X[:, lay.qd], X[:, lay.work_in], X[:, lay.dissipated], tau_cmd,
         tau, dict(attrs), energy0, frames=F,
     )  # fmt: skip

@@ -21,17 +21,18 @@ import shutil
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
-import pandas as pd
-import xarray as xr
-from xarray.indexes import PandasIndex
 
 from flexsat.analysis.run_records import Record, RunRecords
 from flexsat.dynamics.attitude import inertial_records, vectors_to_inertial
 from flexsat.dynamics.plant import Plant
 from flexsat.dynamics.records import derive_records
 from flexsat.errors import SimulationError
+
+if TYPE_CHECKING:  # xarray and pandas (0.4 s) load when a dataset is built or read
+    import xarray as xr
 
 __all__ = ["FIGURE_PROVIDER", "Result", "ResultFigures", "build_dataset", "build_records",
            "dataset_of", "register_result_figures", "result_figures"]  # fmt: skip
@@ -286,6 +287,8 @@ class Result:
     @classmethod
     def from_netcdf(cls, path: str | Path) -> Result:
         """Read a result written by :meth:`to_netcdf` (loaded into memory)."""
+        import xarray as xr
+
         with xr.open_dataset(path) as ds:
             return cls(ds.load())
 
@@ -523,6 +526,10 @@ def _dataset(data_vars: dict, coords: dict, attrs: dict) -> xr.Dataset:
     attrs : dict
         Dataset attributes.
     """
+    import pandas as pd
+    import xarray as xr
+    from xarray.indexes import PandasIndex
+
     variables, indexes = {}, {}
     for name, (values, attributes) in coords.items():
         values = np.asarray(values)

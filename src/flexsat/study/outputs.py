@@ -165,7 +165,8 @@ def write_modal(plant: Plant, out: Path | None = None, animate: list[int] | None
     return analysis, summary
 
 
-def fly_openloop(plant: Plant, scenario=None, out: Path | None = None, progress=None):
+def fly_openloop(plant: Plant, scenario=None, out: Path | None = None, progress=None, *,
+                 dataset: bool = True):  # fmt: skip
     """Open-loop run and its metrics; with ``out``, result.nc, figures, metrics.json.
 
     Parameters
@@ -178,14 +179,21 @@ def fly_openloop(plant: Plant, scenario=None, out: Path | None = None, progress=
         A run whose records do not fit in memory streams them to ``out/result.nc``.
     progress : bool or None
         Progress bar: None shows it on a terminal only.
+    dataset : bool
+        Build the result's dataset. False (only without ``out``): the metrics are
+        computed from the records as plain arrays, the same numbers, without xarray
+        (``flexsat openloop`` without ``--out``, docs/performance.md, 'Start-up').
 
     Returns
     -------
-    result : Result
+    result : Result or RunRecords
+        The run; its records (:class:`~flexsat.analysis.run_records.RunRecords`) when
+        ``dataset`` is False and the run was held in memory.
     metrics : dict
         :func:`flexsat.analysis.openloop.openloop_metrics`, plus ``files``.
     """
     from flexsat.analysis.openloop import openloop_metrics
+    from flexsat.analysis.run_records import RunRecords
     from flexsat.simulate import OpenLoopScenario, run_openloop
 
     def figures() -> list[Path]:  # matplotlib is imported only when figures are drawn
@@ -202,8 +210,11 @@ def fly_openloop(plant: Plant, scenario=None, out: Path | None = None, progress=
         prepare_output_dir(out)
         fits = check_run_size(plant.n_dof, scenario, can_stream=True).fits_in_memory
         record_path = None if fits else Path(out) / "result.nc"  # streamed into place
-    result = run_openloop(plant, scenario, progress=progress, record_path=record_path)
-    metrics = openloop_metrics(result.dataset)
+    if not dataset and out is not None:
+        raise ValueError("fly_openloop: the files of out need the dataset (dataset=True)")
+    result = run_openloop(plant, scenario, progress=progress, record_path=record_path,
+                          records=not dataset)  # fmt: skip
+    metrics = openloop_metrics(result if isinstance(result, RunRecords) else result.dataset)
     if out is not None:
         _write_run(result, metrics, Path(out), figures)
     return result, metrics
