@@ -14,7 +14,9 @@ import pytest
 from flexsat.analysis.openloop import openloop_metrics
 from flexsat.analysis.run_records import RunRecords
 from flexsat.config import validate_config
+from flexsat.dynamics.integrators import applied_torque
 from flexsat.simulate import OpenLoopScenario, run_openloop
+from flexsat.simulate.openloop import commanded_torques
 from flexsat.simulate.result import Result
 from flexsat.study.outputs import fly_openloop
 
@@ -24,6 +26,8 @@ _PULSE = {"duration_s": 20.0}
 # 1 MN m about Z from t = 0 (tests/simulate/test_divergence.py): the run overflows near
 # t = 10.17 s, so the metrics come from the finite part of the records.
 _HUGE_TORQUE = {"duration_s": 11.0, "torque": [{"start_s": 0.0, "torque_nm": [0, 0, 1e6]}]}
+SEED = 46
+"""The random segment torques' seed (fixed, printed)."""
 
 
 def _same(a, b) -> bool:
@@ -69,3 +73,20 @@ def test_openloop_metrics_read_a_dataset_and_records_alike(nominal_plant):
 def test_the_files_of_out_need_the_dataset(nominal_plant, tmp_path):
     with pytest.raises(ValueError, match="dataset=True"):
         fly_openloop(nominal_plant, OpenLoopScenario(duration_s=1.0), tmp_path, dataset=False)
+
+
+def test_commanded_torques_are_the_per_record_applied_torques():
+    # Segments that overlap, start and end between and on record times, one never
+    # ending: the batch must sum them exactly as applied_torque does record by record.
+    print(f"seed = {SEED}")
+    rng = np.random.default_rng(SEED)
+    t = np.arange(0.0, 20.0 + 1e-9, 0.01)
+    seg_start = np.array([0.0, 2.5, 3.0, 7.123, 15.0])
+    seg_end = np.array([10.0, 2.5, 12.0, 7.125, np.inf])
+    seg_torque = rng.normal(size=(5, 3))
+    expected = np.array([applied_torque(tk, seg_start, seg_end, seg_torque, np.zeros(3))
+                         for tk in t])  # fmt: skip
+    got = commanded_torques(t, seg_start, seg_end, seg_torque)
+    assert got.shape == (t.size, 3)
+    assert np.array_equal(got, expected)  # exact: the same additions in the same order
+    assert commanded_torques(t[:0], seg_start, seg_end, seg_torque).shape == (0, 3)
