@@ -14,7 +14,7 @@ from flexsat.analysis import (
     relative_performance_error,
     slew_metrics,
 )
-from flexsat.analysis.requirements import residual_rate_verdict
+from flexsat.analysis.requirements import residual_rate_verdict, unjudged_reason
 from flexsat.control.quaternion import quaternion_error, target_quaternion
 from flexsat.errors import ConfigError
 from flexsat.simulate import SlewScenario, load_slew, run_slew
@@ -118,11 +118,53 @@ def test_the_window_comes_from_the_stored_requirements():
     assert not metrics["r1_pass"]  # at 30 s the error is still 45 e^-6 = 0.11 deg
 
 
-def test_a_run_that_ends_before_the_deadline_fails():
+def test_a_run_planned_to_end_before_the_deadline_is_not_judged():
+    # 80 s planned, the window opens at 90 s: never observed, so neither pass nor fail
     metrics = slew_metrics(synthetic_slew(settles, quiet, duration_s=80.0))
     assert metrics["observation_window_s"] == [90.0, 80.0]
-    assert not metrics["r1_pass"] and not metrics["r2_pass"]
+    assert metrics["r1_pass"] is None and metrics["r2_pass"] is None
+    assert metrics["not_judged_reason"] == (
+        "the run ends at 80 s, before the observation window starts at 90 s "
+        "(requirements.settling_deadline_s)"
+    )
+    for key in ("ape_deg", "rpe_deg", "max_rate_error_deg_s"):
+        assert np.isnan(metrics[key]), key
+    assert metrics["r3_pass"] is True  # R3 is judged on every record of any run
+
+
+def test_a_run_planned_to_end_before_its_stated_window_end_is_not_judged():
+    # the window is 90-110 s, the run planned to 100 s: it never meant to observe it all
+    metrics = slew_metrics(synthetic_slew(settles, quiet, duration_s=100.0, window_end_s=110.0))
+    assert metrics["r1_pass"] is None and metrics["r2_pass"] is None
+    assert "before the observation window ends at 110 s" in metrics["not_judged_reason"]
     assert np.isnan(metrics["ape_deg"])
+
+
+def test_a_run_planned_to_cover_the_window_that_stops_early_fails():
+    # Planned to 120 s, records to 100 s (a run stopped by a fault): judged, and failed,
+    # although every record it has is inside both bands.
+    ds = synthetic_slew(settles, quiet).sel(time=slice(0.0, 100.0))
+    metrics = slew_metrics(ds)
+    assert metrics["r1_pass"] is False and metrics["r2_pass"] is False
+    assert metrics["not_judged_reason"] == ""
+    # the APE is over the records it has: the largest, at 90 s (settles decreases);
+    # the same float64 expression on the same record time, so round-off only
+    assert metrics["ape_deg"] == pytest.approx(settles(90.0), rel=1e-12)
+
+
+@pytest.mark.parametrize(
+    ("duration_s", "fields", "judged"),
+    [
+        (90.0, {}, False),  # the window [90, 90] is empty
+        (90.5, {}, True),
+        (100.0, {"window_end_s": 110.0}, False),
+        (110.0, {"window_end_s": 110.0}, True),
+        (120.0, {"settling_deadline_s": 30.0, "window_end_s": 100.0}, True),
+    ],
+)
+def test_unjudged_reason_says_whether_the_planned_run_covers_the_window(duration_s, fields, judged):
+    reason = unjudged_reason(Requirements(**fields), duration_s)
+    assert (reason == "") is judged
 
 
 def test_explicit_bands_override_the_stored_ones():

@@ -8,6 +8,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from flexsat.analysis.requirements import NotJudgedWarning
 from flexsat.campaigns import CampaignStore, resolve_cases
 from flexsat.campaigns.definition import CampaignDefinition, Reduced
 from flexsat.campaigns.jk_bisection import bisect_jk_min, with_jk_min
@@ -135,3 +136,35 @@ def test_a_kind_registered_outside_flexsat_keeps_its_cases(tmp_path):
         assert {c.scenario["controller"]["jk_min_nm"] for c in cases} == {0.3}
     finally:
         KINDS.unregister("corners")
+
+
+def test_a_campaign_not_judged_is_refused_before_it_flies(three, tmp_path):
+    # 60 s runs end before the 90 s window opens: no verdict to bisect on
+    short = three.model_copy(update={"base": {"duration_s": 60.0}})
+    with pytest.raises(ConfigError) as refused:
+        bisect_jk_min(short, nominal(), tmp_path / "out", LOW, HIGH, 0)
+    assert str(refused.value) == (
+        "duration_s: R1 and R2 are not judged in every case: the run ends at 60 s, before "
+        "the observation window starts at 90 s (requirements.settling_deadline_s); the "
+        "JK_min bisection needs judged runs: give duration_s past the end of the "
+        "observation window (requirements.settling_deadline_s, window_end_s)"
+    )
+    assert not (tmp_path / "out").exists()  # refused before any campaign ran
+
+
+def test_a_case_not_judged_is_refused_once_flown(tmp_path):
+    # The base is judged (window 0.2-0.5 s); one case's own deadline, 1 s, is after
+    # its 0.5 s run: the first campaign flown shows it, and the bisection stops there.
+    data = {"name": "jk-late", "base": {"duration_s": 0.5,
+                                        "requirements": {"settling_deadline_s": 0.2}},
+            "reduced": Reduced().model_dump(mode="json"),
+            "cases": [{"id": "late", "scenario": [
+                {"path": "requirements.settling_deadline_s", "value": 1.0}]}]}  # fmt: skip
+    definition = validate_config(data, model=CampaignDefinition)
+    refused = pytest.raises(
+        ConfigError,
+        match=r"R1 and R2 are not judged in case 'late': the "
+        r"run ends at 0.5 s, before the observation window starts at 1 s",
+    )
+    with refused, pytest.warns(NotJudgedWarning, match="not judged in 1 of the first 2 cases"):
+        bisect_jk_min(definition, nominal(), tmp_path, LOW, HIGH, 0)

@@ -2,11 +2,12 @@
 
 from __future__ import annotations
 
+import pandas as pd
 import pytest
 
 from flexsat.campaigns import load_campaign
 from flexsat.campaigns.definition import CampaignDefinition, Reduced
-from flexsat.campaigns.reduction import compare_reduction
+from flexsat.campaigns.reduction import compare_reduction, reduction_table
 from flexsat.config import nominal, validate_config
 
 THESIS = ("sensitivity", "montecarlo-critical", "deployment-shock")
@@ -117,3 +118,19 @@ def test_a_reduced_record_period_of_its_own_is_kept_and_a_longer_base_one_wins()
     data["base"] = {**data["base"], "record_dt_s": 0.1}
     case = resolve_cases(validate_config(data, model=CampaignDefinition), nominal())[0]
     assert case.scenario["record_dt_s"] == 0.1
+
+
+def test_not_judged_is_a_verdict_of_its_own():
+    # a: same verdict; b: not judged on both models; c: judged on one model only (a
+    # changed verdict, not a pass equal to a fail as a cast to bool would read it)
+    full = pd.DataFrame(
+        {
+            "case_id": ["a", "b", "c"],
+            "status": ["ok"] * 3,
+            "metrics.r1_pass": pd.array([True, None, None], dtype="boolean"),
+        }
+    )
+    reduced = full.assign(**{"metrics.r1_pass": pd.array([True, None, False],
+                                                         dtype="boolean")})  # fmt: skip
+    row = reduction_table(full, reduced).set_index("metric").loc["r1_pass"]
+    assert (row["cases"], row["verdicts_changed"], row["not_judged"]) == (3, 1, 2)

@@ -77,6 +77,27 @@ def test_requirements_list_their_failing_cases_and_a_failed_run_fails_all():
     assert bounds == pass_rate_interval(2, 4)
 
 
+def test_a_case_not_judged_is_neither_a_pass_nor_a_failure():
+    # c's run ended before its window (a reason, a null verdict): out of the rate; d
+    # failed before it had metrics: it still fails every requirement.
+    table = _table()
+    table["metrics.r1_pass"] = pd.array([True, False, None, None], dtype="boolean")
+    table["metrics.not_judged_reason"] = ["", "", "the run ends at 60 s, ...", np.nan]
+    row = requirement_statistics(table).set_index("requirement").loc["r1_pass"]
+    assert (row["passes"], row["cases"], row["not_judged"]) == (1, 3, 1)
+    assert row["failing"] == ["b", "d"] and row["pass_rate"] == 1 / 3
+    assert (row["ci_low"], row["ci_high"]) == pass_rate_interval(1, 3)
+
+
+def test_a_campaign_of_cases_not_judged_has_no_pass_rate():
+    table = _table().iloc[:3].copy()
+    table["metrics.r1_pass"] = pd.array([None] * 3, dtype="boolean")
+    table["metrics.not_judged_reason"] = ["the run ends at 60 s, ..."] * 3
+    row = requirement_statistics(table).set_index("requirement").loc["r1_pass"]
+    assert (row["cases"], row["not_judged"], row["failing"]) == (0, 3, [])
+    assert np.isnan(row["pass_rate"]) and np.isnan(row["ci_low"])
+
+
 def test_metric_percentiles_beside_min_and_max():
     # numpy's linear percentiles of [1, 2, 3]: 5 % -> 1.1, 50 % -> 2, 95 % -> 2.9.
     row = metric_statistics(_table()).set_index("metric").loc["final_pointing_error_deg"]

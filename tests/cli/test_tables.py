@@ -169,6 +169,33 @@ def test_campaign_table(width, narrow, capsys, tmp_path):
     assert out.code == 0, out.stderr
     summary = json.loads((store / "summary.json").read_text())
     assert assert_whole(out.stdout, summary) >= 8
+    # Its 1 s runs end before the default observation window opens (90 s): R1 and R2
+    # are not judged, said once before the cases fly, and no table reads FAIL.
+    notice = (
+        "campaign two-cases: R1 and R2 are not judged: the run ends at 1 s, before "
+        "the observation window starts at 90 s (requirements.settling_deadline_s)"
+    )
+    assert notice in " ".join(out.stderr.split())
+    assert "FAIL" not in out.stdout
+    assert (summary["r1_not_judged"], summary["r2_not_judged"]) == (2, 2)
+    for label in ("R1 pass rate", "R2 pass rate"):
+        row = next(line for line in out.stdout.splitlines() if label in line)
+        assert "not judged" in row, row
+
+
+def test_a_verdict_not_judged_reads_so_in_its_rows(capsys):
+    console = Console(width=100, markup=False)
+    print_table(console, "verdicts", ("metric", "asmc", "pd"),
+                [["r1_pass", None, False], ["r2_pass", True, None],
+                 ["R1 pass rate (absolute pointing, over the judged cases)", math.nan, 0.5],
+                 ["settling_time_s", None, math.nan]])  # fmt: skip
+    rows = [line.split("│")[1:4] for line in capsys.readouterr().out.splitlines()
+            if line.startswith("│")]  # fmt: skip
+    cells = [[c.strip() for c in row] for row in rows]
+    assert cells == [["r1_pass", "not judged", "False"], ["r2_pass", "True", "not judged"],
+                         ["R1 pass rate (absolute pointing, over the judged cases)",
+                          "not judged", "0.5"],
+                         ["settling_time_s", "-", "nan"]]  # fmt: skip
 
 
 def test_config_show_prints_tables_and_keeps_json(narrow, capsys):

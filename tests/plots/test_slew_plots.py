@@ -124,9 +124,22 @@ def test_pointing_bands_at_the_requirements(slew_ds) -> None:
 
 
 def test_pointing_verdicts_over_the_observation_window(slew_ds) -> None:
-    # The 30 s run ends before the default 90 s deadline: no window observed, FAIL.
-    r1 = plot_pointing(slew_ds).axes[0]
-    assert r1.get_title().startswith("R1 FAIL: the run ends at 30 s, before the 90 s deadline")
+    # The 30 s run was planned to end before the default 90 s deadline: not judged.
+    r1, r2 = plot_pointing(slew_ds).axes[:2]
+    for ax, tag in ((r1, "R1"), (r2, "R2")):
+        assert ax.get_title().startswith(
+            f"{tag} not judged: the run ends at 30 s, before the observation window starts "
+            "at 90 s (requirements.settling_deadline_s)"
+        ), ax.get_title()
+    # Planned to 40 s with the window from 20 s, its records stop at 30 s (as a run
+    # stopped by a fault): judged, and failed.
+    stopped = _with_scenario(slew_ds, requirements={"settling_deadline_s": 20.0})
+    stopped.attrs["scenario"] = json.dumps({**json.loads(stopped.attrs["scenario"]),
+                                            "duration_s": 40.0})  # fmt: skip
+    r1 = plot_pointing(stopped).axes[0]
+    assert r1.get_title().startswith(
+        "R1 FAIL: the run stops at 30 s, before its window ends (40 s)"
+    )
     # A 20 s deadline: the window 20-30 s is shaded, and R1 fails over it (the
     # error is still above 0.05 deg at 20 s).
     r1 = plot_pointing(_with_scenario(slew_ds, requirements={"settling_deadline_s": 20.0})).axes[0]

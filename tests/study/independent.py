@@ -470,7 +470,10 @@ def slew_metrics(ds, plates: bool = True) -> dict:
     assert sc["reference"]["kind"] == "step", "omega_d = 0 holds for a step reference only"
     start = req["settling_deadline_s"]
     end = req["window_end_s"] if req["window_end_s"] is not None else sc["duration_s"]
-    inside = (t >= start - eps) & (t <= end + eps)
+    # judged only when the planned run covers the window; a run planned to end before
+    # it is "not judged" (None), one that stopped early fails
+    judged = start < end <= sc["duration_s"] + eps
+    inside = (t >= start - eps) & (t <= end + eps) & judged
     covered = t[-1] >= end - eps
     ape = float(pointing[inside].max()) if inside.any() else None
     max_rate = float(rate[inside].max()) if inside.any() else None
@@ -503,8 +506,11 @@ def slew_metrics(ds, plates: bool = True) -> dict:
         "settling_time_s": settle(t, pointing, req["pointing_deg"]),
         "r2_settling_time_s": settle(t, rate, req["jitter_deg_s"]),
         "observation_window_s": [start, end],
-        "r1_pass": bool(covered and ape < req["pointing_deg"]),
-        "r2_pass": bool(covered and max_rate < req["jitter_deg_s"]),
+        "r1_pass": bool(covered and ape < req["pointing_deg"]) if judged else None,
+        "r2_pass": bool(covered and max_rate < req["jitter_deg_s"]) if judged else None,
+        # the reason's wording is flexsat's; here only whether there is one (the runs
+        # this module rebuilds are all judged, so a non-empty text would not match)
+        "not_judged_reason": "" if judged else "not judged",
         "ape_deg": ape,
         "rpe_deg": rpe,
         "rpe_window_s": window,

@@ -54,6 +54,15 @@ def _lookup(data, path: str):
     return data
 
 
+def _shown(value, path: str) -> str:
+    """What a cell shows: :func:`format_value`, and "not judged" for a verdict that is
+    null (a run planned to end before its observation window)."""
+    from flexsat.study.report import _VERDICTS
+
+    return "not judged" if value is None and path.split("/")[-1] in _VERDICTS else (
+        format_value(value))  # fmt: skip
+
+
 def test_every_number_is_the_one_its_json_file_holds(report):
     out, _, parser = report
     assert len(parser.cells) > 300  # config 45, M(0) blocks 180, modes 60, metrics of 4 runs
@@ -61,7 +70,7 @@ def test_every_number_is_the_one_its_json_file_holds(report):
     for cell in parser.cells:
         held = _lookup(json.loads((out / cell["data-source"]).read_text()), cell["data-path"])
         assert json.loads(cell["data-value"]) == held, cell
-        assert cell["text"] == format_value(held), cell
+        assert cell["text"] == _shown(held, cell["data-path"]), cell
         sources.add(cell["data-source"])
     assert {"openloop/metrics.json", "slew/asmc/metrics.json", "slew/pd/metrics.json",
             "slew/smc/metrics.json", "modal/modal.json",
@@ -270,3 +279,36 @@ def test_a_campaign_table_says_what_it_counts_and_names_each_requirements_worst(
     r2 = [g["requirement"] for g in summary["worst_by_requirement"]].index("R2")
     assert shown[f"worst_by_requirement/{r2}/cases/0/passes"] is False
     assert "random-00000" in html.split("Worst cases per requirement")[1]
+
+
+def test_a_campaign_not_judged_reads_so_in_the_report(tmp_path):
+    # Two cases whose runs ended before their observation window: R1 and R2 null with
+    # the reason. The report says "not judged" where a pass rate or verdict would be,
+    # and counts them; no cell reads "fail" for them.
+    from flexsat.campaigns import CampaignStore, summarize
+    from flexsat.strict_json import dumps
+    from flexsat.study import report
+
+    store = CampaignStore(tmp_path / "campaigns" / "short")
+    store.cases_dir.mkdir(parents=True)
+    reason = "the run ends at 60 s, before the observation window starts at 90 s"
+    for case_id in ("nominal", "random-00000"):
+        metrics = {"r1_pass": None, "r2_pass": None, "r3_pass": True, "ape_deg": None,
+                   "max_rate_error_deg_s": None, "max_commanded_torque_nm": [1.0, 1.0, 1.0],
+                   "final_pointing_error_deg": 0.5, "not_judged_reason": reason}  # fmt: skip
+        store.write_case({"case_id": case_id, "status": "ok", "metrics": metrics,
+                          "inputs_digest": "x", "case_cpu_time_s": 2.0})  # fmt: skip
+    summary = {**summarize(store.root), "computed_this_run": 2, "resumed_this_run": 0,
+               "run_wall_time_s": 0.04}  # fmt: skip
+    (store.root / "summary.json").write_text(dumps(summary))  # NaN rates as null
+    outputs = {"summaries": {"short": "campaigns/short/summary.json"}, "figures": []}
+    cells = _Cells()
+    cells.feed(report._campaigns(tmp_path, outputs, {}))
+    shown = {(c["data-source"].split("/")[-1], c["data-path"]): c["text"] for c in cells.cells}
+    totals = {path: text for (source, path), text in shown.items() if source == "summary.json"}
+    assert totals["r1_pass_rate"] == totals["r2_pass_rate"] == "not judged"
+    assert totals["r1_not_judged"] == totals["r2_not_judged"] == "2"
+    assert totals["r3_pass_rate"] == "1"
+    for case in ("nominal.json", "random-00000.json"):
+        assert shown[case, "metrics/r1_pass"] == shown[case, "metrics/r2_pass"] == "not judged"
+    assert "fail" not in shown.values()

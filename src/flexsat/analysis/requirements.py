@@ -11,17 +11,20 @@ and the relative performance error (RPE) over the window. ``docs/control.md``
 from __future__ import annotations
 
 import json
-from typing import Annotated
+from typing import TYPE_CHECKING, Annotated
 
 import numpy as np
-import xarray as xr
 from pydantic import Field, model_validator
 
 from flexsat.config.models import Positive, _Frozen
 
+if TYPE_CHECKING:  # annotations only: the scenario models import this module
+    import xarray as xr
+
 __all__ = [
     "DECAY_RATIO",
     "GROWTH_RATIO",
+    "NotJudgedWarning",
     "Requirements",
     "absolute_performance_error",
     "actuator_saturation_times",
@@ -31,6 +34,7 @@ __all__ = [
     "residual_rate_verdict",
     "settling_time",
     "slew_metrics",
+    "unjudged_reason",
 ]
 
 _TIME_TOL = (
@@ -116,6 +120,47 @@ def observation_window(requirements: Requirements, planned_end_s: float) -> tupl
     """
     end = requirements.window_end_s if requirements.window_end_s is not None else planned_end_s
     return float(requirements.settling_deadline_s), float(end)
+
+
+class NotJudgedWarning(UserWarning):
+    """R1 and R2 will not be judged: the planned run ends before its observation window
+    does (:func:`unjudged_reason`); the message says when each ends."""
+
+
+def unjudged_reason(requirements: Requirements, planned_end_s: float) -> str:
+    """Why R1 and R2 are not judged on a run planned to end at ``planned_end_s``; "" if they are.
+
+    R1 and R2 are judged over :func:`observation_window`. A run whose planned end
+    (the scenario's ``duration_s``) comes before the window ends was never meant to
+    observe it: its verdicts are "not judged" (None), not a failure. A run planned to
+    cover the window but stopped early (a fault, a divergence) is judged, and fails.
+
+    Parameters
+    ----------
+    requirements : Requirements
+        The scenario's requirements.
+    planned_end_s : float
+        End of the planned run, the scenario's duration [s].
+
+    Returns
+    -------
+    str
+        "" when the planned run covers the window; otherwise the reason, naming the
+        times and the field that sets the window.
+    """
+    start, end = observation_window(requirements, planned_end_s)
+    planned = float(planned_end_s)
+    if planned <= start + _TIME_TOL:
+        return (
+            f"the run ends at {planned:g} s, before the observation window starts at "
+            f"{start:g} s (requirements.settling_deadline_s)"
+        )
+    if planned < end - _TIME_TOL:
+        return (
+            f"the run ends at {planned:g} s, before the observation window ends at "
+            f"{end:g} s (requirements.window_end_s)"
+        )
+    return ""
 
 
 def error_rotation_vector(quaternion: np.ndarray, target: np.ndarray) -> np.ndarray:
@@ -355,8 +400,12 @@ def slew_metrics(ds: xr.Dataset, *, requirements: Requirements | None = None) ->
     dict
         Keys end in their unit. R1: the pointing error stays below ``pointing_deg``
         at every record of ``observation_window_s`` (start, end); R2: the residual
-        rate stays below ``jitter_deg_s`` there; both fail when the records do not
-        reach the window's end (a run shorter than the deadline, or stopped). R3, the
+        rate stays below ``jitter_deg_s`` there. Both are None, "not judged", when
+        the scenario's planned run (its ``duration_s``) ends before the window does
+        (:func:`unjudged_reason`, whose text ``not_judged_reason`` holds; "" when
+        judged); APE, RPE and the largest residual rate are NaN then. A run planned to
+        cover the window whose records stop before its end (a fault, a divergence)
+        fails both. R3, the
         actuator asked no more than it can give (``docs/control.md``, 'R3 with an
         actuator of units'): an actuator of units that records
         ``actuator_torque_ratio`` (a wheel cluster: the largest motor torque asked of a
@@ -383,8 +432,11 @@ def slew_metrics(ds: xr.Dataset, *, requirements: Requirements | None = None) ->
     t = ds.variables["time"].values
     pointing = ds.variables["pointing_error_deg"].values
     jitter = ds.variables["rate_error_deg_s"].values
-    start, end = observation_window(req, float(stored.get("duration_s", t[-1])))
-    inside = (t >= start - _TIME_TOL) & (t <= end + _TIME_TOL)
+    planned_end_s = float(stored.get("duration_s", t[-1]))
+    start, end = observation_window(req, planned_end_s)
+    reason = unjudged_reason(req, planned_end_s)
+    # a run never planned to cover the window observes none of it: its figures are NaN
+    inside = (t >= start - _TIME_TOL) & (t <= end + _TIME_TOL) & (not reason)
     covered = bool(inside.any()) and t[-1] >= end - _TIME_TOL
     target = np.asarray(ds.attrs["target_quaternion"])
     if "reference_quaternion" in ds.variables:  # a moving target: the reference produced
@@ -410,8 +462,9 @@ def slew_metrics(ds: xr.Dataset, *, requirements: Requirements | None = None) ->
         "settling_time_s": settling_time(t, pointing, req.pointing_deg),
         "r2_settling_time_s": settling_time(t, jitter, req.jitter_deg_s),
         "observation_window_s": [start, end],
-        "r1_pass": covered and ape < req.pointing_deg,
-        "r2_pass": covered and max_rate < req.jitter_deg_s,
+        "r1_pass": None if reason else bool(covered and ape < req.pointing_deg),
+        "r2_pass": None if reason else bool(covered and max_rate < req.jitter_deg_s),
+        "not_judged_reason": reason,
         "ape_deg": ape,
         "rpe_deg": relative_performance_error(t[inside], error_deg, req.rpe_window_s),
         "rpe_window_s": req.rpe_window_s,

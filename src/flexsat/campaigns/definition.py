@@ -29,6 +29,7 @@ import itertools
 import json
 import math
 import re
+import warnings
 from collections.abc import Iterator
 from dataclasses import dataclass
 from importlib import resources
@@ -38,6 +39,7 @@ from typing import Annotated, Any, Literal
 import numpy as np
 from pydantic import Field, field_validator, model_validator
 
+from flexsat.analysis.requirements import NotJudgedWarning, Requirements, unjudged_reason
 from flexsat.campaigns.kinds import KINDS, CampaignKind, CaseSource, register_kind
 from flexsat.campaigns.modifiers import Modifier, ModifierError, apply_modifiers
 from flexsat.config.load import read_toml, validate_config
@@ -438,7 +440,9 @@ class CaseStream:
     prepared up front. What can be checked without resolving every case is checked
     on construction, before any case runs: the case count, unique ids, every
     explicit and grid case and the first :data:`HEAD_CASES` cases (resolved,
-    validated and their run sizes estimated, strictly).
+    validated and their run sizes estimated, strictly). When those cases' runs end
+    before their observation window, a :class:`~flexsat.analysis.requirements.NotJudgedWarning`
+    says so then: their R1 and R2 will read "not judged".
 
     Iterating resolves the cases in order; a later case whose draws are refused is
     yielded with its ``error`` set (stored as a failed row), not raised, unless
@@ -507,6 +511,7 @@ class CaseStream:
         self.head = [self.resolve(spec) for spec in self._fixed]
         n_head = min(self._n_streamed, max(1, HEAD_CASES - len(self.head)))
         self.head += [self.resolve(self._streamed_spec(i)) for i in range(n_head)]
+        _announce_unjudged(definition.name, self.head)
 
     def counts(self) -> dict[str, int]:
         """How many cases come from each source (see :func:`describe_counts`).
@@ -588,6 +593,24 @@ class CaseStream:
                 raise ConfigError(f"campaign {name}, case {case_id!r}: {exc}") from None
             self._sized.add(timing)
         return ResolvedCase(case_id, root, index, plant, scenario, realised)
+
+
+def _announce_unjudged(name: str, head: list[ResolvedCase]) -> None:
+    """Say before any case runs when the checked cases' runs end before their observation
+    window: their R1 and R2 will read "not judged" (a :class:`NotJudgedWarning`, which
+    ``flexsat`` prints as one line), neither passed nor failed."""
+    reasons: dict[str, list[str]] = {}
+    for case in head:
+        if case.scenario:
+            requirements = Requirements.model_validate(case.scenario.get("requirements") or {})
+            reason = unjudged_reason(requirements, case.scenario["duration_s"])
+            if reason:
+                reasons.setdefault(reason, []).append(case.case_id)
+    for reason, ids in reasons.items():
+        where = "" if len(ids) == len(head) else f" in {len(ids)} of the first {len(head)} cases"
+        warnings.warn(f"campaign {name}: R1 and R2 are not judged{where}: {reason}; their "
+                      "verdicts read 'not judged', neither pass nor fail",
+                      NotJudgedWarning, stacklevel=3)  # fmt: skip
 
 
 def _check_initial_state(satellite: SatelliteConfig, scenario: SlewScenario, source: str) -> None:

@@ -8,7 +8,9 @@ step) and counts a step as passing when every case ran and met R1, R2 and R3
 robustness gain JK_min").
 
 Bisection assumes that the campaign passes above some gain and fails below it; the
-docs say where that was checked.
+docs say where that was checked. It needs judged runs: a campaign whose runs end
+before their observation window (R1 and R2 "not judged",
+:func:`flexsat.analysis.requirements.unjudged_reason`) is refused.
 """
 
 from __future__ import annotations
@@ -16,6 +18,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from flexsat.analysis.requirements import unjudged_reason
 from flexsat.campaigns.definition import CampaignDefinition
 from flexsat.campaigns.runner import run_campaign
 from flexsat.campaigns.store import CampaignStore
@@ -164,13 +167,20 @@ def bisect_jk_min(
     Raises
     ------
     ConfigError
-        A range that is not 0 < low_nm < high_nm, a negative ``steps``, or a
+        A range that is not 0 < low_nm < high_nm, a negative ``steps``, a campaign
+        whose runs end before their observation window (R1 and R2 not judged: its
+        base scenario, checked before any run, or a case, once flown), or a
         campaign the runner refuses.
     """
     if not 0.0 < low_nm < high_nm:
         raise ConfigError(f"low_nm, high_nm: need 0 < low_nm < high_nm, got {low_nm}, {high_nm}")
     if steps < 0:
         raise ConfigError(f"steps: must be >= 0, got {steps}")
+    from flexsat.config.load import validate_config
+    from flexsat.simulate.scenario import SlewScenario
+
+    base = validate_config(definition.base, source="base", model=SlewScenario)
+    _refuse_unjudged(unjudged_reason(base.requirements, base.duration_s), ["every case"])
     out = Path(out)
     done: list[JKStep] = []
 
@@ -179,6 +189,10 @@ def bisect_jk_min(
         summary = run_campaign(with_jk_min(definition, jk), satellite, store, workers=workers,
                                resume=store.exists(), progress=False, runner=runner)  # fmt: skip
         rows = CampaignStore(store).rows()
+        unjudged = [row for row in rows if row["metrics"].get("not_judged_reason")]
+        if unjudged:  # a case whose scenario modifiers shortened its run
+            _refuse_unjudged(unjudged[0]["metrics"]["not_judged_reason"],
+                             [f"case {row['case_id']!r}" for row in unjudged])  # fmt: skip
         failing = tuple(sorted(
             row["case_id"] for row in rows
             if row["status"] != "ok" or not all(row["metrics"].get(k) for k in _REQUIREMENTS)
@@ -198,3 +212,14 @@ def bisect_jk_min(
         else:
             low_nm = middle
     return JKBisection(low_nm, high_nm, True, done)
+
+
+def _refuse_unjudged(reason: str, cases: list[str]) -> None:
+    """Refuse a bisection over runs whose R1 and R2 are not judged (``reason`` given)."""
+    if reason:
+        shown = ", ".join(cases[:5]) + (f" and {len(cases) - 5} more" if len(cases) > 5 else "")
+        raise ConfigError(
+            f"duration_s: R1 and R2 are not judged in {shown}: {reason}; the JK_min "
+            "bisection needs judged runs: give duration_s past the end of the observation "
+            "window (requirements.settling_deadline_s, window_end_s)"
+        )

@@ -54,7 +54,10 @@ def reduction_table(full: pd.DataFrame, reduced: pd.DataFrame) -> pd.DataFrame:
     -------
     DataFrame
         One row per metric of :data:`REDUCTION_METRICS` present: ``units``,
-        ``cases``, ``verdicts_changed`` (verdicts only), ``max_abs_diff`` and
+        ``cases``, ``verdicts_changed`` (verdicts only: pass, fail and "not judged"
+        are three verdicts, so a case judged on one model and not on the other
+        counts), ``not_judged`` (verdicts only: the cases not judged on the full
+        model), ``max_abs_diff`` and
         ``max_rel_diff`` (numbers only; relative to the full model's value), and the
         case where the largest relative difference occurs.
     """
@@ -68,8 +71,10 @@ def reduction_table(full: pd.DataFrame, reduced: pd.DataFrame) -> pd.DataFrame:
             continue
         x, y = a.loc[common, column], b.loc[common, column]
         row = {"metric": name, "units": units, "cases": len(common)}
-        if name in VERDICTS:
-            row["verdicts_changed"] = int((x.astype(bool) != y.astype(bool)).sum())
+        if name in VERDICTS:  # three states: pass, fail, not judged (null)
+            x, y = _verdicts(x), _verdicts(y)
+            row["verdicts_changed"] = int((x != y).sum())
+            row["not_judged"] = int((x == "not judged").sum())
         else:
             x, y = x.astype(float), y.astype(float)
             diff = (y - x).abs()
@@ -79,6 +84,11 @@ def reduction_table(full: pd.DataFrame, reduced: pd.DataFrame) -> pd.DataFrame:
             row["worst_case"] = str(rel.idxmax()) if rel.notna().any() else ""
         rows.append(row)
     return pd.DataFrame(rows)
+
+
+def _verdicts(column: pd.Series) -> pd.Series:
+    """A verdict column as text: "pass", "fail" or "not judged" (null)."""
+    return column.map(lambda v: "not judged" if pd.isna(v) else ("pass" if v else "fail"))
 
 
 def compare_reduction(

@@ -110,7 +110,10 @@ def cases_needed(probability: float, confidence: float = 0.95, failures: int = 0
 def requirement_statistics(table: pd.DataFrame, confidence: float = 0.95) -> pd.DataFrame:
     """Pass rate, its exact interval and the failing cases of each requirement.
 
-    A case that failed to run counts as failing every requirement.
+    A case that failed to run counts as failing every requirement. A case whose
+    verdict is "not judged" (null, with a ``metrics.not_judged_reason``: its run was
+    planned to end before the observation window, docs/control.md, 'How R1 and R2 are
+    judged') is left out of the pass rate and counted apart.
 
     Parameters
     ----------
@@ -122,21 +125,28 @@ def requirement_statistics(table: pd.DataFrame, confidence: float = 0.95) -> pd.
     Returns
     -------
     DataFrame
-        One row per requirement present: ``requirement``, ``passes``, ``cases``,
-        ``pass_rate``, ``ci_low``, ``ci_high`` (at ``confidence``), ``failing``
-        (the failing case ids, sorted).
+        One row per requirement present: ``requirement``, ``passes``, ``cases``
+        (the judged ones), ``not_judged``, ``pass_rate`` (over the judged cases; NaN
+        when none is), ``ci_low``, ``ci_high`` (at ``confidence``), ``failing`` (the
+        failing case ids, sorted).
     """
+    reason = table.get("metrics.not_judged_reason", pd.Series("", index=table.index))
+    explained = reason.map(lambda text: isinstance(text, str) and bool(text))
     rows = []
     for key, what in REQUIREMENTS.items():
         column = f"metrics.{key}"
         if column not in table:
             continue
-        passed = table[column].fillna(False).astype(bool) & (table["status"] == "ok")
-        n, k = len(table), int(passed.sum())
+        verdict = table[column]
+        unjudged = verdict.isna() & explained
+        passed = verdict.fillna(False).astype(bool) & (table["status"] == "ok")
+        judged = ~unjudged
+        n, k = int(judged.sum()), int(passed.sum())
         low, high = pass_rate_interval(k, n, confidence) if n else (np.nan, np.nan)
         rows.append({"requirement": key, "description": what, "passes": k, "cases": n,
-                     "pass_rate": k / n if n else np.nan, "ci_low": low, "ci_high": high,
-                     "failing": sorted(table.loc[~passed, "case_id"])})  # fmt: skip
+                     "not_judged": int(unjudged.sum()), "pass_rate": k / n if n else np.nan,
+                     "ci_low": low, "ci_high": high,
+                     "failing": sorted(table.loc[judged & ~passed, "case_id"])})  # fmt: skip
     return pd.DataFrame(rows)
 
 

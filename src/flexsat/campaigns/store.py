@@ -303,6 +303,9 @@ class CampaignStore:
                 expanded = pd.DataFrame(padded, index=frame.index)
                 expanded.columns = [f"{column}[{k}]" for k in expanded.columns]
                 frame = pd.concat([frame.drop(columns=column), expanded], axis=1)
+        for column in frame.columns:  # a verdict not judged (None) stays null, not False
+            if column.startswith("metrics.") and _nullable_verdict(frame[column]):
+                frame[column] = frame[column].astype("boolean")
         return frame.sort_values("case_id").reset_index(drop=True) if len(frame) else frame
 
     def write_tables(self) -> pd.DataFrame:
@@ -313,6 +316,25 @@ class CampaignStore:
             with replacing_name(path) as tmp:
                 writer(tmp, index=False)
         return frame
+
+
+_VERDICTS = ("metrics.r1_pass", "metrics.r2_pass", "metrics.r3_pass")
+"""The requirement verdicts: True, False or None ("not judged", the run ended before
+its observation window; ``docs/control.md``, 'How R1 and R2 are judged')."""
+
+
+def _nullable_verdict(column: pd.Series) -> bool:
+    """Whether a table column holds verdicts with nulls among them (object dtype).
+
+    Such a column is cast to pandas' nullable ``boolean``: Parquet stores it as a
+    boolean column with nulls (even when every case is null), never as False.
+    """
+    if column.dtype != object:
+        return False
+    values = column.dropna()
+    return column.name in _VERDICTS or (
+        len(values) > 0 and all(isinstance(v, bool) for v in values)
+    )
 
 
 def _read_row(path: Path) -> dict | None:

@@ -35,9 +35,11 @@ SUMMARY_ROWS = (
     ("computed_this_run", "computed by this run"),
     ("resumed_this_run", "resumed from the store by this run"),
     ("failed", "failed cases (stopped or refused)"),
-    ("r1_pass_rate", "R1 pass rate (absolute pointing)"),
-    ("r2_pass_rate", "R2 pass rate (residual rate)"),
+    ("r1_pass_rate", "R1 pass rate (absolute pointing, over the judged cases)"),
+    ("r2_pass_rate", "R2 pass rate (residual rate, over the judged cases)"),
     ("r3_pass_rate", "R3 pass rate (torque limit)"),
+    ("r1_not_judged", "R1 not judged (the run ends before the observation window)"),
+    ("r2_not_judged", "R2 not judged (the run ends before the observation window)"),
     ("worst_final_pointing_error_deg", "worst final pointing error [deg]"),
     ("cpu_time_s", "CPU time of the stored cases [s]"),
     ("case_wall_time_s", "wall time of the stored cases, summed [s]"),
@@ -65,10 +67,15 @@ def summarize(store: str | Path, definition: CampaignDefinition | None = None) -
     -------
     dict
         ``cases`` (stored), ``failed``, the pass rate of each requirement
-        (``r1_pass_rate``..., fractions in [0, 1]), ``worst_by_requirement`` (for R1,
-        R2, R3 and the final pointing error, :data:`WORST_BY`: the metric, its unit,
-        the failing count and the :data:`WORST_CASES` worst cases, failing ones first,
-        then by the metric, largest first: ``case_id``, ``value``, ``passes``) and
+        (``r1_pass_rate``..., fractions in [0, 1] of the judged cases; None when no
+        case is judged, NaN when none is stored), ``r1_not_judged`` and
+        ``r2_not_judged`` (the cases whose run was planned to end before the
+        observation window: R1 and R2 "not judged", neither passed nor failed;
+        ``not_judged_reason`` says why, "" when every case is judged),
+        ``worst_by_requirement`` (for R1, R2, R3 and the final pointing
+        error, :data:`WORST_BY`: the metric, its unit, the failing count and the
+        :data:`WORST_CASES` worst cases, failing ones first, then by the metric,
+        largest first: ``case_id``, ``value``, ``passes``, None when not judged) and
         ``worst_cases``, those by final pointing error alone [deg]. ``cpu_time_s``: the
         stored cases' own CPU time, summed [s] (a case stored without it counts its
         wall time); ``case_wall_time_s``: their own wall times, summed [s] (what a
@@ -92,8 +99,15 @@ def summarize(store: str | Path, definition: CampaignDefinition | None = None) -
     rows = opened.rows()
     n = len(rows)
 
-    def rate(key: str) -> float:
-        return sum(bool(r["metrics"].get(key)) for r in rows) / n if n else float("nan")
+    def rate(key: str) -> float | None:
+        if not n:
+            return float("nan")
+        judged = [r for r in rows if not _not_judged(r, key)]
+        passed = sum(bool(r["metrics"].get(key)) for r in judged)
+        return passed / len(judged) if judged else None  # not judged, as the verdicts
+
+    reasons = sorted({r["metrics"]["not_judged_reason"] for r in rows
+                      if _not_judged(r, "r1_pass") or _not_judged(r, "r2_pass")})  # fmt: skip
 
     def seconds(row: dict, key: str) -> float:
         value = row.get(key, row.get("case_wall_time_s"))
@@ -111,6 +125,9 @@ def summarize(store: str | Path, definition: CampaignDefinition | None = None) -
         "r1_pass_rate": rate("r1_pass"),
         "r2_pass_rate": rate("r2_pass"),
         "r3_pass_rate": rate("r3_pass"),
+        "r1_not_judged": sum(_not_judged(r, "r1_pass") for r in rows),
+        "r2_not_judged": sum(_not_judged(r, "r2_pass") for r in rows),
+        "not_judged_reason": "; ".join(reasons),
         "worst_final_pointing_error_deg": pointing[0]["value"] if pointing else float("nan"),
         "worst_cases": worst_cases,
         "worst_by_requirement": worst_by,
@@ -129,6 +146,16 @@ def summarize(store: str | Path, definition: CampaignDefinition | None = None) -
     return summary
 
 
+def _not_judged(row: dict, verdict: str) -> bool:
+    """Whether a case's verdict is "not judged": None, with the reason its metrics give
+    (its run was planned to end before the observation window). A case that failed
+    before it had metrics is not that: it fails every requirement."""
+    metrics = row["metrics"]
+    return (
+        verdict in metrics and metrics[verdict] is None and bool(metrics.get("not_judged_reason"))
+    )
+
+
 def _worst(rows: list[dict], name: str, verdict: str | None, metric: str, unit: str) -> dict:
     """The worst cases by one requirement (see :data:`WORST_BY`)."""
     ranked = []
@@ -139,11 +166,16 @@ def _worst(rows: list[dict], name: str, verdict: str | None, metric: str, unit: 
             value = max(value) if value else None
         if not isinstance(value, int | float) or not math.isfinite(value):
             value = None
-        passes = None if verdict is None else bool(ok and row["metrics"].get(verdict))
-        if verdict is None and value is None:
-            continue  # no value to rank by
-        # failing first, then the largest value; a case without a value after those with one
-        ranked.append(((passes is True, value is None, -(value or 0.0), row["case_id"]),
+        if verdict is None or _not_judged(row, verdict):
+            passes = None  # no verdict to rank by (not judged: neither pass nor fail)
+        else:
+            passes = bool(ok and row["metrics"].get(verdict))
+        if passes is None and value is None:
+            continue  # nothing to rank by
+        # failing first, then the largest value; a case without a value after those with
+        # one; a case not judged after every judged one
+        ranked.append(((passes is not False, passes is None, value is None, -(value or 0.0),
+                        row["case_id"]),
                        {"case_id": row["case_id"], "value": value, "passes": passes}))  # fmt: skip
     ranked.sort(key=lambda item: item[0])
     return {

@@ -7,20 +7,33 @@ here rather than by rich's own shrinking, which cuts a cell with an ellipsis whe
 the terminal is narrow: a column of values is never narrower than its longest word
 (a number is one word), text wraps at spaces, and a table that does not fit even so
 is printed in several parts, each repeating the first column.
+
+A requirement's verdict that was not judged (a run that ends before its observation
+window: ``r1_pass`` None, a pass rate over no judged case) reads "not judged" in the
+rows :data:`VERDICT_ROW` names, never "FAIL" nor a bare "-".
 """
 
 from __future__ import annotations
 
 import math
+import re
 from collections.abc import Mapping, Sequence
 
 from rich.console import Console
 from rich.table import Table
 
-__all__ = ["SIGNIFICANT_DIGITS", "cell", "format_number", "print_table"]
+__all__ = ["NOT_JUDGED", "SIGNIFICANT_DIGITS", "VERDICT_ROW", "cell", "format_number",
+           "print_table"]  # fmt: skip
 
 SIGNIFICANT_DIGITS = 4
 """Significant digits of every number in a table."""
+
+NOT_JUDGED = "not judged"
+"""The text of a verdict that was not judged (None, or a pass rate of NaN)."""
+
+VERDICT_ROW = re.compile(r"r\d_pass(_rate)?|R\d pass rate\b.*")
+"""Labels (first cell) of the rows that hold a requirement's verdict or pass rate: a
+missing value there (None, NaN) is :data:`NOT_JUDGED`."""
 
 _LABEL_MIN = 12  # narrowest first (label) column, its words folded below it
 
@@ -103,11 +116,14 @@ def print_table(
     header : sequence of str
         Column names; the first column labels the rows and is repeated in every part.
     rows : sequence of sequence
-        The cells, one sequence per row; non-strings are formatted by :func:`cell`.
+        The cells, one sequence per row; non-strings are formatted by :func:`cell`,
+        except a missing value (None, NaN) in a row whose label matches
+        :data:`VERDICT_ROW`, which reads :data:`NOT_JUDGED`.
     right : sequence of bool, optional
         Right-align that column (default: every column but the first).
     """
-    texts = [[c if isinstance(c, str) else cell(c) for c in row] for row in rows]
+    texts = [[c if isinstance(c, str) else _verdict_cell(c) if k and _verdict_row(row) else cell(c)
+              for k, c in enumerate(row)] for row in rows]  # fmt: skip
     n = len(header)
     right = [k > 0 for k in range(n)] if right is None else list(right)
     natural = [_width(header[k], [row[k] for row in texts]) for k in range(n)]
@@ -123,6 +139,16 @@ def print_table(
         for row in texts:
             table.add_row(*(row[k] for k in part))
         console.print(table)
+
+
+def _verdict_row(row: Sequence[object]) -> bool:
+    return bool(row) and isinstance(row[0], str) and VERDICT_ROW.fullmatch(row[0]) is not None
+
+
+def _verdict_cell(value: object) -> str:
+    """A verdict's cell: :data:`NOT_JUDGED` for a missing value, else :func:`cell`."""
+    missing = value is None or (isinstance(value, float) and math.isnan(value))
+    return NOT_JUDGED if missing else cell(value)
 
 
 def _width(head: str, cells: list[str]) -> int:

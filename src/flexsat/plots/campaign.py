@@ -455,6 +455,10 @@ def _parameters(row: dict) -> str:
 def plot_summary_table(store_dir: str | Path) -> Figure:
     """Pass rates R1/R2/R3 and the five worst cases (final pointing error) with parameters.
 
+    A pass rate is over the judged cases; R1 and R2 of a case whose run ends before
+    its observation window read "not judged" (counted beside the rate, or in its
+    place when no case is judged).
+
     Parameters
     ----------
     store_dir : str or Path
@@ -473,16 +477,21 @@ def plot_summary_table(store_dir: str | Path) -> Figure:
     for ax in (top, bottom):
         ax.set_axis_off()
 
-    def percent(value: float) -> str:
-        return "—" if value != value else f"{100.0 * value:.1f} %"
+    def percent(requirement: str) -> str:
+        value = summary[f"{requirement}_pass_rate"]
+        unjudged = summary.get(f"{requirement}_not_judged", 0)
+        if value is None or value != value:  # no case judged (None), or none stored
+            return "not judged" if unjudged else "—"
+        text = f"{100.0 * value:.1f} %"
+        return f"{text} ({unjudged} not judged)" if unjudged else text
 
     rates = [
         [
             str(summary["cases"]),
             str(summary["failed"]),
-            percent(summary["r1_pass_rate"]),
-            percent(summary["r2_pass_rate"]),
-            percent(summary["r3_pass_rate"]),
+            percent("r1"),
+            percent("r2"),
+            percent("r3"),
         ]
     ]
     table = top.table(

@@ -266,10 +266,12 @@ def plot_slew_quaternion(ds: xr.Dataset) -> Figure:
 
 def _requirement_panel(ax: Axes, t: np.ndarray, values: np.ndarray, bound: float, tag: str,
                        unit: str, label: str, colour: str,
-                       verdict: tuple[tuple[float, float], bool, float]) -> None:  # fmt: skip
+                       verdict: tuple[tuple[float, float], bool | None, float, str],
+                       ) -> None:  # fmt: skip
     """``values`` on a log axis with the band below ``bound`` shaded, its settling time and
     the observation window with the verdict over it: ``verdict`` = (window, passed, the
-    largest value in the window)."""
+    largest value in the window, why it is not judged); passed is None, "not judged",
+    when the run was planned to end before the window does."""
     values = np.asarray(values, dtype=float)
     style.line(ax, t, style.positive(values), color=colour, linewidth=1.1, label=label)
     ax.set_yscale("log")
@@ -289,7 +291,7 @@ def _requirement_panel(ax: Axes, t: np.ndarray, values: np.ndarray, bound: float
     ax.axhline(bound, color=style.BAND, linewidth=1.4, label=f"{tag}: {bound:.3g} {unit}")
     ax.set_ylim(lo, hi)
     settle = settling_time(t, values, bound)
-    (start, end), passed, worst = verdict
+    (start, end), passed, worst, reason = verdict
     if start < t[-1]:  # a run that ends before the deadline has no window to shade
         ax.axvspan(start, min(end, t[-1]), color="0.85", alpha=0.5, linewidth=0,
                    label=f"observation window {start:.4g}–{end:.4g} s")  # fmt: skip
@@ -298,7 +300,9 @@ def _requirement_panel(ax: Axes, t: np.ndarray, values: np.ndarray, bound: float
         ax.annotate(f"in the {tag} band for good\nfrom t = {settle:.4g} s", xy=(settle, bound),
                     xytext=(8, 18), textcoords="offset points", fontsize=9, color="darkgreen",
                     arrowprops={"arrowstyle": "->", "color": "darkgreen"})  # fmt: skip
-    if t[-1] < start:
+    if passed is None:  # never planned to reach the window: neither pass nor fail
+        judged = f"{tag} not judged: {reason}"
+    elif t[-1] < start:
         judged = f"{tag} FAIL: the run ends at {t[-1]:.4g} s, before the {start:.4g} s deadline"
     elif t[-1] < end - 1e-6:
         judged = f"{tag} FAIL: the run stops at {t[-1]:.4g} s, before its window ends ({end:.4g} s)"
@@ -317,7 +321,9 @@ def plot_pointing(ds: xr.Dataset) -> Figure:
     rate (jitter) ‖omega - omega_d‖ with the R2 band (``requirements.jitter_deg_s``).
     Each panel marks the time its quantity enters its band for good
     (:func:`flexsat.analysis.requirements.settling_time`), shades the observation
-    window and gives the verdict over it (:func:`flexsat.analysis.slew_metrics`).
+    window and gives the verdict over it (:func:`flexsat.analysis.slew_metrics`): pass,
+    fail, or "not judged" with the reason when the run was planned to end before the
+    window does.
 
     Parameters
     ----------
@@ -331,15 +337,17 @@ def plot_pointing(ds: xr.Dataset) -> Figure:
     req = _scenario(ds).requirements
     metrics = slew_metrics(ds)
     window = tuple(metrics["observation_window_s"])
+    reason = metrics["not_judged_reason"]
     t = style.time_s(ds)
     fig, axes = style.figure(2, 1, size=(11.0, 8.5))
     _requirement_panel(axes[0, 0], t, ds["pointing_error_deg"].values, req.pointing_deg, "R1",
                        "deg", "pointing error 2 asin|q_v,e|", "black",
-                       (window, metrics["r1_pass"], metrics["ape_deg"]))  # fmt: skip
+                       (window, metrics["r1_pass"], metrics["ape_deg"], reason))  # fmt: skip
     axes[0, 0].set_ylabel("pointing error [deg] (log)")
     _requirement_panel(axes[1, 0], t, ds["rate_error_deg_s"].values, req.jitter_deg_s, "R2",
                        "deg/s", "residual rate |ω − ω_d|", "tab:blue",
-                       (window, metrics["r2_pass"], metrics["max_rate_error_deg_s"]))  # fmt: skip
+                       (window, metrics["r2_pass"], metrics["max_rate_error_deg_s"],
+                        reason))  # fmt: skip
     axes[1, 0].set_ylabel("residual rate |ω| [deg/s] (log)")
     style.finish_time_axis(axes, t)
     style.suptitle(fig, ds, f"Pointing requirements ({_law_name(ds)}): R1 pointing, R2 jitter")

@@ -93,17 +93,27 @@ class _Source:
             node = node[key]
         return node
 
-    def cell(self, *path, tag: str = "td") -> str:
+    def cell(self, *path, tag: str = "td", not_judged: bool = False) -> str:
         value = self.get(*path)
         css = "num"
+        text = format_value(value)
         if isinstance(value, bool):
             css = "pass" if value else "fail"
+        elif value is None and (not_judged or str(path[-1]) in _VERDICTS):  # neither
+            css, text = "notjudged", "not judged"  # pass nor fail
         return (
             f'<{tag} class="{css}" data-source="{html.escape(self.relative)}" '
             f'data-path="{html.escape("/".join(str(p) for p in path))}" '
             f"data-value='{html.escape(json.dumps(value), quote=True)}'>"
-            f"{html.escape(format_value(value))}</{tag}>"
+            f"{html.escape(text)}</{tag}>"
         )
+
+
+_VERDICTS = ("r1_pass", "r2_pass", "r3_pass", "passes")
+"""Keys whose null value is a verdict not judged: the run was planned to end before its
+observation window (docs/control.md, 'How R1 and R2 are judged'); the report says
+"not judged" there, not a bare dash. (A null pass rate is "not judged" only where the
+campaign counts cases not judged: with no case run, it is a dash.)"""
 
 
 def _esc(text) -> str:
@@ -381,8 +391,9 @@ def _slew(root: Path, outputs: dict, context: dict) -> str:
         "settling deadline (90 s unless the scenario says otherwise) to the end of the "
         "run: the pointing error must stay below its band at every record of the window "
         "(its largest value there is the absolute performance error, APE, of "
-        "ECSS-E-ST-60-10C), and so must the residual rate. A run that ends before the "
-        "window closes fails both. The relative performance error (RPE) is the largest "
+        "ECSS-E-ST-60-10C), and so must the residual rate. A run planned to end before "
+        "the window closes is not judged (neither pass nor fail); one that stops before "
+        "it closes fails both. The relative performance error (RPE) is the largest "
         "distance of the error vector from its mean over consecutive windows of the "
         "stated duration: the pointing stability, bias removed. R3 holds at every "
         "record.</p>",
@@ -595,6 +606,14 @@ def _campaign_cases(root: Path, store: str) -> str:
                   "Every case (click a column header to sort)", sortable=True)  # fmt: skip
 
 
+def _rate_not_judged(summary: dict, key: str) -> bool:
+    """Whether a campaign's pass rate ``key`` counts cases not judged (``r1_not_judged``):
+    its null value then means that no case was judged."""
+    return key.endswith("_pass_rate") and bool(
+        summary.get(key.removesuffix("_pass_rate") + "_not_judged")
+    )
+
+
 _SUMMARY_TABLE_FIGURE = "summary_table.png"  # shown as the HTML tables above instead
 
 
@@ -621,7 +640,9 @@ def _campaigns(root: Path, outputs: dict, context: dict) -> str:
     parts = []
     for name, rel in outputs["summaries"].items():
         src = _Source(root, rel)
-        rows = [[label, src.cell(key)] for key, label in SUMMARY_ROWS]
+        # a summary written before a row was added has no value for it: left out
+        rows = [[label, src.cell(key, not_judged=_rate_not_judged(src.data, key))]
+                for key, label in SUMMARY_ROWS if key in src.data]  # fmt: skip
         store = Path(rel).parent.as_posix()
         parts.append(f"<h3>{_esc(name)}</h3>")
         counted = src.data.get("cases_text", f"{src.get('cases')} cases")
@@ -936,6 +957,7 @@ table.sortable th[aria-sort=ascending]::after{content:" ▲";color:#334}
 table.sortable th[aria-sort=descending]::after{content:" ▼";color:#334}
 td.num{text-align:right;font-variant-numeric:tabular-nums}
 td.pass{color:#0a6b2d;font-weight:600}
+td.notjudged{color:#555;font-style:italic}
 td.fail{color:#b00020;font-weight:600}
 .badge{border-radius:.3rem;padding:.05rem .4rem;font-size:.8rem;color:#fff}
 .badge.ok{background:#0a6b2d}
