@@ -35,6 +35,7 @@ import numpy as np
 
 from flexsat.control.laws.statespace import DiscreteController
 from flexsat.errors import ConfigError
+from flexsat.linear.blas_threads import one_blas_thread
 from flexsat.linear.hinf import HinfWeights, _as_model, design_plant, generalized_plant
 from flexsat.linear.model import LinearModel
 from flexsat.linear.reduce import balanced_truncation
@@ -109,6 +110,7 @@ def _augment(D, n_y: int):
     return control.ss(D.A, B, C, Dd)
 
 
+@one_blas_thread
 def dk_iterate(
     P,
     n_y: int,
@@ -257,6 +259,7 @@ class DKDesign:
     weights: HinfWeights = field(default_factory=HinfWeights)
 
 
+@one_blas_thread
 def synthesize_dk(
     model: LinearModel,
     lft,

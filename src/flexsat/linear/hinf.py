@@ -37,6 +37,7 @@ import numpy as np
 
 from flexsat.control.laws.statespace import CONTROLLER_INPUTS, DiscreteController
 from flexsat.errors import ConfigError
+from flexsat.linear.blas_threads import one_blas_thread
 from flexsat.linear.model import LinearModel
 from flexsat.linear.reduce import _split_marginal, balanced_truncation, modal_truncation
 
@@ -255,6 +256,7 @@ def _as_model(K) -> LinearModel:
     )  # fmt: skip
 
 
+@one_blas_thread
 def synthesize(
     model: LinearModel,
     control_dt_s: float,

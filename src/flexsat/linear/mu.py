@@ -40,6 +40,7 @@ import numpy as np
 from scipy.optimize import minimize, minimize_scalar
 
 from flexsat.errors import ConfigError
+from flexsat.linear.blas_threads import one_blas_thread
 from flexsat.linear.uncertain import UncertainModel
 
 __all__ = [
@@ -165,6 +166,7 @@ def _dg_bound(p: np.ndarray, N: np.ndarray, real: np.ndarray) -> tuple[float, np
     return float(lam[-1]), np.concatenate([dx, dg])
 
 
+@one_blas_thread
 def mu_upper_bound(
     N: np.ndarray,
     real: np.ndarray,
@@ -254,6 +256,7 @@ def lmi_certificate(N: np.ndarray, D: np.ndarray, G: np.ndarray) -> float:
     return float(np.sqrt(max(lam, 0.0)))
 
 
+@one_blas_thread
 def mu_upper_bound_lmi(
     N: np.ndarray,
     blocks: np.ndarray,
@@ -381,6 +384,7 @@ def _poles_max_real(model: UncertainModel, loop, delta: np.ndarray) -> tuple[flo
     return float(lam[k].real), float(abs(lam[k].imag))
 
 
+@one_blas_thread
 def stability_boundary(
     model: UncertainModel, loop, direction: np.ndarray, alpha_max: float = _ALPHA_MAX
 ) -> tuple[float, float]:
@@ -517,6 +521,7 @@ def _search_worst(model: UncertainModel, loop, seed_directions: Sequence[np.ndar
     return best
 
 
+@one_blas_thread
 def analyze(
     model: UncertainModel,
     controller: LinearController,

@@ -17,6 +17,7 @@ import numpy as np
 
 from flexsat.config.models import SatelliteConfig
 from flexsat.errors import ConfigError
+from flexsat.linear.blas_threads import one_blas_thread
 from flexsat.study.outputs import prepare_output_dir, write_json
 
 __all__ = [
@@ -371,6 +372,7 @@ def decay_rate(time_s: np.ndarray, elastic_energy_j: np.ndarray) -> float:
     return float(np.log(late / early) / (2.0 * span))
 
 
+@one_blas_thread
 def robust_study(config: SatelliteConfig, scenario, out: str | Path, quick: bool = False) -> dict:
     """The study's robustness part: mu of its law, the sampling check, the worst cases flown.
 
