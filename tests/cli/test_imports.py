@@ -87,12 +87,20 @@ def test_openloop_json_loads_neither_figures_spectra_nor_the_closed_loop():
     # (bit for bit SciPy's); a satellite of plates does not load the chain's kernels.
     assert heavy(modules, ("scipy.spatial", "flexsat.dynamics.appendages.chain",
                            "flexsat.dynamics.appendages.chain_kernels")) == []  # fmt: skip
+    # Without --out the metrics come from the records as plain arrays: no dataset,
+    # so neither xarray nor pandas (0.4 s of start-up).
+    assert heavy(modules, ("xarray", "pandas")) == []
 
 
 def test_openloop_with_out_still_builds_the_dataset(tmp_path):
     modules = loaded("openloop", "--json", "--duration", "2", "--out", str(tmp_path / "run"))
     assert "xarray" in modules  # result.nc is the dataset's
     assert (tmp_path / "run" / "result.nc").is_file()
+
+
+def test_the_scenario_models_load_neither_xarray_nor_pandas():
+    modules = loaded("import", "flexsat.simulate.scenario")
+    assert heavy(modules, ("xarray", "pandas", "scipy.spatial")) == []
 
 
 def test_slew_json_loads_neither_figures_nor_spectra(tmp_path):
