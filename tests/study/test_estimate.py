@@ -27,9 +27,10 @@ def test_the_campaigns_are_counted_case_by_case():
     # the full study flies them again for each variant but the default law's (its
     # stores are the campaigns part's): the other registered laws and the ASMC with
     # hybrid damping; the campaigns of slews from rest fly every variant, the default
-    # law's too, on the reduced model, each case REDUCED_SHARE of a full one.
+    # law's too, on the reduced model, each case REDUCED_SHARE of a full one, but the
+    # laws of FULL_MODEL_LAWS (the STSMC), on the full model.
     from flexsat.campaigns import load_campaign, resolve_cases
-    from flexsat.study.laws import REDUCED_CAMPAIGNS
+    from flexsat.study.laws import FULL_MODEL_LAWS, REDUCED_CAMPAIGNS
 
     count = {name: len(resolve_cases(load_campaign(name), nominal()))
              for name in pipeline.CAMPAIGNS}  # fmt: skip
@@ -39,10 +40,12 @@ def test_the_campaigns_are_counted_case_by_case():
     assert (campaigns.runs, campaigns.simulated_s) == (cases, 120.0 * cases)
     variants = len(law_names())  # the other laws (n - 1) and the damped ASMC
     reduced = sum(count[name] for name in REDUCED_CAMPAIGNS)
+    on_full = sum(law in FULL_MODEL_LAWS for law in law_names())  # not the default law
+    assert on_full == 1 and law_names()[0] not in FULL_MODEL_LAWS
     laws, _ = full["laws"]
     assert laws.runs == variants * (cases - reduced) + (variants + 1) * reduced
-    simulated = 120.0 * (variants * (cases - reduced)
-                         + (variants + 1) * reduced * estimate.REDUCED_SHARE)  # fmt: skip
+    simulated = 120.0 * (variants * (cases - reduced) + on_full * reduced
+                         + (variants + 1 - on_full) * reduced * estimate.REDUCED_SHARE)  # fmt: skip
     assert laws.simulated_s == pytest.approx(simulated, rel=1e-12)
     # The rate: each case at the calibrated rate times CASE_FACTOR, on two workers
     # (exact: the same product in the same order).

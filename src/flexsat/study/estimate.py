@@ -246,12 +246,18 @@ def part_work(name: str, ctx, side_by_side: int = 2) -> PartWork:
             return PartWork(n, n * first, side_by_side, overhead, what, CASE_FACTOR)
         # a full-model default law's stores are the campaigns part's own; a reduced
         # campaign flies every variant on the reduced model (laws.REDUCED_CAMPAIGNS)
+        # but those of laws.FULL_MODEL_LAWS, on the full one (the default law's store
+        # again the campaigns part's)
+        full_model = [law in laws.FULL_MODEL_LAWS for law in ctx.laws]
         n = simulated = 0.0
         for campaign, (count, duration) in cases.items():
-            reduced = campaign in laws.REDUCED_CAMPAIGNS
-            flown_variants = variants if reduced else variants - 1
-            n += flown_variants * count
-            simulated += flown_variants * count * duration * (REDUCED_SHARE if reduced else 1.0)
+            if campaign in laws.REDUCED_CAMPAIGNS:
+                on_full = sum(full_model[1:])
+                on_reduced = variants - on_full - full_model[0]
+            else:
+                on_full, on_reduced = variants - 1, 0
+            n += (on_full + on_reduced) * count
+            simulated += (on_full + on_reduced * REDUCED_SHARE) * count * duration
         what = (f"{int(n)} cases ({variants - 1} variants besides the default law; "
                 f"{', '.join(laws.REDUCED_CAMPAIGNS)} on the reduced model)")  # fmt: skip
         return PartWork(int(n), simulated, ctx.workers or side_by_side, overhead, what,

@@ -693,16 +693,19 @@ def _laws(root: Path, outputs: dict, context: dict) -> str:
         f"panels (hybrid active damping), flown through {scope}. Control energy is "
         "the integral of |tau . omega|; residual elastic energy the largest elastic "
         "energy over the last 10 s. A campaign of slews from rest may fly the reduced "
-        "model (root translations locked, 20 ms step: every verdict kept, peak tau_flex "
-        "within 5.1 %, docs/campaigns.md, 'Reduced models'); each campaign names its "
-        "model.</p>"
+        "model (root translations locked, 20 ms step: the verdicts of the laws it flies "
+        "kept, peak tau_flex within 5.1 %, docs/campaigns.md, 'Reduced models'); each "
+        "campaign names its model.</p>"
     ]
     models = src.data.get("models", {})
     for name in src.get("campaigns"):
         rows = [[label, *(src.cell("campaigns", name, v, *path) for v in variants)]
                 for label, path in _LAW_ROWS]  # fmt: skip
         model = models.get(name, "full")
-        parts.append(f"<h3>{_esc(name)}</h3><p>Flown on the {_esc(model)} model.</p>")
+        full_too = [get_law(v).label if v in law_names() else v
+                    for v in src.data.get("full_model_variants", {}).get(name, [])]  # fmt: skip
+        model += f" model ({', '.join(full_too)} on the full one)" if full_too else " model"
+        parts.append(f"<h3>{_esc(name)}</h3><p>Flown on the {_esc(model)}.</p>")
         parts.append(_table(["figure", *labels], rows, f"Laws over the {name} campaign"))
     return "".join(parts)
 
