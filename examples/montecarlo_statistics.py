@@ -226,7 +226,7 @@ for path, value in found["parameters"].items():
 
 replayed = replay_case(search_dir, found["case_id"])
 replayed_metrics = slew_metrics(replayed.dataset)
+r2 = {True: "met", False: "not met", None: "not judged"}[replayed_metrics["r2_pass"]]
 print(f"replayed {found['case_id']}: max_rate_error_deg_s = "
-      f"{replayed_metrics['max_rate_error_deg_s']:.4g} deg/s, "
-      f"R2 {'met' if replayed_metrics['r2_pass'] else 'not met'}")  # fmt: skip
+      f"{replayed_metrics['max_rate_error_deg_s']:.4g} deg/s, R2 {r2}")  # fmt: skip
 plot_pointing(replayed.dataset)
