@@ -37,6 +37,17 @@ def test_statistics_count_rates_and_distributions():
     assert s["control_energy_j"] == {"median": 2.0, "max": 3.0}
 
 
+def test_rates_leave_out_the_cases_not_judged():
+    # a run planned to end before its observation window is neither a pass nor a fail
+    rows = [_row(r1_pass=True, r2_pass=None, r3_pass=True), _row(r1_pass=None, r2_pass=None,
+            r3_pass=False), _row(status="failed")]  # fmt: skip
+    s = law_statistics(rows)
+    assert s["r1_pass_rate"] == pytest.approx(1 / 2)  # the pass and the failed case
+    assert s["r2_pass_rate"] == 0.0  # the failed case alone is judged
+    assert s["r3_pass_rate"] == pytest.approx(1 / 3)
+    assert law_statistics([_row(r1_pass=None, r2_pass=None, r3_pass=True)])["r1_pass_rate"] is None
+
+
 def test_the_study_compares_every_law_and_the_damped_asmc(quick_study):
     out, manifest = quick_study
     entry = next(p for p in manifest["parts"] if p["name"] == "laws")

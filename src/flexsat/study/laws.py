@@ -95,7 +95,9 @@ def law_statistics(rows: list[dict]) -> dict:
     Returns
     -------
     dict
-        ``cases``, ``failed``, ``r1_pass_rate``, ``r2_pass_rate``, ``r3_pass_rate``,
+        ``cases``, ``failed``, ``r1_pass_rate``, ``r2_pass_rate``, ``r3_pass_rate``
+        (over the judged cases, a case that failed to run counting as failing; None
+        when no case is judged: docs/campaigns.md, 'Cases not judged'),
         ``settling_time_s`` and ``r2_settling_time_s`` (min, median, p90, max over
         the cases that settle, ``never`` the count of those that do not),
         ``peak_flex_torque_nm`` and ``peak_tip_displacement_m`` (largest over the
@@ -105,8 +107,9 @@ def law_statistics(rows: list[dict]) -> dict:
     ok = [r["metrics"] for r in rows if r.get("status") == "ok"]
     n = len(rows)
 
-    def rate(key: str) -> float | None:
-        return sum(bool(m.get(key)) for m in ok) / n if n else None
+    def rate(key: str) -> float | None:  # over the judged cases, a failed case failing
+        judged = n - sum(m.get(key) is None for m in ok)
+        return sum(m.get(key) is True for m in ok) / judged if judged else None
 
     def largest(key: str) -> float | None:
         values = [np.max(m[key]) for m in ok if m.get(key) is not None]
