@@ -78,11 +78,12 @@ def test_the_public_names_still_import_on_demand():
 def test_openloop_json_loads_neither_figures_spectra_nor_the_closed_loop():
     modules = loaded("openloop", "--json", "--duration", "2")
     assert "flexsat.simulate.openloop" in modules  # the run did happen
-    # The scenario models name every law and loop stage (the slew's validation), so
-    # those modules load; the closed loop, the study and the figures do not.
+    # The open-loop scenario models alone: not the slew's, which name every law and
+    # loop stage; neither the closed loop, the study nor the figures.
     assert heavy(modules, ("matplotlib", "scipy.signal", "flexsat.plots",
                            "flexsat.simulate.closedloop", "flexsat.study.pipeline",
-                           "scipy.integrate")) == []  # fmt: skip
+                           "scipy.integrate", "flexsat.simulate.scenario",
+                           "flexsat.control.laws", "flexsat.control.stages")) == []  # fmt: skip
     # SciPy's rotations (scipy.spatial): the plate packs its mount with flexsat's own
     # (bit for bit SciPy's); a satellite of plates does not load the chain's kernels.
     assert heavy(modules, ("scipy.spatial", "flexsat.dynamics.appendages.chain",

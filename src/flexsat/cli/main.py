@@ -571,9 +571,10 @@ def openloop(
     A run that diverges stops cleanly: its history up to the failure is saved (with
     --out) and the command exits with code 1 after naming the time.
     """
+    # the open-loop models, not flexsat.simulate.scenario: the slew's import every law
     from flexsat.config import load_config, validate_config
     from flexsat.dynamics.plant import Plant
-    from flexsat.simulate import OpenLoopScenario, load_scenario
+    from flexsat.simulate.openloop_scenario import OpenLoopScenario, load_scenario
     from flexsat.study.outputs import fly_openloop
 
     cfg = load_config(config)  # a config's mistakes are told before any notice

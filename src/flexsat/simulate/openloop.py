@@ -24,6 +24,7 @@ from flexsat.dynamics.integrators import (
 )
 from flexsat.dynamics.kernels import STATUS_OK, hub_cs
 from flexsat.dynamics.plant import Plant
+from flexsat.simulate.openloop_scenario import OpenLoopScenario, thesis_openloop
 from flexsat.simulate.run_setup import (
     PROGRESS_MIN_STEPS,
     check_run_size,
@@ -31,7 +32,6 @@ from flexsat.simulate.run_setup import (
     progress_bar,
     run_attributes,
 )
-from flexsat.simulate.scenario import OpenLoopScenario, thesis_openloop
 
 if TYPE_CHECKING:  # xarray (0.4 s to import) loads only when a dataset is built
     import xarray as xr

@@ -194,7 +194,8 @@ def fly_openloop(plant: Plant, scenario=None, out: Path | None = None, progress=
     """
     from flexsat.analysis.openloop import openloop_metrics
     from flexsat.analysis.run_records import RunRecords
-    from flexsat.simulate import OpenLoopScenario, run_openloop
+    from flexsat.simulate.openloop import run_openloop
+    from flexsat.simulate.openloop_scenario import OpenLoopScenario
 
     def figures() -> list[Path]:  # matplotlib is imported only when figures are drawn
         from flexsat.analysis.modal import modal_analysis
