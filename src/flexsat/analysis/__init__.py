@@ -17,7 +17,7 @@ _LAZY = {
     "openloop_metrics": "openloop",
     "dominant_frequency": "spectral",
     **dict.fromkeys(("DEFAULT_OVERLAP", "DEFAULT_WINDOW_S", "HUB_ROTATION_DOF",
-                     "coupled_frequencies", "spectrogram"), "spectrogram"),
+                     "coupled_frequencies", "spectrogram"), "time_frequency"),
 }  # fmt: skip
 
 __all__ = [

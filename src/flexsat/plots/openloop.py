@@ -37,7 +37,7 @@ from scipy.ndimage import maximum_filter1d
 
 from flexsat.analysis.modal import ModalAnalysis
 from flexsat.analysis.spectral import dominant_frequency
-from flexsat.analysis.spectrogram import (
+from flexsat.analysis.time_frequency import (
     DEFAULT_OVERLAP,
     DEFAULT_WINDOW_S,
     HUB_ROTATION_DOF,
@@ -654,11 +654,11 @@ def plot_spectrogram(
     """Spectrogram of the detrended hub angular acceleration about one body axis.
 
     Left: power spectral density of omega_dot about ``axis`` (see
-    :func:`flexsat.analysis.spectrogram.spectrogram`) in dB relative to
+    :func:`flexsat.analysis.time_frequency.spectrogram`) in dB relative to
     1 (rad/s^2)^2/Hz over 0 to ``max_hz``, colour range the top 80 dB, each
     column at the centre time of its window. Right: the same spectrum averaged
     over time. The natural frequencies of the flexible modes that drive the hub
-    about ``axis`` (:func:`flexsat.analysis.spectrogram.coupled_frequencies`) are
+    about ``axis`` (:func:`flexsat.analysis.time_frequency.coupled_frequencies`) are
     overlaid as dashed lines when an analysis is given.
 
     Parameters

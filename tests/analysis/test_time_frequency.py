@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from flexsat.analysis.modal import modal_analysis
-from flexsat.analysis.spectrogram import coupled_frequencies, spectrogram
+from flexsat.analysis.time_frequency import coupled_frequencies, spectrogram
 
 DT = 0.01  # 100 Hz
 DURATION = 120.0
@@ -100,3 +100,13 @@ def test_coupled_frequencies_per_axis(nominal_analysis) -> None:
 def test_coupled_frequencies_rejects_unknown_axis(nominal_analysis) -> None:
     with pytest.raises(ValueError, match="hub_axis"):
         coupled_frequencies(nominal_analysis, "w")
+
+
+def test_the_package_name_is_the_function_after_the_module_is_imported():
+    # the module's name differs from its function's, so importing the module does not
+    # rebind flexsat.analysis.spectrogram to it
+    import flexsat.analysis
+    import flexsat.analysis.time_frequency as module
+
+    assert flexsat.analysis.spectrogram is module.spectrogram
+    assert callable(flexsat.analysis.spectrogram)
