@@ -75,15 +75,18 @@ def test_cli_refuses_a_gain_that_breaks_the_lyapunov_condition(tmp_path):
 
 @pytest.mark.parametrize("kind", NEW_LAWS)
 def test_law_meets_r1_r2_r3_in_the_sensitivity_campaign(tmp_path, kind):
-    # The thesis's sensitivity campaign (sec. 5.2.1), each case cut to 90 s: both
-    # laws have settled by then in every case (the slowest, ISMC, meets R2 from 77 s
-    # on the nominal case). Full-length pass rates are in docs/control.md.
+    # The thesis's sensitivity campaign (sec. 5.2.1), each case cut to 95 s: both
+    # laws have settled by the window's start, 90 s, in every case (the slowest, ISMC,
+    # meets R2 from 77 s on the nominal case), and R1 and R2 are judged over 90-95 s
+    # (a run ending at 90 s would leave the window empty: not judged). Full-length
+    # pass rates are in docs/control.md.
     data = load_campaign("sensitivity").model_dump(mode="json")
-    data["base"] = {**data["base"], "duration_s": 90.0, "controller": {"kind": kind}}
+    data["base"] = {**data["base"], "duration_s": 95.0, "controller": {"kind": kind}}
     definition = validate_config(data, source=kind, model=CampaignDefinition)
     run_campaign(definition, nominal(), tmp_path, workers=2, progress=False)
     summary = summarize(tmp_path)
     assert summary["cases"] == 12 and summary["failed"] == 0
+    assert summary["r1_not_judged"] == summary["r2_not_judged"] == 0
     assert (summary["r1_pass_rate"], summary["r2_pass_rate"], summary["r3_pass_rate"]) == (
         1.0, 1.0, 1.0,
     )  # fmt: skip
