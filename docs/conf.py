@@ -134,9 +134,12 @@ def _module_page(name: str, modules: list[str]) -> str:
 
 
 def _write_api(app) -> None:
-    """Write ``api/<module>.rst`` for every public module (only files that changed)."""
+    """Write ``api/<module>.rst`` for every public module (only files that changed),
+    and remove the pages of modules that no longer exist (a renamed module)."""
     modules = _public_modules()
     API.mkdir(exist_ok=True)
+    for stale in set(API.glob("*.rst")) - {API / f"{name}.rst" for name in modules}:
+        stale.unlink()
     for name in modules:
         page, text = API / f"{name}.rst", _module_page(name, modules)
         if not page.is_file() or page.read_text(encoding="utf-8") != text:
