@@ -952,6 +952,13 @@ def study(
             "separated, or all (every registered law)."
         ),
     ] = "all",
+    parts: Annotated[
+        str | None,
+        typer.Option(
+            help="Run only these parts of the study (comma separated; the parts they "
+            "need run too), the others shown as not run. Default: every part."
+        ),
+    ] = None,
 ) -> None:
     """The thesis study end to end, then an HTML report: OUT/report.html.
 
@@ -959,12 +966,23 @@ def study(
     (the thesis's ASMC), the controller comparison (every registered law, or those
     of --controller), the slew animation and, unless --quick, the three
     thesis campaigns. A part that fails is reported in its section and the others
-    go on; the command then exits with code 1.
+    go on; the command then exits with code 1. With --parts, only the parts named
+    (configuration, modal, openloop, slew, frequency, robust, pointing, comparison,
+    animation, avionics, campaigns, laws) and those they need run.
     """
     from flexsat.config import load_config
     from flexsat.control.laws import get_law
+    from flexsat.errors import ConfigError
     from flexsat.study import run_study
+    from flexsat.study.pipeline import chosen_parts
 
+    chosen_names = None
+    if parts is not None:
+        chosen_names = [name.strip() for name in parts.split(",") if name.strip()]
+        try:
+            chosen_parts(chosen_names)
+        except ConfigError as exc:
+            raise ConfigError(f"--parts: {exc}") from None
     cfg = load_config(config)
     _announce_compilation()
     chosen = () if controller == "all" else tuple(c.strip() for c in controller.split(","))
@@ -976,7 +994,7 @@ def study(
     source = str(config) if config is not None else "the built-in nominal case"
     manifest = run_study(
         cfg, out, quick=quick, config_source=source, workers=workers, console=_errors,
-        controllers=chosen,
+        controllers=chosen, parts=chosen_names,
     )  # fmt: skip
     failed = [part["title"] for part in manifest["parts"] if part["status"] == "failed"]
     _console.print(f"report: {manifest['report']}")

@@ -7,11 +7,12 @@ comparison, the slew animation, the avionics, unless ``quick`` the three thesis
 campaigns, and the law comparison), after compiling every kernel they need up front
 (its time is ``compilation_s`` in the manifest; the parts' wall times exclude it),
 writes each part's outputs under its own folder, and keeps ``study.json``, the
-manifest, up to date after every part: status (ok, failed, skipped), wall time, the
-files written and, for a failed part, the error and its traceback. A failed part
-does not stop the others (a part whose input failed is marked failed with that
-reason). Finally it writes ``report.html`` from the manifest and the parts' JSON
-files.
+manifest, up to date after every part: status (ok, failed, skipped, not run), wall
+time, the files written and, for a failed part, the error and its traceback. A failed
+part does not stop the others (a part whose input failed is marked failed with that
+reason). ``parts`` restricts the study to some parts and those they need
+(:func:`chosen_parts`, ``flexsat study --parts``): the others are "not run". Finally
+it writes ``report.html`` from the manifest and the parts' JSON files.
 
 On two cores or more the parts run in two lanes side by side (:data:`LANES`): this
 process runs lane 0 (the campaigns among them, with their progress bars) and a
@@ -57,7 +58,16 @@ from flexsat.study.outputs import (
 )
 from flexsat.study.thesis import CAMPAIGNS
 
-__all__ = ["CAMPAIGNS", "LANES", "PARTS", "Part", "StudyContext", "run_study"]
+__all__ = [
+    "CAMPAIGNS",
+    "LANES",
+    "NOT_RUN",
+    "PARTS",
+    "Part",
+    "StudyContext",
+    "chosen_parts",
+    "run_study",
+]
 
 QUICK_ANIMATED_MODES = 2
 """Mode GIFs of the quick study: the lowest flexible modes that drive a hub DOF (the
@@ -67,6 +77,8 @@ QUICK_ANIMATION_FRAMES = 60
 
 MANIFEST = "study.json"
 REPORT = "report.html"
+NOT_RUN = "not run"
+"""The status of a part left out of a study restricted to some parts (``--parts``)."""
 
 
 @dataclass
@@ -89,6 +101,8 @@ class StudyContext:
         The comparison's laws; empty: every registered law.
     results : dict
         Part name -> its returned outputs, filled as the parts run.
+    only : frozenset of str or None
+        The parts that run (:func:`chosen_parts`); None: every part.
     """
 
     config: SatelliteConfig
@@ -98,6 +112,11 @@ class StudyContext:
     workers: int | None = None
     controllers: tuple[str, ...] = ()  # the comparison's laws; empty: every registered law
     results: dict = field(default_factory=dict)  # part name -> its returned outputs
+    only: frozenset[str] | None = None  # the parts that run; None: every part
+
+    def runs(self, name: str) -> bool:
+        """Whether the part called ``name`` is among those that run."""
+        return self.only is None or name in self.only
 
     @property
     def laws(self) -> tuple[str, ...]:
@@ -352,6 +371,46 @@ PARTS = (
 )
 """The study's parts, in the order they appear in the report (and run, lane by lane)."""
 
+
+def chosen_parts(names) -> frozenset[str]:
+    """The parts ``names`` asks for and every part they need (:attr:`Part.needs`, in turn
+    their needs): what a study restricted to ``names`` runs.
+
+    Parameters
+    ----------
+    names : iterable of str
+        Names of parts of :data:`PARTS`, at least one.
+
+    Returns
+    -------
+    frozenset of str
+
+    Raises
+    ------
+    ConfigError
+        A name that is no part's, or no name at all; the message lists the parts.
+    """
+    from flexsat.errors import ConfigError, shorten
+
+    by_name = {part.name: part for part in PARTS}
+    allowed = ", ".join(by_name)
+    asked = [name for name in names]
+    if not asked:
+        raise ConfigError(f"no part named: name one or more of {allowed}")
+    for name in asked:
+        if name not in by_name:
+            raise ConfigError(f"unknown part {shorten(repr(name))}: the study's parts are "
+                              f"{allowed}")  # fmt: skip
+    chosen: set[str] = set()
+    pending = list(asked)
+    while pending:
+        name = pending.pop()
+        if name not in chosen:
+            chosen.add(name)
+            pending += by_name[name].needs
+    return frozenset(chosen)
+
+
 LANES = 2
 """Lanes the parts run in side by side when :func:`flexsat.parallel.figure_workers`
 allows two processes. Each part's ``lane`` splits the quick study's CPU time about
@@ -373,6 +432,7 @@ def run_study(
     workers: int | None = None,
     console: Console | None = None,
     controllers: tuple[str, ...] = (),
+    parts=None,
 ) -> dict:
     """Run the study into ``out`` and write ``out/report.html``.
 
@@ -396,6 +456,10 @@ def run_study(
     controllers : tuple of str, optional
         Registered laws flown in the comparison besides the default one; empty:
         every registered law.
+    parts : iterable of str, optional
+        Run only these parts of :data:`PARTS` and those they need
+        (:func:`chosen_parts`); the others are recorded with the status
+        :data:`NOT_RUN`. None (the default): every part.
 
     Returns
     -------
@@ -407,22 +471,26 @@ def run_study(
     ------
     ConfigError
         ``out`` cannot be written, or a part's folder in it is a symbolic link
-        (:func:`flexsat.files.ensure_dir`), before any part runs.
+        (:func:`flexsat.files.ensure_dir`), or ``parts`` names no part or an unknown
+        one, before any part runs.
     """
     from flexsat.study.report import write_report
 
+    only = None if parts is None else chosen_parts(parts)
     out = prepare_output_dir(out)
     for part in PARTS:  # a part's folder that is a link is refused before any work
         if (out / part.name).is_symlink():
             ensure_dir(out / part.name)
     console = console or Console(stderr=True)
-    ctx = StudyContext(config, out, quick, progress, workers, tuple(controllers))
+    ctx = StudyContext(config, out, quick, progress, workers, tuple(controllers), only=only)
     manifest = {
         "flexsat_version": __version__,
         "created_utc": dt.datetime.now(dt.UTC).strftime("%Y-%m-%d %H:%M:%S UTC"),
         "config_name": config.name,
         "config_source": config_source,
         "quick": quick,
+        # the parts chosen with their needs (--parts), in the report's order; None: all
+        "chosen_parts": None if only is None else [p.name for p in PARTS if p.name in only],
         "parts": [],
     }
     lanes = LANES if figure_workers() > 1 else 1
@@ -481,11 +549,18 @@ def _compile_runs(ctx: StudyContext) -> list[tuple[dict | str | None, frozenset[
     laws = [{"controller": {"kind": kind}} for kind in ctx.laws]
     every_law = frozenset({"slew", "comparison", "laws", "robust"})
     avionics = frozenset({"avionics"})
-    return [(laws[0], every_law), ("stages", frozenset()), ("drive plant", frozenset()),
+    runs = [(laws[0], every_law), ("stages", frozenset()), ("drive plant", frozenset()),
             ("open loop", frozenset({"openloop"})),
             (delayed(1), avionics), (AVIONICS, avionics), (None, avionics),
             ({"joint_actuator": HYBRID_DAMPING}, frozenset({"laws"})),
             *((law, every_law) for law in laws[1:])]  # fmt: skip
+    if ctx.only is None:
+        return runs
+    # a study of some parts flies the runs of those parts only, and the first law's slew,
+    # which the estimate's calibration flies (:func:`_split_runs`); the steps no part
+    # flies ("stages", "drive plant") stay: they are flown only to fill an empty cache
+    return [(fields, parts & ctx.only) for k, (fields, parts) in enumerate(runs)
+            if k == 0 or not parts or parts & ctx.only]  # fmt: skip
 
 
 def _fly_short(ctx: StudyContext, fields: dict | str | None) -> None:
@@ -581,16 +656,20 @@ def _split_runs(runs: list, lanes: int) -> tuple[list, dict[int, list]]:
     (loops the parts of both lanes fly) and, per lane, those only its parts fly.
 
     Returns ``(shared, {lane: runs})``; with one lane every run is shared. A run no
-    part flies (only compiled, the drive's plant) is in neither.
+    part flies (only compiled, the drive's plant) is in neither, but the first, the
+    first law's slew, is always shared: the estimate's calibration
+    (:func:`flexsat.study.estimate.calibrate`) flies that loop in this process before
+    the lanes start, and would otherwise time its loading (a study of some parts,
+    ``--parts``, may fly it in one lane or not at all).
     """
-    runs = [(fields, parts) for fields, parts in runs if parts]
+    runs = [(k, fields, parts) for k, (fields, parts) in enumerate(runs) if k == 0 or parts]
     if lanes < 2:
-        return [fields for fields, _ in runs], {}
+        return [fields for _, fields, _ in runs], {}
     lane_of = {part.name: part.lane for part in PARTS}
     shared, per_lane = [], {lane: [] for lane in range(lanes)}
-    for fields, parts in runs:
+    for k, fields, parts in runs:
         used = {lane_of[name] for name in parts}
-        (per_lane[used.pop()] if len(used) == 1 else shared).append(fields)
+        (per_lane[used.pop()] if len(used) == 1 and k > 0 else shared).append(fields)
     return shared, per_lane
 
 
@@ -679,6 +758,8 @@ def _entry(part: Part, status: str = "ok", error: str | None = None) -> dict:
 
 
 def _run_part(part: Part, ctx: StudyContext) -> dict:
+    if not ctx.runs(part.name):
+        return _entry(part, NOT_RUN, "not run: the study was asked for other parts (--parts)")
     if part.full_only and ctx.quick:
         return _entry(part, "skipped", "skipped with --quick; run the study without it for "
                                        "this part")  # fmt: skip
@@ -710,7 +791,7 @@ def _estimate(ctx: StudyContext, console: Console, lanes: int) -> dict | None:
 
     try:
         basis = estimate.calibrate(ctx.plant, ctx.workers)
-        rows = estimate.study_estimate(ctx, PARTS, basis)
+        rows = estimate.study_estimate(ctx, [p for p in PARTS if ctx.runs(p.name)], basis)
     except Exception as exc:  # the parts that fly the same satellite report the problem
         console.print(f"no estimate: {escape(f'{type(exc).__name__}: {exc}')}", highlight=False)
         return None
@@ -728,7 +809,9 @@ def _announce(console: Console, part: Part, entry: dict, estimate: dict | None =
     from rich.progress_bar import ProgressBar
     from rich.table import Table
 
-    style = {"ok": "green", "failed": "bold red", "skipped": "yellow"}[entry["status"]]
+    style = {"ok": "green", "failed": "bold red", "skipped": "yellow", NOT_RUN: "dim"}[
+        entry["status"]
+    ]
     line = f"[{style}]{entry['status']:>7}[/] {part.title} ({entry['wall_time_s']:.1f} s"
     expected = (estimate or {}).get("parts", {}).get(part.name)
     line += f", estimate {expected:.0f} s)" if expected is not None else ")"

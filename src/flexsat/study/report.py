@@ -825,12 +825,12 @@ def _section(root: Path, section: Section, number: int, entry: dict | None,
         return anchor + "<p class='error'>This part did not run (the study stopped).</p></section>"
     status = entry["status"]
     head = (
-        f"<p class='meta'><span class='badge {status}'>{status}</span> "
+        f"<p class='meta'>{_badge(status)} "
         f"wall time {entry['wall_time_s']:.1f} s (compilation excluded)</p>"
     )
     if section.caveat and not context["nominal"]:
         head += f"<p class='caveat'>{_esc(section.caveat)}</p>"
-    if status == "skipped":
+    if status in ("skipped", "not run"):
         return anchor + head + f"<p class='note'>{_esc(entry['error'])}</p></section>"
     if status == "failed":
         trace = f"<pre>{_esc(entry['traceback'])}</pre>" if entry.get("traceback") else ""
@@ -844,23 +844,38 @@ def _title(section: Section, entry: dict | None) -> str:
     return section.title or (entry["title"] if entry else section.name)
 
 
+def _badge(status: str) -> str:
+    """A part's status as a coloured badge (``not run``: class ``notrun``)."""
+    return f"<span class='badge {status.replace(' ', '')}'>{_esc(status)}</span>"
+
+
 def _summary(manifest: dict) -> str:
+    """The parts' table: status, wall time and the estimate said before the study (a
+    part that was not estimated, skipped or not run, shows a dash)."""
+    estimate = manifest.get("estimate") or {}
+    planned = estimate.get("parts", {})
+
+    def said(seconds: float | None) -> str:
+        return "—" if seconds is None else f"{seconds:.1f}"
+
     rows = []
     for entry in manifest["parts"]:
         name = entry["name"]
         rows.append(
             [
                 f"<td><a href='#{name}'>{_esc(entry['title'])}</a></td>",
-                f"<td><span class='badge {entry['status']}'>{entry['status']}</span></td>",
+                f"<td>{_badge(entry['status'])}</td>",
                 f"{entry['wall_time_s']:.1f}",
+                said(planned.get(name)),
             ]
         )
-    rows.append(["total", "", f"{manifest.get('total_wall_time_s', 0.0):.1f}"])
+    rows.append(["total", "", f"{manifest.get('total_wall_time_s', 0.0):.1f}",
+                 said(estimate.get("total_s"))])  # fmt: skip
     if "compilation_s" in manifest:
         rows.append(["compilation, before the parts (not in their times)", "",
-                     f"{manifest['compilation_s']:.1f}"])  # fmt: skip
-    return _table(["part", "status", "wall time [s], compilation excluded"], rows,
-                  "Parts of the study")  # fmt: skip
+                     f"{manifest['compilation_s']:.1f}", ""])  # fmt: skip
+    return _table(["part", "status", "wall time [s], compilation excluded", "estimate [s]"],
+                  rows, "Parts of the study")  # fmt: skip
 
 
 def write_report(study_dir: str | Path) -> Path:
@@ -966,6 +981,7 @@ td.fail{color:#b00020;font-weight:600}
 .badge.ok{background:#0a6b2d}
 .badge.failed{background:#b00020}
 .badge.skipped{background:#a66a00}
+.badge.notrun{background:#667}
 .error,.problem{color:#b00020}
 .error pre{color:#222;background:#fbeaea;padding:.5rem;overflow-x:auto;font-size:.75rem}
 .success{color:#0a6b2d}
