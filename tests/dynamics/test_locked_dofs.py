@@ -114,6 +114,43 @@ def test_plates_that_lock_nothing_run_passes_compiled_without_the_locks():
 
 
 @pytest.mark.parametrize(
+    ("names", "kind"),
+    [([], plate.JOINT_FREE), (TRANSLATIONS, plate.JOINT_SPHERICAL),
+     (["eta_x", "eta_y"], plate.JOINT_LOCKED), (["eta_ry"], plate.JOINT_LOCKED),
+     ([*TRANSLATIONS, "eta_rz"], plate.JOINT_LOCKED)],
+)  # fmt: skip
+def test_each_plate_packs_the_kind_of_its_joint(names, kind):
+    # The passes dispatch on the packed kind: the spherical equations for exactly the
+    # translations locked, the general elimination for any other set.
+    plant = _locked(names) if names else Plant.from_config(nominal())
+    assert [row[plate.P_JOINT] for row in plant.packed.params[0]] == [kind, kind]
+
+
+def test_the_spherical_joint_equations_equal_the_general_elimination():
+    # Independent formulation: the translations-locked plates solved by the general
+    # elimination over the free rows (the packed kind switched to JOINT_LOCKED) and by
+    # the spherical joint's equations agree to rounding: 1e-12 relative for q_ddot and
+    # the constraint forces (measured at most 3e-15; different operation orders).
+    spherical = _locked(TRANSLATIONS)
+    params = spherical.packed.params[0].copy()
+    params[:, plate.P_JOINT] = plate.JOINT_LOCKED
+    general = spherical.packed._replace(params=(params,), work=(np.zeros_like(
+        spherical.packed.work[0]),))  # fmt: skip
+    rng = np.random.default_rng(46)
+    locked = list(spherical.locked_coordinates())
+    for _ in range(4):
+        q, qd, Q = (0.1 * rng.normal(size=spherical.n_dof) for _ in range(3))
+        q[locked], qd[locked] = 0.0, 0.0
+        by_sphere, by_rows = np.zeros(spherical.n_dof), np.zeros(spherical.n_dof)
+        assert kernels.accelerations(q, qd, Q, spherical.packed, by_sphere) == 0
+        lam_sphere = spherical.packed.reaction[1].copy()
+        assert kernels.accelerations(q, qd, Q, general, by_rows) == 0
+        lam_rows = general.reaction[1]
+        assert np.max(np.abs(by_sphere - by_rows)) <= 1e-12 * np.max(np.abs(by_rows))
+        assert np.max(np.abs(lam_sphere - lam_rows)) <= 1e-12 * np.max(np.abs(lam_rows))
+
+
+@pytest.mark.parametrize(
     ("names", "fragment"),
     [(["eta_q"], "locked_dofs"), (["eta_x", "eta_x"], "names a DOF twice")],
 )

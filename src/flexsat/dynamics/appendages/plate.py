@@ -103,7 +103,17 @@ P_LOCKED = 49  # (6) 1.0 where the joint DOF is locked (``locked_dofs``), else 0
 P_IP = 55  # (9) I_P, panel inertia about the root, panel frame [kg m^2]
 P_IP_INV = 64  # (9) its inverse
 P_M_ROOT = 73  # (9) M_P = m 1 + m^2 [d]x I_P^-1 [d]x, the effective mass at the root [kg]
-N_PARAMS = 82
+P_JOINT = 82  # (1) the joint's locks, from P_LOCKED: JOINT_FREE, JOINT_SPHERICAL or JOINT_LOCKED
+N_PARAMS = 83
+
+# Joint kinds (P_JOINT): which pass-1 and pass-2 equations a plate's joint takes, read
+# once per plate and evaluation instead of scanning its six lock flags. The passes
+# inline what they call on every evaluation (``inline="always"``: _pose and the
+# spherical joint's equations); LLVM left them as calls, each passing every array's
+# fields as arguments (docs/performance.md, 'Campaign cases').
+JOINT_FREE = 0.0  # nothing locked: the 6-DOF joint
+JOINT_SPHERICAL = 1.0  # exactly the translations locked (the reduced plant's set)
+JOINT_LOCKED = 2.0  # any other set of locks: the general elimination over the free rows
 
 MIN_COS = 1e-9  # |cos(rho_y)| below this is treated as gimbal lock
 
@@ -125,7 +135,7 @@ def _rho_bias(cs, qd, o):
     return euler_rate_bias_cs(cs[0], cs[1], cs[2], cs[3], qd[o + 3], qd[o + 4], qd[o + 5])
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", inline="always")
 def _pose(q, o, p, cs):
     """Pose of the plate whose coordinates start at q[o], relative to the hub, in B.
 
@@ -243,21 +253,13 @@ def _add6(w, k, r0, c0, A, s):
             w[k + 6 * (r0 + a) + c0 + b] += s * A[a][b]
 
 
-@njit(cache=True, error_model="numpy")
-def _is_locked(p):
-    for k in range(6):
-        if p[P_LOCKED + k] != 0.0:
-            return True
-    return False
-
-
-@njit(cache=True, error_model="numpy")
-def _rotations_free(p):
-    """True when exactly the joint's translations are locked (the reduced plant's set)."""
-    for k in range(3):
-        if p[P_LOCKED + k] == 0.0 or p[P_LOCKED + 3 + k] != 0.0:
-            return False
-    return True
+def _joint_kind(locked: np.ndarray) -> float:
+    """The packed joint kind (``P_JOINT``) of a plate's six lock flags (``P_LOCKED``)."""
+    if not np.any(locked):
+        return JOINT_FREE
+    if np.all(locked[:3]) and not np.any(locked[3:]):
+        return JOINT_SPHERICAL
+    return JOINT_LOCKED
 
 
 @njit(cache=True, error_model="numpy")
@@ -275,7 +277,7 @@ W_SPH_SPIN = W_MZ + 9  # (3) omega_P x (omega_P x d), frame P [m/s^2]
 W_SPH_Q_ETA = W_MZ + 12  # (3) Q_eta, the translations' joint forces, frame M [N]
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", inline="always")
 def _spherical_pass1(q, qd, Q, o, p, w, hub):
     """Pass 1 of a plate whose root translations are locked (the reduced plant's set).
 
@@ -336,7 +338,7 @@ def _spherical_pass1(q, qd, Q, o, p, w, hub):
     return STATUS_OK
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", inline="always")
 def _spherical_pass2(o, p, w, hub, qdd):
     """rho_ddot of a plate on a spherical joint given the hub's accelerations, and in
     the locked rows the constraint force lambda = R_MB f - Q_eta (mount frame; the
@@ -374,8 +376,6 @@ def _locked_pass1(q, qd, Q, o, p, w, hub):
     ``w[W_WRENCH:]``). Root translations locked alone: :func:`_spherical_pass1`.
     Returns a status.
     """
-    if _rotations_free(p):
-        return _spherical_pass1(q, qd, Q, o, p, w, hub)
     cs = _rho_cs(q, o)
     R_BM, R_MP, R_BP, S_rho, r_P, r_G = _pose(q, o, p, cs)
     omega_rel_P, rdot_G_rel = _rates(qd, o, p, R_BM, R_BP, S_rho)
@@ -469,9 +469,6 @@ def _locked_pass2(o, p, w, hub, qdd):
     """z_F = D^-1 (r_F - K_F A_hub) on the free rows; on the locked rows the constraint
     force lambda_L = (Mz z)_L + K_L A_hub - r_L (the engine moves it out of ``qdd``).
     Root translations locked alone: :func:`_spherical_pass2`."""
-    if _rotations_free(p):
-        _spherical_pass2(o, p, w, hub, qdd)
-        return
     nf = int(w[W_NF])
     nc = nf + 7
     A = W_SOLVE
@@ -519,8 +516,11 @@ def _passes(holds_locks: bool) -> tuple:
             o = members[j, 1]
             p = params[j]
             w = work[j]
-            if holds_locks and _is_locked(p):  # pruned before typing when False
-                status = _locked_pass1(q, qd, Q, o, p, w, hub)
+            if holds_locks and p[P_JOINT] != JOINT_FREE:  # pruned before typing when False
+                if p[P_JOINT] == JOINT_SPHERICAL:
+                    status = _spherical_pass1(q, qd, Q, o, p, w, hub)
+                else:
+                    status = _locked_pass1(q, qd, Q, o, p, w, hub)
                 if status != STATUS_OK:
                     return status
                 force_B = add(force_B, load_seg(w, W_WRENCH))
@@ -572,8 +572,11 @@ def _passes(holds_locks: bool) -> tuple:
             o = members[j, 1]
             p = params[j]
             w = work[j]
-            if holds_locks and _is_locked(p):  # pruned before typing when False
-                _locked_pass2(o, p, w, hub, qdd)
+            if holds_locks and p[P_JOINT] != JOINT_FREE:  # pruned before typing when False
+                if p[P_JOINT] == JOINT_SPHERICAL:
+                    _spherical_pass2(o, p, w, hub, qdd)
+                else:
+                    _locked_pass2(o, p, w, hub, qdd)
                 continue
             R_BM = load_m33_at(p, P_R_BM)
             R_BP = load_m33_at(w, W_R_BP)
@@ -797,6 +800,7 @@ class PlateModel(AppendageModel):
                                         + config.mass**2 * D @ I_P_inv @ D).ravel()  # fmt: skip
         for name in config.locked_dofs:  # held by pass 1 and 2 themselves
             row[P_LOCKED + JOINT_DOFS.index(name)] = 1.0
+        row[P_JOINT] = _joint_kind(row[P_LOCKED : P_LOCKED + 6])
         return row
 
     def on_drive(self, config: PlateConfig, params: np.ndarray) -> ChainConfig | None:
