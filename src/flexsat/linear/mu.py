@@ -33,10 +33,12 @@ can grow (or must shrink) before the loop can lose stability.
 from __future__ import annotations
 
 import warnings
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
+from scipy.linalg import eigh
 from scipy.optimize import minimize, minimize_scalar
 
 from flexsat.errors import ConfigError
@@ -46,6 +48,8 @@ from flexsat.linear.uncertain import UncertainModel
 __all__ = [
     "LMI_MAX_CHANNELS",
     "LinearController",
+    "LmiBisection",
+    "LmiStep",
     "MuAnalysis",
     "analyze",
     "closed_loop",
@@ -156,7 +160,9 @@ def _dg_bound(p: np.ndarray, N: np.ndarray, real: np.ndarray) -> tuple[float, np
     e = np.exp(0.5 * x)
     Nd = (e[:, None] * N) / e[None, :]
     H = Nd.conj().T @ Nd + 1j * (g[:, None] * Nd - Nd.conj().T * g[None, :])
-    lam, V = np.linalg.eigh(H)
+    # The largest eigenpair alone (LAPACK's MRRR, zheevr): 2.3x faster than the full
+    # eigendecomposition at n = 69 (docs/linear.md, 'Robust stability: mu').
+    lam, V = eigh(H, subset_by_index=[n - 1, n - 1], driver="evr")
     v = V[:, -1]
     a = Nd @ v
     c = Nd.conj().T @ a
@@ -256,6 +262,102 @@ def lmi_certificate(N: np.ndarray, D: np.ndarray, G: np.ndarray) -> float:
     return float(np.sqrt(max(lam, 0.0)))
 
 
+@dataclass(frozen=True)
+class LmiStep:
+    """One beta of :func:`mu_upper_bound_lmi`'s bisection.
+
+    Attributes
+    ----------
+    beta : float
+        The beta tried [-].
+    outcome : str
+        ``"certified"`` (the exact certificate of the D, G found is at most beta),
+        ``"infeasible"`` (the solver's optimal t exceeds its margin: no admissible
+        D, G reach beta), ``"resolution"`` (t within the margin of 0 and the
+        certificate above beta: beta is the LMI's optimum to the solver's accuracy)
+        or ``"undecided"`` (the solver failed, or t is clearly negative, feasible,
+        while the certificate does not confirm it).
+    t : float
+        The SDP's optimal t of the last solve [-] (``nan`` if the solver failed).
+    certificate : float
+        :func:`lmi_certificate` of its D, G [-] (``inf`` if none).
+    solves : int
+        Solves tried at this beta (the first, then the retries).
+    status : str
+        cvxpy's status of the last solve (``"solver_error"`` if it raised).
+    """
+
+    beta: float
+    outcome: str
+    t: float
+    certificate: float
+    solves: int
+    status: str = ""
+
+
+@dataclass(frozen=True)
+class LmiBisection:
+    """How :func:`mu_upper_bound_lmi`'s bisection ended.
+
+    Attributes
+    ----------
+    status : str
+        ``"converged"`` (the interval is below ``rtol``), ``"resolution"`` (the
+        solver's accuracy was reached before ``rtol``), ``"undecided"`` (a beta
+        stayed undecided after every retry: the bisection stopped there, with a
+        ``RuntimeWarning``), ``"max_steps"`` or ``"trivial"`` (N = 0, no SDP).
+    lower : float
+        The bisection's lower end [-]: only betas found infeasible raise it, so the
+        LMI's least beta is not below it (a bound on the LMI, not on mu).
+    upper : float
+        The certified bound returned [-].
+    steps : tuple of LmiStep
+        Every beta tried, in order.
+    """
+
+    status: str
+    lower: float
+    upper: float
+    steps: tuple[LmiStep, ...] = ()
+
+
+def _default_solve(problem, solver: str, settings: dict) -> None:
+    """cvxpy's ``problem.solve`` with one solver and its settings."""
+    problem.solve(solver=solver, **settings)
+
+
+# The solves tried at one beta: the first with the solver's defaults, then tighter
+# tolerances, then the other installed interior-point or first-order solver. Each
+# with the t above which its answer means "infeasible", by status: ten times the
+# solver's absolute gap tolerance (Clarabel 1e-8, or 5e-5 when it reports
+# "optimal_inaccurate"; SCS its eps). t is absolute as the SDP fixes sum tr D_i = n.
+_DEFAULT = {
+    "CLARABEL": ({}, {"optimal": 1e-7, "optimal_inaccurate": 5e-4}),
+    "SCS": ({}, {"optimal": 1e-3}),
+}
+_TIGHT = {
+    "CLARABEL": (
+        {"tol_gap_abs": 1e-10, "tol_gap_rel": 1e-10, "tol_feas": 1e-10, "max_iter": 500},
+        {"optimal": 1e-9, "optimal_inaccurate": 5e-4},
+    ),
+    "SCS": ({"eps_abs": 1e-7, "eps_rel": 1e-7, "max_iters": 20_000}, {"optimal": 1e-6}),
+}
+_OTHER_MARGIN = {"optimal": 1e-6}  # a solver without a row here
+
+
+def _attempts(cp, solver: str | None) -> list[tuple[str, dict, dict]]:
+    """(solver, settings, t margin by status) of each solve tried at one beta."""
+    first = (solver or cp.CLARABEL).upper()
+    out = [(first, *_DEFAULT.get(first, ({}, _OTHER_MARGIN)))]
+    if first in _TIGHT:
+        out.append((first, *_TIGHT[first]))
+    installed = set(cp.installed_solvers())
+    other = next((s for s in _TIGHT if s != first and s in installed), None)
+    if other is not None:
+        out.append((other, *_TIGHT[other]))
+    return out
+
+
 @one_blas_thread
 def mu_upper_bound_lmi(
     N: np.ndarray,
@@ -265,7 +367,9 @@ def mu_upper_bound_lmi(
     rtol: float = 1e-3,
     max_steps: int = 30,
     solver: str | None = None,
-) -> tuple[float, np.ndarray, np.ndarray]:
+    details: bool = False,
+    solve: Callable[[Any, str, dict], None] | None = None,
+) -> tuple[float, np.ndarray, np.ndarray] | tuple[float, np.ndarray, np.ndarray, LmiBisection]:
     """mu upper bound with full D and G blocks for repeated scalar blocks (an LMI).
 
     For ``Delta = diag(delta_i I_{r_i})`` the scalings commuting with Delta are
@@ -276,10 +380,23 @@ def mu_upper_bound_lmi(
     uncertainty", PhD thesis, Caltech 1993). The least beta is a generalized
     eigenvalue problem, solved by bisection on beta: at each beta the SDP ``min t``
     s.t. ``N^H D N + j (G N - N^H G) - beta^2 D <= t I``, ``sum tr D_i = n``,
-    ``D_i >= 1e-6 I`` (cvxpy); its D, G certify :func:`lmi_certificate` (computed
-    exactly, whatever the solver's accuracy), which lowers the upper end when it is
-    at most beta; otherwise beta is the new lower end. The upper end starts at the
-    diagonal bound (D, G diagonal, :func:`mu_upper_bound`), which is always valid.
+    ``D_i >= 1e-6 I`` (cvxpy), posed on ``S N S^-1`` with S the diagonal bound's
+    ``D^1/2`` (:func:`mu_upper_bound`; a similarity commuting with Delta, so its
+    scalings map back as ``S D S``, ``S G S``; the SDP is far better conditioned).
+
+    Each beta ends one of three ways. **Certified**: :func:`lmi_certificate` of the
+    D, G found (exact, whatever the solver's accuracy) is at most beta; the upper
+    end drops to it. **Infeasible**: the solver's optimal t exceeds its margin (ten
+    times its gap tolerance for the status it reports); beta is the new lower end.
+    **Undecided**: the solver failed, or t says feasible while the certificate does
+    not confirm it; the solve is retried with tighter tolerances, then with the
+    other installed solver (Clarabel, SCS), and the lower end never moves on such
+    evidence. A beta still undecided after the retries stops the bisection with a
+    ``RuntimeWarning``: the bound returned is the best certified one, valid but
+    perhaps not the LMI's optimum. A t within the margin of 0 (retried with
+    tighter tolerances only) ends it without a warning: the solver's resolution
+    is reached. The upper end starts at the diagonal bound, which is always
+    valid.
 
     Parameters
     ----------
@@ -296,9 +413,16 @@ def mu_upper_bound_lmi(
         Stop when the bisection's interval is below this, relative to its upper end
         [-].
     max_steps : int
-        At most this many SDPs.
+        At most this many betas (each one SDP, more when retried).
     solver : str, optional
-        cvxpy's solver name; default Clarabel (interior point).
+        cvxpy's solver name for the first solve at each beta; default Clarabel
+        (interior point).
+    details : bool
+        Also return how the bisection ended (:class:`LmiBisection`).
+    solve : callable, optional
+        ``solve(problem, solver, settings)`` solves the cvxpy problem in place;
+        default ``problem.solve(solver=solver, **settings)``. Lets a caller wrap the
+        solver (to log, or to test the bisection against an inaccurate solve).
 
     Returns
     -------
@@ -306,6 +430,8 @@ def mu_upper_bound_lmi(
         The certified bound [-]: never above ``beta0`` nor the diagonal bound.
     D, G : ndarray, shape (n, n)
         The certifying scalings (``lmi_certificate(N, D, G) == bound``) [-].
+    bisection : LmiBisection
+        Only with ``details=True``: its status, ends and steps.
 
     Raises
     ------
@@ -313,6 +439,8 @@ def mu_upper_bound_lmi(
         cvxpy missing (the ``robust`` extra).
     """
     cp = _require_cvxpy()
+    solve = solve or _default_solve
+    attempts = _attempts(cp, solver)
     n = N.shape[0]
     blocks = np.asarray(blocks, dtype=int)
     real = np.asarray(real, dtype=bool)
@@ -320,15 +448,31 @@ def mu_upper_bound_lmi(
     b_diag, x, g = mu_upper_bound(N, real_ch)
     best = (b_diag, np.diag(np.exp(x)).astype(complex), np.diag(g).astype(complex))
     beta = b_diag if beta0 is None else min(float(beta0), b_diag)
-    if beta <= 0.0:
+
+    def done(status, lo, steps):
+        if status == "undecided":
+            warnings.warn(
+                f"mu_upper_bound_lmi: the solver stayed inaccurate at beta = {steps[-1].beta:.6g}"
+                f" after {steps[-1].solves} solves; the bound {best[0]:.6g} is certified but"
+                f" the LMI's optimum lies in [{lo:.6g}, {best[0]:.6g}]",
+                RuntimeWarning,
+                stacklevel=3,
+            )
+        if details:
+            return (*best, LmiBisection(status, lo, best[0], tuple(steps)))
         return best
+
+    if beta <= 0.0:
+        return done("trivial", 0.0, [])
+    s = np.exp(0.5 * x)  # S = D^1/2 of the diagonal bound
+    Ns = (s[:, None] * N) / s[None, :]
     terms_h, terms_d, Ds, Gs = [], [], [], []
     for i in np.unique(blocks):
         idx = np.flatnonzero(blocks == i)
         r = idx.size
         E = np.zeros((r, n))
         E[np.arange(r), idx] = 1.0
-        Ni = N[idx]
+        Ni = Ns[idx]
         Di = cp.Variable((r, r), hermitian=True)
         Ds.append((idx, Di))
         terms_h.append(Ni.conj().T @ Di @ Ni)
@@ -343,35 +487,61 @@ def mu_upper_bound_lmi(
     cons = [lmi << t * np.eye(n), sum(cp.real(cp.trace(Di)) for _, Di in Ds) == n]
     cons += [Di >> 1e-6 * np.eye(Di.shape[0]) for _, Di in Ds]
     problem = cp.Problem(cp.Minimize(t), cons)
+
+    def scalings():
+        """The D, G of the last solve, mapped back to N: S D S, S G S."""
+        D = np.zeros((n, n), complex)
+        G = np.zeros((n, n), complex)
+        for idx, Di in Ds:
+            D[np.ix_(idx, idx)] = Di.value
+        for idx, Gi in Gs:
+            G[np.ix_(idx, idx)] = Gi.value
+        return s[:, None] * D * s[None, :], s[:, None] * G * s[None, :]
+
     lo, hi = 0.0, beta
     beta = 0.5 * hi if beta0 is None else beta  # a given beta0 is tried first
+    steps: list[LmiStep] = []
     for _ in range(max_steps):
         beta2.value = beta**2
-        try:
-            with warnings.catch_warnings():  # an inaccurate solve still gives D, G to check
-                warnings.simplefilter("ignore")
-                problem.solve(solver=solver or cp.CLARABEL)
-            ok = problem.status in ("optimal", "optimal_inaccurate") and t.value is not None
-        except cp.SolverError:
-            ok = False
-        b_new = float("inf")
-        if ok:
-            D = np.zeros((n, n), complex)
-            G = np.zeros((n, n), complex)
-            for idx, Di in Ds:
-                D[np.ix_(idx, idx)] = Di.value
-            for idx, Gi in Gs:
-                G[np.ix_(idx, idx)] = Gi.value
-            b_new = lmi_certificate(N, D, G)  # exact, whatever the solver's accuracy
-            if b_new < best[0]:
-                best = (b_new, D, G)
-        hi = min(hi, best[0])
-        if b_new > beta:  # not certified at beta: mu's bound lies above
-            lo = beta
-        if hi - lo <= rtol * hi:
+        outcome, t_val, cert, solves, tol = "undecided", float("nan"), float("inf"), 0, np.inf
+        status = "not_solved"
+        for name, settings, margin in attempts:
+            if outcome == "resolution" and margin["optimal"] >= tol:
+                continue  # a solver no finer than the last cannot resolve t near 0
+            solves += 1
+            try:
+                with warnings.catch_warnings():  # an inaccurate solve still gives D, G
+                    warnings.simplefilter("ignore")
+                    solve(problem, name, settings)
+                status = problem.status
+            except cp.SolverError:
+                status = "solver_error"
+            if status not in ("optimal", "optimal_inaccurate") or t.value is None:
+                continue
+            t_val = float(t.value)
+            D, G = scalings()
+            cert = lmi_certificate(N, D, G)  # exact, whatever the solver's accuracy
+            if cert < best[0]:
+                best = (cert, D, G)
+            tol = margin.get(status, np.inf)
+            if cert <= beta:
+                outcome = "certified"
+            elif t_val > tol:
+                outcome = "infeasible"
+            else:  # t within the margin of 0, or feasible while the certificate is not
+                outcome = "resolution" if t_val >= -tol else "undecided"
+                continue  # retry
             break
+        steps.append(LmiStep(beta, outcome, t_val, cert, solves, status))
+        hi = min(hi, best[0])
+        if outcome == "infeasible":
+            lo = beta
+        elif outcome in ("undecided", "resolution"):
+            return done(outcome, lo, steps)
+        if hi - lo <= rtol * hi:
+            return done("converged", lo, steps)
         beta = 0.5 * (lo + hi)
-    return best
+    return done("max_steps", lo, steps)
 
 
 def _poles_max_real(model: UncertainModel, loop, delta: np.ndarray) -> tuple[float, float]:
