@@ -92,6 +92,33 @@ def test_lmi_bound_single_repeated_real_scalar():
         assert lmi_certificate(N, D, G) == bound
 
 
+def test_lmi_bound_repeated_real_scalar_without_real_eigenvalues():
+    """One repeated real scalar and N with complex eigenvalues only: mu = 0 exactly.
+
+    det(I - delta N) = 0 needs 1/delta, real, to be an eigenvalue of N (as above), so
+    no real delta destabilizes and mu = 0. The LMI's t is then unbounded below (a G
+    alone makes it negative definite); the bisection takes its D, G from the same SDP
+    with t >= -1 and must certify 0, where the diagonal bound stays far above.
+    """
+    pytest.importorskip("cvxpy")
+    rng = np.random.default_rng(SEED)
+    print(f"seed {SEED}")
+    T = rng.normal(size=(4, 4))
+    L = np.zeros((4, 4))
+    L[:2, :2] = [[0.3, 3.0], [-3.0, 0.3]]  # eigenvalues 0.3 +- 3j, -0.5 +- 2j
+    L[2:, 2:] = [[-0.5, 2.0], [-2.0, -0.5]]
+    N = (T @ L @ np.linalg.inv(T)).astype(complex)
+    bound, D, G, info = mu_upper_bound_lmi(N, np.zeros(4, int), np.array([True]), details=True)
+    diagonal = mu_upper_bound(N, np.ones(4, bool))[0]
+    print(bound, diagonal, info)
+    # The certificate's matrix is negative definite at beta = 0: exactly 0, no round-off
+    # (lmi_certificate clips a negative lambda_max to 0).
+    assert bound == 0.0 and lmi_certificate(N, D, G) == 0.0
+    assert info.status == "converged" and diagonal > 1.0
+    # The bounded SDP was used: its t sits on t >= -1 (to Clarabel's 1e-8 gap).
+    assert all(abs(s.t + 1.0) <= 1e-6 for s in info.steps)
+
+
 def test_rank_one_complex_matrices():
     """mu of a rank-one u v^H is sum |u_i v_i| (Packard & Doyle); the D bound reaches it."""
     rng = np.random.default_rng(SEED)

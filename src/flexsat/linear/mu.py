@@ -284,7 +284,8 @@ class LmiStep:
     solves : int
         Solves tried at this beta (the first, then the retries).
     status : str
-        cvxpy's status of the last solve (``"solver_error"`` if it raised).
+        cvxpy's status of the last solve (``"solver_error"`` if it raised); of the SDP
+        with ``t >= -1`` when the first was unbounded.
     """
 
     beta: float
@@ -395,8 +396,9 @@ def mu_upper_bound_lmi(
     ``RuntimeWarning``: the bound returned is the best certified one, valid but
     perhaps not the LMI's optimum. A t within the margin of 0 (retried with
     tighter tolerances only) ends it without a warning: the solver's resolution
-    is reached. The upper end starts at the diagonal bound, which is always
-    valid.
+    is reached. A t unbounded below (G alone makes the LMI negative: beta is
+    feasible with room to spare) is solved again with ``t >= -1`` for its D, G.
+    The upper end starts at the diagonal bound, which is always valid.
 
     Parameters
     ----------
@@ -456,7 +458,7 @@ def mu_upper_bound_lmi(
                 f" after {steps[-1].solves} solves; the bound {best[0]:.6g} is certified but"
                 f" the LMI's optimum lies in [{lo:.6g}, {best[0]:.6g}]",
                 RuntimeWarning,
-                stacklevel=3,
+                stacklevel=4,  # the caller of the one-BLAS-thread wrapper
             )
         if details:
             return (*best, LmiBisection(status, lo, best[0], tuple(steps)))
@@ -487,6 +489,9 @@ def mu_upper_bound_lmi(
     cons = [lmi << t * np.eye(n), sum(cp.real(cp.trace(Di)) for _, Di in Ds) == n]
     cons += [Di >> 1e-6 * np.eye(Di.shape[0]) for _, Di in Ds]
     problem = cp.Problem(cp.Minimize(t), cons)
+    # t unbounded below (G can make the LMI as negative as it likes: beta is feasible
+    # with room to spare) leaves no D, G; the same SDP with t >= -1 returns some.
+    bounded = cp.Problem(cp.Minimize(t), [*cons, t >= -1.0])
 
     def scalings():
         """The D, G of the last solve, mapped back to N: S D S, S G S."""
@@ -513,7 +518,10 @@ def mu_upper_bound_lmi(
                 with warnings.catch_warnings():  # an inaccurate solve still gives D, G
                     warnings.simplefilter("ignore")
                     solve(problem, name, settings)
-                status = problem.status
+                    status = problem.status
+                    if status == "unbounded":
+                        solve(bounded, name, settings)
+                        status = bounded.status
             except cp.SolverError:
                 status = "solver_error"
             if status not in ("optimal", "optimal_inaccurate") or t.value is None:
