@@ -160,7 +160,7 @@ def _dg_bound(p: np.ndarray, N: np.ndarray, real: np.ndarray) -> tuple[float, np
     e = np.exp(0.5 * x)
     Nd = (e[:, None] * N) / e[None, :]
     H = Nd.conj().T @ Nd + 1j * (g[:, None] * Nd - Nd.conj().T * g[None, :])
-    # The largest eigenpair alone (LAPACK's MRRR, zheevr): 2.3x faster than the full
+    # The largest eigenpair alone (LAPACK's MRRR, zheevr): 2-2.5x faster than the full
     # eigendecomposition at n = 69 (docs/linear.md, 'Robust stability: mu').
     lam, V = eigh(H, subset_by_index=[n - 1, n - 1], driver="evr")
     v = V[:, -1]
