@@ -454,9 +454,10 @@ def mu_upper_bound_lmi(
     def done(status, lo, steps):
         if status == "undecided":
             warnings.warn(
-                f"mu_upper_bound_lmi: the solver stayed inaccurate at beta = {steps[-1].beta:.6g}"
-                f" after {steps[-1].solves} solves; the bound {best[0]:.6g} is certified but"
-                f" the LMI's optimum lies in [{lo:.6g}, {best[0]:.6g}]",
+                "mu_upper_bound_lmi: the solver failed or stayed inaccurate at beta = "
+                f"{steps[-1].beta:.6g} after {steps[-1].solves} solves; the bound "
+                f"{best[0]:.6g} is certified but the LMI's optimum lies in "
+                f"[{lo:.6g}, {best[0]:.6g}]",
                 RuntimeWarning,
                 stacklevel=4,  # the caller of the one-BLAS-thread wrapper
             )
