@@ -7,10 +7,17 @@ side by side, and its overhead, the figures, files and analyses besides the runs
 One slew flown on this machine just before the parts start (:func:`calibrate`)
 gives the wall time a simulated second takes now: the runs are counted at that
 rate, and the overheads, known on a quiet 2-core reference machine
-(:data:`QUICK_OVERHEAD_S`), are scaled by the same speed against the reference.
-A campaign case costs about its simulated time at that rate: the full study's
-extra 414 cases of 120 s took about 4 min on two quiet cores, 1.2 s a case per core,
-against 1.32 s for the bare thesis slew.
+(:data:`QUICK_OVERHEAD_S`), are scaled by the same speed against the reference
+(:data:`REFERENCE_WALL_PER_SIM_S`). A campaign case costs about its simulated time
+at that rate, times :data:`CASE_FACTOR` for its records and store (a reduced-model
+case :data:`REDUCED_SHARE` of a full one), and each campaign of the campaigns part
+:data:`CAMPAIGN_OVERHEAD_S` more for its summary and figures.
+
+The constants were measured again on 2026-12-07 (docs/results.md, 'The study
+report'): on the reference the quick study is estimated at 17.6 s (a quiet warm
+quick study takes 21.9 s, whole process, some 3.5 s of which outside the parts:
+loading the kernels, the calibration, the report) and the full study at 104 s
+(106.1 s, whole process, by ``bench/bench_study.py`` on a quiet machine).
 
 The estimate is an estimate: a part whose runs stop early takes less, and a
 machine whose load changes during the study, or whose load slows its files and
@@ -23,6 +30,7 @@ import time
 from dataclasses import dataclass
 
 __all__ = [
+    "CAMPAIGN_OVERHEAD_S",
     "CASE_FACTOR",
     "QUICK_OVERHEAD_S",
     "REDUCED_SHARE",
@@ -36,40 +44,60 @@ __all__ = [
 
 CALIBRATION_S = 10.0
 """Simulated seconds of the calibration slew [s]."""
-REFERENCE_WALL_PER_SIM_S = 0.008
+REFERENCE_WALL_PER_SIM_S = 0.0029
 """Wall time per simulated second of the calibration slew on the reference machine
-(a quiet 2-core machine: 0.08 s for its 10 s) [s/s]."""
-CASE_FACTOR = 1.26
+(the quiet 2-core machine the overheads were measured on) [s/s]. Measured 2026-12-07:
+2.9 ms in the calibration of a warm quick study at load 0.4-0.5 and again in two at
+load 2.4-2.8 (the 10 s slew takes 0.03 s: it gets a core of its own even then);
+:func:`calibrate` seven times in one process at load 3.4, 2.84-3.52 ms, median 2.87.
+It was 0.008 before the loop's steps grew faster: the overheads, scaled by the speed
+against it, then counted about a third of their time (a quick study estimated at
+12.5 s)."""
+CASE_FACTOR = 1.13
 """A campaign case's wall time against its simulated time at the calibrated rate [-]:
-its records, metrics and stored files besides the run. On the reference machine the
-full study's 414 cases beyond the quick study (4 min 29 s against 18.5 s) took 1.21 s
-a case on each of the two cores, against 0.96 s for 120 s at the calibrated rate."""
-REDUCED_SHARE = 0.06
-"""A reduced-model campaign case's wall time against a full-model one's [-]: 0.067-0.069
-CPU-s in ``run_case`` (docs/campaigns.md, 'Reduced models') against the 1.21 s a case
-of :data:`CASE_FACTOR`."""
+its records, metrics and stored files besides the run. Measured 2026-12-07 from the
+full study on a quiet machine (``bench/bench_study.py``, load 0.9-2.0): its law
+comparison took 43.1 s for 197 full-model and 185 reduced-model cases of 120 s on two
+workers; less its 1.1 s overhead (:data:`QUICK_OVERHEAD_S`), with
+:data:`REDUCED_SHARE`, that is 1.13 times 120 s at the reference rate a full case on
+each core. ``run_case`` alone (``bench/bench_case_cost.py --cases 5``, load 2.9-4.6)
+takes 0.336-0.338 CPU-s a full case, 0.97 times 120 s at that rate: the rest is the
+campaign's store and its workers."""
+REDUCED_SHARE = 0.09
+"""A reduced-model campaign case's wall time against a full-model one's [-]. Measured
+2026-12-07 with ``bench/bench_case_cost.py --cases 5``: 0.0287 against 0.3375 CPU-s
+(load 2.9) and 0.0331 against 0.3357 (load 4.6), 0.085 and 0.099."""
+CAMPAIGN_OVERHEAD_S = 3.4
+"""What each thesis campaign of the full study's campaigns part does besides its cases
+(its summary, its figures, starting its workers) on the reference machine [s]: the
+part took 23.7 s for 69 cases of 120 s in the full study of 2026-12-07 (quiet,
+``bench/bench_study.py``), of which 13.6 s its cases at :data:`CASE_FACTOR` on two
+workers; the other 10.1 s shared among its three campaigns."""
 QUICK_OVERHEAD_S = {
-    "configuration": 0.0, "modal": 5.7, "openloop": 2.9, "slew": 3.0, "frequency": 4.8,
-    "comparison": 2.0, "animation": 1.8, "avionics": 4.5, "laws": 1.5, "pointing": 1.7,
-    "robust": 7.0,
+    "configuration": 0.0, "modal": 2.5, "openloop": 2.2, "slew": 2.7, "frequency": 3.0,
+    "comparison": 1.1, "animation": 1.5, "avionics": 3.9, "laws": 1.1, "pointing": 0.6,
+    "robust": 4.7,
 }  # fmt: skip
 """What each part of the quick study does besides flying its runs (figures, files,
-analyses) on the reference machine [s]: the quick study's 18.5 s there (warm,
-docs/performance.md) shared among the parts as their wall times were in one quick
-study on this 2-core machine, less their runs' simulated time; the pointing part
-(frequency domain only, no run) added since, measured alone; the robustness part's
-mu analysis (8 log-spaced frequencies and the modal ones) and its 2,000 linear cases,
-measured alone on a loaded machine and scaled by its calibration slew (3.4 to 7 s; the
-upper end taken: in a quick study at load 9 the part took 4.5 times its estimate with
-5 s, the other parts 2.3 to 3.5 times theirs)."""
+analyses) on the reference machine [s]. Measured 2026-12-07 in warm quick studies of
+the nominal case, each part's CPU time (its process's and its forked processes',
+those flown side by side counted at half), at load 2.4-2.8 (two other processes
+busy: no quiet window that day), less its runs at the reference rate: modal 2.5 s,
+open loop 2.5, slew 3.0, frequency 3.0, comparison 1.8, animation 1.5, lane 1
+11.8 s; robustness 5.0, pointing 0.6, avionics 6.0, law comparison 3.5, lane 0
+17.6 s (the study's parts took 28.1 s then, 1.6 times that; a quiet warm quick study
+takes 21.9 s, whole process, of which about 3.5 s load the kernels, calibrate and
+write the report)."""
 FULL_OVERHEAD_FACTOR = {
-    "modal": 3.0, "comparison": 13.0, "animation": 2.5, "avionics": 1.4, "robust": 5.0,
+    "modal": 3.0, "comparison": 13.0, "animation": 2.5, "avionics": 1.4, "robust": 4.2,
 }  # fmt: skip
 """The full study's overhead against the quick one's, per part [-]: three times the
 mode GIFs (6 against 2), each compared law's 13 figures (against the one comparison
 figure), 150 animation frames against 60, the longer delay sweep, the mu grid of 60
 log-spaced frequencies at 200 iterations each against 8 at 100 (72 against 20 with the
-modal ones)."""
+modal ones): measured 2026-12-07, the full study's robustness part took 20.3 s on a
+quiet machine (``bench/bench_study.py``), 4.2 times the quick one's overhead with its
+two 60 s flights."""
 
 
 @dataclass(frozen=True)
@@ -235,6 +263,7 @@ def part_work(name: str, ctx, side_by_side: int = 2) -> PartWork:
         flown = sum(c * d for c, d in cases.values())
         if name == "campaigns":
             listed = ", ".join(f"{k} {c}" for k, (c, _) in cases.items())
+            overhead += CAMPAIGN_OVERHEAD_S * len(cases)  # summaries and figures
             return PartWork(every, flown, ctx.workers or side_by_side, overhead,
                             f"{every} cases ({listed})", CASE_FACTOR)  # fmt: skip
         variants = others + 2  # the laws and the ASMC with hybrid damping
