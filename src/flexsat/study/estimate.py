@@ -48,7 +48,8 @@ REFERENCE_WALL_PER_SIM_S = 0.0029
 """Wall time per simulated second of the calibration slew on the reference machine
 (the quiet 2-core machine the overheads were measured on) [s/s]. Measured 2026-12-07:
 2.9 ms in the calibration of a warm quick study at load 0.4-0.5 and again in two at
-load 2.4-2.8 (the 10 s slew takes 0.03 s: it gets a core of its own even then);
+load 1.7-2.7 (the 10 s slew takes 0.03 s: it gets a core even then; a third at load
+1.8 gave 3.7 ms);
 :func:`calibrate` seven times in one process at load 3.4, 2.84-3.52 ms, median 2.87.
 It was 0.008 before the loop's steps grew faster: the overheads, scaled by the speed
 against it, then counted about a third of their time (a quick study estimated at
@@ -80,14 +81,17 @@ QUICK_OVERHEAD_S = {
 }  # fmt: skip
 """What each part of the quick study does besides flying its runs (figures, files,
 analyses) on the reference machine [s]. Measured 2026-12-07 in warm quick studies of
-the nominal case, each part's CPU time (its process's and its forked processes',
-those flown side by side counted at half), at load 2.4-2.8 (two other processes
-busy: no quiet window that day), less its runs at the reference rate: modal 2.5 s,
-open loop 2.5, slew 3.0, frequency 3.0, comparison 1.8, animation 1.5, lane 1
-11.8 s; robustness 5.0, pointing 0.6, avionics 6.0, law comparison 3.5, lane 0
-17.6 s (the study's parts took 28.1 s then, 1.6 times that; a quiet warm quick study
-takes 21.9 s, whole process, of which about 3.5 s load the kernels, calibrate and
-write the report)."""
+the nominal case at load 1.8-3.4 (two other processes busy: no quiet window that
+day): each part's wall time on the reference taken as its CPU time (its process's
+and its forked processes', those flown side by side counted at half), rounded, less
+its runs at the reference rate: modal 2.5 s, open loop 2.5, slew 3.0, frequency 3.0,
+comparison 1.8, animation 1.5 (lane 1, 11.8 s); robustness 5.0, pointing 0.6,
+avionics 6.0, law comparison 3.5 (lane 0, 17.6 s), near the parts' wall times of an
+earlier quiet quick study (CHANGELOG.md, 'The quick study, on a quiet machine':
+modal 2.4, open loop 2.2, slew 2.7, frequency 3.3, comparison 2.0, animation 1.3,
+avionics 6.6, law comparison 3.8) and the about 18.4 s of today's quiet warm quick
+study's parts (21.9 s whole process, some 3.5 s of it loading the kernels, the
+calibration and the report)."""
 FULL_OVERHEAD_FACTOR = {
     "modal": 3.0, "comparison": 13.0, "animation": 2.5, "avionics": 1.4, "robust": 4.2,
 }  # fmt: skip
