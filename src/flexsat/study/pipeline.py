@@ -378,7 +378,7 @@ def chosen_parts(names) -> frozenset[str]:
 
     Parameters
     ----------
-    names : iterable of str
+    names : str or iterable of str
         Names of parts of :data:`PARTS`, at least one.
 
     Returns
@@ -394,7 +394,7 @@ def chosen_parts(names) -> frozenset[str]:
 
     by_name = {part.name: part for part in PARTS}
     allowed = ", ".join(by_name)
-    asked = [name for name in names]
+    asked = [names] if isinstance(names, str) else list(names)
     if not asked:
         raise ConfigError(f"no part named: name one or more of {allowed}")
     for name in asked:
