@@ -3,6 +3,7 @@ first use, with one clear error when a kernel cannot take it."""
 
 from __future__ import annotations
 
+import pickle
 import subprocess
 import sys
 
@@ -28,6 +29,18 @@ def test_a_kernel_declared_without_its_signature_is_compiled_with_it_on_first_us
     kernel = first_class(_lazy_tips, TIPS_SIGNATURE)
     assert TIPS_SIGNATURE.args in _lazy_tips.signatures
     assert first_class(_lazy_tips, TIPS_SIGNATURE) is kernel  # cached: compiled once
+
+
+def test_an_equal_signature_from_another_process_finds_the_same_kernel() -> None:
+    # A kernel unpickled in a worker brings an equal signature that is a new object: it
+    # must find the entry made for the module's own signature (looked up by its text),
+    # and the module's own signature keeps finding it (looked up by identity).
+    kernel = first_class(_lazy_tips, TIPS_SIGNATURE)
+    copy = pickle.loads(pickle.dumps(TIPS_SIGNATURE))
+    assert copy is not TIPS_SIGNATURE and str(copy) == str(TIPS_SIGNATURE)
+    assert first_class(_lazy_tips, copy) is kernel
+    assert first_class(_lazy_tips, TIPS_SIGNATURE) is kernel
+    assert pickle.loads(pickle.dumps(kernel)) is kernel  # first_class again, by text
 
 
 def test_a_kernel_that_cannot_take_its_signature_is_named_in_one_error() -> None:

@@ -47,6 +47,7 @@ class FirstClassKernel:
 
 
 _KERNELS: dict[tuple[int, str], FirstClassKernel] = {}
+_BY_IDENTITY: dict[tuple[int, int], FirstClassKernel] = {}
 
 
 def first_class(dispatcher, signature) -> FirstClassKernel:
@@ -75,8 +76,13 @@ def first_class(dispatcher, signature) -> FirstClassKernel:
         If the kernel was declared with other signatures only, or does not compile
         with ``signature``.
     """
-    # By the signature's text, not its identity: an unpickled kernel (another process)
-    # brings an equal signature that is a new object, and must find the same entry.
+    # First by identity: a plant packs a dozen kernels, and the signature's text takes
+    # tens of microseconds to build.
+    known = _BY_IDENTITY.get((id(dispatcher), id(signature)))
+    if known is not None:
+        return known
+    # Then by the signature's text: an unpickled kernel (another process) brings an
+    # equal signature that is a new object, and must find the same entry.
     key = (id(dispatcher), str(signature))
     if key not in _KERNELS:
         name = getattr(dispatcher, "__name__", dispatcher)
@@ -89,4 +95,7 @@ def first_class(dispatcher, signature) -> FirstClassKernel:
                                 f"{signature} (declare it @njit(cache=True) or with that "
                                 f"signature): {first_line}") from None  # fmt: skip
         _KERNELS[key] = FirstClassKernel(dispatcher, signature)
-    return _KERNELS[key]
+    kernel = _KERNELS[key]
+    if kernel.signature is signature:  # the kernel holds both: their ids stay theirs
+        _BY_IDENTITY[id(dispatcher), id(signature)] = kernel
+    return kernel
