@@ -118,7 +118,7 @@ JOINT_LOCKED = 2.0  # any other set of locks: the general elimination over the f
 MIN_COS = 1e-9  # |cos(rho_y)| below this is treated as gimbal lock
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", inline="always")
 def _rho_cs(q, o):
     """Cosines and sines of the joint angles rho = q[o+3:o+6]: (c1, s1, c2, s2, c3, s3).
 
@@ -129,7 +129,7 @@ def _rho_cs(q, o):
     return cos(q[o + 3]), sin(q[o + 3]), cos(q[o + 4]), sin(q[o + 4]), cos(q[o + 5]), sin(q[o + 5])
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", inline="always")
 def _rho_bias(cs, qd, o):
     """S_dot(rho) rho_dot of the joint angles, from :func:`_rho_cs` [rad/s^2]."""
     return euler_rate_bias_cs(cs[0], cs[1], cs[2], cs[3], qd[o + 3], qd[o + 4], qd[o + 5])
@@ -152,7 +152,7 @@ def _pose(q, o, p, cs):
     return R_BM, R_MP, R_BP, S_rho, r_P, r_G
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", inline="always")
 def _rates(qd, o, p, R_BM, R_BP, S_rho):
     """Relative rates: omega_rel_P (panel frame) and the B-frame rate of r_G."""
     omega_rel_P = mv(S_rho, load_seg(qd, o + 3))
@@ -163,7 +163,7 @@ def _rates(qd, o, p, R_BM, R_BP, S_rho):
     return omega_rel_P, rdot_G_rel
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", inline="always")
 def _joint_forces(q, qd, Q, o, p):
     """Elastic, damping and external generalized forces on the joint (Q_eta, Q_rho)."""
     k, c = P_K, P_C
@@ -180,7 +180,7 @@ def _joint_forces(q, qd, Q, o, p):
     return Q_eta, Q_rho
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", inline="always")
 def _joint_wrench(q, qd, Q, o, p, cs):
     """Joint wrench on the plate from its elastic, damping and external generalized forces.
 
@@ -198,7 +198,7 @@ def _joint_wrench(q, qd, Q, o, p, cs):
     return Q_eta, mtv(S_inv, Q_rho), S_inv, STATUS_OK
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", inline="always")
 def _add_hub_wrench(out, f, r_P, R_BM, R_BP, F_M, N_P):
     """Subtract the joint's reaction from the hub wrench at out[f:f+6]; returns F_B.
 
