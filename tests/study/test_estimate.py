@@ -179,3 +179,15 @@ def test_the_full_study_estimate_on_the_reference_is_near_its_measured_time():
     total = estimate.total_s(estimate.study_estimate(ctx, PARTS, REFERENCE), lanes)
     print(f"full study: estimate {total:.1f} s against {FULL_STUDY_S} s measured")
     assert total == pytest.approx(FULL_STUDY_S, rel=0.10)
+
+
+def test_the_quiet_quick_study_the_overheads_came_from_is_given_back():
+    # The warm quick study of 2026-12-07 at load 0.7-1.3 (QUICK_OVERHEAD_S's docstring):
+    # its calibration slew took 2.706 ms per simulated second, its parts 18.5 s (lane
+    # 0). The overheads were rounded to 0.1 s: 5 % covers the five of lane 0 (0.25 s
+    # at most, 1.4 %) and the case factor's rounding.
+    basis = estimate.Basis(0.0027065, workers=2, side_by_side=2)
+    ctx = pipeline.StudyContext(nominal(), Path("unused"), quick=True)
+    rows = estimate.study_estimate(ctx, PARTS, basis)
+    total = estimate.total_s(rows, {part.name: part.lane for part in PARTS})
+    assert total == pytest.approx(18.5, rel=0.05)

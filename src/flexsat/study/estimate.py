@@ -14,10 +14,11 @@ case :data:`REDUCED_SHARE` of a full one), and each campaign of the campaigns pa
 :data:`CAMPAIGN_OVERHEAD_S` more for its summary and figures.
 
 The constants were measured again on 2026-12-07 (docs/results.md, 'The study
-report'): on the reference the quick study is estimated at 17.6 s (a quiet warm
-quick study takes 21.9 s, whole process, some 3.5 s of which outside the parts:
-loading the kernels, the calibration, the report) and the full study at 104 s
-(106.1 s, whole process, by ``bench/bench_study.py`` on a quiet machine).
+report'): on the reference the quick study is estimated at 19.8 s and the full study
+at 106.2 s (106.1 s measured, whole process, by ``bench/bench_study.py`` on a quiet
+machine); the quiet warm quick study the overheads were measured on, whose
+calibration gave 0.93 times the reference, took 18.5 s in its parts (22.3 s as a
+whole process), which the constants give back.
 
 The estimate is an estimate: a part whose runs stop early takes less, and a
 machine whose load changes during the study, or whose load slows its files and
@@ -48,19 +49,19 @@ REFERENCE_WALL_PER_SIM_S = 0.0029
 """Wall time per simulated second of the calibration slew on the reference machine
 (the quiet 2-core machine the overheads were measured on) [s/s]. Measured 2026-12-07:
 2.9 ms in the calibration of a warm quick study at load 0.4-0.5 and again in two at
-load 1.7-2.7 (the 10 s slew takes 0.03 s: it gets a core even then; a third at load
-1.8 gave 3.7 ms);
+load 1.7-2.7 (the 10 s slew takes 0.03 s: it gets a core even then), 2.7 ms in two
+at load 0.7-1.5 and 3.7 ms in one at load 1.8-3.4;
 :func:`calibrate` seven times in one process at load 3.4, 2.84-3.52 ms, median 2.87.
 It was 0.008 before the loop's steps grew faster: the overheads, scaled by the speed
 against it, then counted about a third of their time (a quick study estimated at
 12.5 s)."""
-CASE_FACTOR = 1.13
+CASE_FACTOR = 1.14
 """A campaign case's wall time against its simulated time at the calibrated rate [-]:
 its records, metrics and stored files besides the run. Measured 2026-12-07 from the
 full study on a quiet machine (``bench/bench_study.py``, load 0.9-2.0): its law
 comparison took 43.1 s for 197 full-model and 185 reduced-model cases of 120 s on two
-workers; less its 1.1 s overhead (:data:`QUICK_OVERHEAD_S`), with
-:data:`REDUCED_SHARE`, that is 1.13 times 120 s at the reference rate a full case on
+workers; less its 0.9 s overhead (:data:`QUICK_OVERHEAD_S`), with
+:data:`REDUCED_SHARE`, that is 1.14 times 120 s at the reference rate a full case on
 each core. ``run_case`` alone (``bench/bench_case_cost.py --cases 5``, load 2.9-4.6)
 takes 0.336-0.338 CPU-s a full case, 0.97 times 120 s at that rate: the rest is the
 campaign's store and its workers."""
@@ -68,40 +69,37 @@ REDUCED_SHARE = 0.09
 """A reduced-model campaign case's wall time against a full-model one's [-]. Measured
 2026-12-07 with ``bench/bench_case_cost.py --cases 5``: 0.0287 against 0.3375 CPU-s
 (load 2.9) and 0.0331 against 0.3357 (load 4.6), 0.085 and 0.099."""
-CAMPAIGN_OVERHEAD_S = 3.4
+CAMPAIGN_OVERHEAD_S = 3.3
 """What each thesis campaign of the full study's campaigns part does besides its cases
 (its summary, its figures, starting its workers) on the reference machine [s]: the
 part took 23.7 s for 69 cases of 120 s in the full study of 2026-12-07 (quiet,
-``bench/bench_study.py``), of which 13.6 s its cases at :data:`CASE_FACTOR` on two
-workers; the other 10.1 s shared among its three campaigns."""
+``bench/bench_study.py``), of which 13.7 s its cases at :data:`CASE_FACTOR` on two
+workers; the other 10.0 s shared among its three campaigns."""
 QUICK_OVERHEAD_S = {
-    "configuration": 0.0, "modal": 2.5, "openloop": 2.2, "slew": 2.7, "frequency": 3.0,
-    "comparison": 1.1, "animation": 1.5, "avionics": 3.9, "laws": 1.1, "pointing": 0.6,
-    "robust": 4.7,
+    "configuration": 0.0, "modal": 3.4, "openloop": 2.9, "slew": 2.4, "frequency": 3.1,
+    "comparison": 1.3, "animation": 2.9, "avionics": 3.6, "laws": 0.9, "pointing": 0.5,
+    "robust": 6.6,
 }  # fmt: skip
 """What each part of the quick study does besides flying its runs (figures, files,
-analyses) on the reference machine [s]. Measured 2026-12-07 in warm quick studies of
-the nominal case at load 1.8-3.4 (two other processes busy: no quiet window that
-day): each part's wall time on the reference taken as its CPU time (its process's
-and its forked processes', those flown side by side counted at half), rounded, less
-its runs at the reference rate: modal 2.5 s, open loop 2.5, slew 3.0, frequency 3.0,
-comparison 1.8, animation 1.5 (lane 1, 11.8 s); robustness 5.0, pointing 0.6,
-avionics 6.0, law comparison 3.5 (lane 0, 17.6 s), near the parts' wall times of an
-earlier quiet quick study (CHANGELOG.md, 'The quick study, on a quiet machine':
-modal 2.4, open loop 2.2, slew 2.7, frequency 3.3, comparison 2.0, animation 1.3,
-avionics 6.6, law comparison 3.8) and the about 18.4 s of today's quiet warm quick
-study's parts (21.9 s whole process, some 3.5 s of it loading the kernels, the
-calibration and the report)."""
+analyses) on the reference machine [s]. Measured 2026-12-07 in a warm quick study of
+the nominal case at load 0.7-1.3 (its own processes, nothing else running): each
+part's wall time less its runs at the rate its calibration measured (2.7 ms per
+simulated second, 0.93 times the reference), divided by that 0.93. The parts took
+modal 3.15 s, open loop 3.07, slew 2.54, frequency 2.91, comparison 1.86, animation
+2.73 (lane 1, 13.1 s); robustness 6.52, pointing 0.49, avionics 5.31, law comparison
+3.03 (lane 0, 18.5 s: the study's parts); the whole process 22.3 s, of which 1.5 s
+loading the kernels. A second run minutes later, with another process starting
+beside it (load 1.1-1.5), took 23.9 s in its parts."""
 FULL_OVERHEAD_FACTOR = {
-    "modal": 3.0, "comparison": 13.0, "animation": 2.5, "avionics": 1.4, "robust": 4.2,
+    "modal": 3.0, "comparison": 13.0, "animation": 2.5, "avionics": 1.4, "robust": 3.0,
 }  # fmt: skip
 """The full study's overhead against the quick one's, per part [-]: three times the
 mode GIFs (6 against 2), each compared law's 13 figures (against the one comparison
 figure), 150 animation frames against 60, the longer delay sweep, the mu grid of 60
 log-spaced frequencies at 200 iterations each against 8 at 100 (72 against 20 with the
 modal ones): measured 2026-12-07, the full study's robustness part took 20.3 s on a
-quiet machine (``bench/bench_study.py``), 4.2 times the quick one's overhead with its
-two 60 s flights."""
+quiet machine (``bench/bench_study.py``, load 0.9-2.0), 3.0 times the quick one's
+overhead with its two 60 s flights at the reference rate."""
 
 
 @dataclass(frozen=True)
