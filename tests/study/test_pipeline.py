@@ -46,6 +46,34 @@ def test_the_study_states_its_estimate_per_part(quick_study):
     assert estimate["basis"].startswith("basis: a 10 s slew flown now took")
 
 
+def test_the_total_wall_time_is_the_longer_lanes_parts(quick_study):
+    # The report's "total" row: the parts of the lane that took longer, one after
+    # another (each lane's own kernel loading is in compilation_s), recomputed here
+    # from the parts' entries; on one core, every part's.
+    _, manifest = quick_study
+    lanes = {part.name: part.lane for part in PARTS}
+    walls = {part["name"]: part["wall_time_s"] for part in manifest["parts"]}
+    per_lane = [sum(w for name, w in walls.items() if lanes[name] == lane) for lane in (0, 1)]
+    expected = max(per_lane) if figure_workers() > 1 else sum(walls.values())
+    assert manifest["total_wall_time_s"] == pytest.approx(expected, rel=1e-12)
+    assert manifest["total_wall_time_s"] >= max(walls.values())
+
+
+def test_a_lane_still_loading_does_not_shorten_the_total():
+    # Lane 0 loads its kernels for 40 s, then runs a 3 s part; lane 1 runs 25 s of
+    # parts meanwhile. The elapsed 43 s less the 40 s of loading would say 3 s; the
+    # total is the longer lane's parts, 25 s (28 s in one lane).
+    entries = [{"name": part.name, "wall_time_s": 0.0} for part in PARTS]
+    lane_1 = [entry for entry, part in zip(entries, PARTS, strict=True) if part.lane == 1]
+    for entry, seconds in zip(lane_1, (10.0, 15.0), strict=False):
+        entry["wall_time_s"] = seconds
+    entries[0]["wall_time_s"] = 3.0  # a lane-0 part
+    assert PARTS[0].lane == 0
+    assert pipeline.parts_wall_time(entries, lanes=2) == 25.0
+    assert pipeline.parts_wall_time(entries, lanes=1) == 28.0
+    assert pipeline.parts_wall_time([], lanes=2) == 0.0
+
+
 def test_every_output_the_manifest_names_exists(quick_study):
     out, manifest = quick_study
 

@@ -66,6 +66,7 @@ __all__ = [
     "Part",
     "StudyContext",
     "chosen_parts",
+    "parts_wall_time",
     "run_study",
 ]
 
@@ -507,9 +508,8 @@ def run_study(
         _announce(console, part, entry, manifest["estimate"], done)
 
     # each lane's own kernels, loaded before its first part: compilation, not the parts'
-    prepared = _run_parts(ctx, record, lanes, per_lane)
-    manifest["compilation_s"] += prepared
-    manifest["total_wall_time_s"] = time.perf_counter() - start - prepared
+    manifest["compilation_s"] += _run_parts(ctx, record, lanes, per_lane)
+    manifest["total_wall_time_s"] = parts_wall_time(manifest["parts"], lanes)
     write_json(out / MANIFEST, manifest)
     report = write_report(out)
     # a part whose section the report could not draw is failed there: study.json says so
@@ -749,6 +749,33 @@ def _run_lane(parts: list[Part], ctx: StudyContext, send, runs: list, parent_pid
         entry = _run_part(part, ctx)
         send.send((part.name, entry, ctx.results.get(part.name)))
     send.close()
+
+
+def parts_wall_time(entries: list[dict], lanes: int) -> float:
+    """The parts' wall time: the longer lane's parts, one after another [s].
+
+    Each lane runs its parts back to back, after loading the kernels only it flies
+    (counted in ``compilation_s``). Subtracting that loading from the elapsed time
+    would be wrong when one lane runs parts while the other is still loading.
+
+    Parameters
+    ----------
+    entries : list of dict
+        The manifest's part entries (``name``, ``wall_time_s`` [s]).
+    lanes : int
+        1, or :data:`LANES` when the parts ran side by side.
+
+    Returns
+    -------
+    float
+        The sum of the wall times of the lane whose parts took longest [s].
+    """
+    lane = {part.name: part.lane if lanes > 1 else 0 for part in PARTS}
+    totals: dict[int, float] = {}
+    for entry in entries:
+        key = lane[entry["name"]]
+        totals[key] = totals.get(key, 0.0) + entry["wall_time_s"]
+    return max(totals.values(), default=0.0)
 
 
 def _entry(part: Part, status: str = "ok", error: str | None = None) -> dict:
