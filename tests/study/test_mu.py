@@ -37,7 +37,9 @@ out here: every scaling gives a valid upper bound, so the peak on the grid alone
 only be lower than the refined one, never invalid, and the claims below rest on the
 lower bound (the worst case and its alpha, which refinement does not touch) and on
 k_max[0] < 1. At SADM 0 deg the refinement did not raise the peak (8.504 with and
-without); it took a quarter of the analysis (72 s against 54 s at load 16-21)."""
+without, with the full eigendecomposition; the peak of the diagonal bound moves with
+its eigensolver's round-off, docs/linear.md); it took a quarter of the analysis (72 s
+against 54 s at load 16-21)."""
 ROUND_OFF_RE = 1e-9
 """Absolute tolerance [1/s] on a closed-loop pole's real part: with zeta = 0 the panels'
 antisymmetric modes (which do not move the hub) are undamped whatever the law, so the
