@@ -489,6 +489,13 @@ def robust_synthesize(
     iterations: Annotated[
         int, typer.Option(help="--method dk: D-K steps after the first design, 1 ... 10.")
     ] = 3,
+    points: Annotated[
+        int,
+        typer.Option(
+            help="--method dk: frequencies of the D step's grid, log-spaced over 1e-3 ... "
+            "1e2 rad/s, 8 ... 200 (fewer: a faster, coarser fit of the scalings)."
+        ),
+    ] = 30,
 ) -> None:
     """H-infinity or mu (D-K) design of an attitude controller for the statespace law.
 
@@ -506,6 +513,8 @@ def robust_synthesize(
         raise ConfigError(f"--method: hinf or dk, got {method!r}")
     if not 1 <= iterations <= 10:
         raise ConfigError(f"--iterations: must be in 1 ... 10, got {iterations}")
+    if not 8 <= points <= 200:
+        raise ConfigError(f"--points: must be in 8 ... 200, got {points}")
     if out.suffix.lower() not in (".npz", ".mat"):
         raise ConfigError(f"--out: the suffix must be .npz or .mat, got {out.suffix or 'none'!r}")
     if not out.parent.is_dir():
@@ -519,11 +528,13 @@ def robust_synthesize(
     cfg = load_config(config)
     model = linearize(Plant.from_config(cfg))
     if method == "dk":
+        import numpy as np
+
         from flexsat.linear.dk import synthesize_dk
         from flexsat.linear.uncertain import uncertain_model
 
         dk = synthesize_dk(model, uncertain_model(cfg), control_dt, order, modes,
-                           n_iterations=iterations)  # fmt: skip
+                           omega=np.logspace(-3, 2, points), n_iterations=iterations)  # fmt: skip
         design, gamma, full = dk, dk.result.gammas[-1], dk.result.controller.nstates
         extra = {"mu_history": list(dk.result.mu_history), "mu": dk.result.mu,
                  "input_uncertainty": dk.r0, "stopped": dk.result.stopped}  # fmt: skip
