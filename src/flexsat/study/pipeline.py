@@ -497,19 +497,17 @@ def run_study(
     lanes = LANES if figure_workers() > 1 else 1
     manifest["compilation_s"], per_lane = _compile(ctx, console, lanes)
     manifest["estimate"] = _estimate(ctx, console, lanes)
-    start = time.perf_counter()
     done: dict[str, dict] = {}
 
     def record(part: Part, entry: dict) -> None:
         done[part.name] = entry
         manifest["parts"] = [done[p.name] for p in PARTS if p.name in done]
-        manifest["total_wall_time_s"] = time.perf_counter() - start
+        manifest["total_wall_time_s"] = parts_wall_time(manifest["parts"], lanes)
         write_json(out / MANIFEST, manifest)
         _announce(console, part, entry, manifest["estimate"], done)
 
     # each lane's own kernels, loaded before its first part: compilation, not the parts'
     manifest["compilation_s"] += _run_parts(ctx, record, lanes, per_lane)
-    manifest["total_wall_time_s"] = parts_wall_time(manifest["parts"], lanes)
     write_json(out / MANIFEST, manifest)
     report = write_report(out)
     # a part whose section the report could not draw is failed there: study.json says so
